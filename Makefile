@@ -1,0 +1,68 @@
+# Fast Multi-Touch (FMT) controller -- top-level commands.
+#   make sim     the main job: the default scene (or SCENE=path) through the chain
+#   make test    the whole suite (model tests + cocotb under Icarus and Verilator)
+#   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file
+#   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
+# Every target installs what it needs the first time (iverilog from Debian, a pinned
+# Python environment in .venv); a second run reinstalls nothing.
+
+SHELL        := /bin/bash
+PYTHON       ?= python3
+VENV         := .venv
+VPY          := $(VENV)/bin/python
+STAMP        := $(VENV)/.installed
+VERILATOR_ROOT := $(abspath $(VENV))/lib/python3.11/site-packages/verilator
+export VERILATOR_ROOT
+export PATH  := $(abspath $(VENV))/bin:$(VERILATOR_ROOT)/bin:$(PATH)
+export PYTHONPATH := $(abspath sim):$(abspath tb)
+# pytest-xdist workers (2 cores here); JOBS=1 for a serial run.
+JOBS         ?= 2
+SCENE        ?= sim/scenes/default.json
+SIM          ?=
+export SIM
+
+.PHONY: all setup sim test test-model test-rtl lint synth clean distclean iverilog
+
+all: test
+
+# ---- environment ---------------------------------------------------------------
+iverilog:
+	@command -v iverilog >/dev/null 2>&1 || { \
+	  echo "iverilog missing: installing Debian's package"; \
+	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq iverilog >/dev/null; \
+	  else sudo apt-get update -qq && sudo apt-get install -y -qq iverilog >/dev/null; fi; }
+
+$(STAMP): requirements.txt
+	@echo "creating $(VENV) with pinned packages (requirements.txt)"
+	@test -x $(VPY) || $(PYTHON) -m venv $(VENV)
+	@$(VPY) -m pip install -q --disable-pip-version-check -r requirements.txt
+	@touch $@
+
+setup: iverilog $(STAMP)
+
+# ---- main job ------------------------------------------------------------------
+sim: setup
+	$(VPY) -m fmt.run_sim --scene $(SCENE)
+
+# ---- tests ---------------------------------------------------------------------
+test: setup lint
+	$(VPY) -m pytest -q -n $(JOBS) sim/tests tb
+
+test-model: setup
+	$(VPY) -m pytest -q -n $(JOBS) sim/tests
+
+test-rtl: setup
+	$(VPY) -m pytest -q -n $(JOBS) tb
+
+lint: setup
+	@bash scripts/lint.sh
+
+synth: setup
+	$(VPY) scripts/synth.py
+
+clean:
+	rm -rf build sim_build .pytest_cache
+	find . -name __pycache__ -prune -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV)

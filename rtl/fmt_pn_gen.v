@@ -1,0 +1,72 @@
+// fmt_pn_gen -- pseudo-noise chip generator shared by the row modulators ("stir")
+// and the column despreaders ("unstir").
+//
+// A Fibonacci LFSR of PN_BITS bits (feedback = XOR of the bits selected by TAPS,
+// shifted in at bit 0, output = bit PN_BITS-1) steps once every chip_len samples.
+// The default polynomial x^15 + x^14 + 1 (TAPS = 15'h6000) is maximal: period
+// 2^15 - 1 chips.  The LFSR is loaded with SEED at reset and free-runs; `enable`
+// only gates the sign that leaves the block (PN off = sign +1 everywhere) so turning
+// the PN on and off never misaligns transmit and receive.
+//
+// tx_sign_o is the transmit sign (1 = multiply by -1) of the current sample.
+// rx_sign_o is the same sequence delayed by rx_delay_i samples (0 = no delay,
+// at most 2^DELAY_W - 1), to line up with the channel delay in front of the ADC.
+// Both outputs are registered; sample i after reset is the i-th cycle with rst low.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_pn_gen #(
+    parameter PN_BITS = `FMT_PN_BITS,   // LFSR length L (period 2^L - 1 chips)
+    parameter TAPS    = 15'h6000,       // feedback taps mask, PN_BITS wide (maximal for L = 15)
+    parameter SEED    = 1,              // non-zero reset state of the LFSR
+    parameter CHIP_W  = 10,             // width of the chip-length setting (samples per chip)
+    parameter DELAY_W = 6               // width of the receive-delay setting
+) (
+    input  wire               clk,
+    input  wire               rst,          // synchronous, active high
+    input  wire               enable_i,     // 0: PN off, both signs stay +1
+    input  wire [CHIP_W-1:0]  chip_len_i,   // samples per chip; 0 is taken as 1
+    input  wire [DELAY_W-1:0] rx_delay_i,   // receive delay in samples
+    output reg                tx_sign_o,    // 1 = invert (transmit side)
+    output reg                rx_sign_o,    // 1 = invert (receive side, delayed)
+    output reg                chip_start_o  // 1 on the first sample of each chip
+);
+
+    localparam DEPTH = 1 << DELAY_W;
+
+    reg [PN_BITS-1:0] lfsr_q;
+    reg [CHIP_W-1:0]  count_q;
+    reg [DEPTH-1:0]   history_q;   // history_q[k] = tx sign of k samples ago
+
+    wire [CHIP_W-1:0] last_count = (chip_len_i == {CHIP_W{1'b0}}) ? {CHIP_W{1'b0}}
+                                                                 : chip_len_i - 1'b1;
+    wire              chip_end   = (count_q >= last_count);
+    wire              feedback   = ^(lfsr_q & TAPS[PN_BITS-1:0]);
+    wire              sign_now   = enable_i & lfsr_q[PN_BITS-1];
+
+    always @(posedge clk) begin
+        if (rst) begin
+            lfsr_q       <= SEED[PN_BITS-1:0];
+            count_q      <= {CHIP_W{1'b0}};
+            history_q    <= {DEPTH{1'b0}};
+            tx_sign_o    <= 1'b0;
+            rx_sign_o    <= 1'b0;
+            chip_start_o <= 1'b0;
+        end else begin
+            if (chip_end) begin
+                count_q <= {CHIP_W{1'b0}};
+                lfsr_q  <= {lfsr_q[PN_BITS-2:0], feedback};
+            end else begin
+                count_q <= count_q + 1'b1;
+            end
+            history_q    <= {history_q[DEPTH-2:0], sign_now};
+            tx_sign_o    <= sign_now;
+            rx_sign_o    <= (rx_delay_i == {DELAY_W{1'b0}}) ? sign_now
+                                                            : history_q[rx_delay_i - 1'b1];
+            chip_start_o <= (count_q == {CHIP_W{1'b0}});
+        end
+    end
+
+endmodule
+
+`default_nettype wire

