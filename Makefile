@@ -29,8 +29,8 @@ all: test
 iverilog:
 	@command -v iverilog >/dev/null 2>&1 || { \
 	  echo "iverilog missing: installing Debian's package"; \
-	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq iverilog >/dev/null; \
-	  else sudo apt-get update -qq && sudo apt-get install -y -qq iverilog >/dev/null; fi; }
+	  if [ "$$(id -u)" = 0 ]; then DEBIAN_FRONTEND=noninteractive apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog >/dev/null; \
+	  else sudo DEBIAN_FRONTEND=noninteractive apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog >/dev/null; fi; }
 
 $(STAMP): requirements.txt
 	@echo "creating $(VENV) with pinned packages (requirements.txt)"
