@@ -1,0 +1,161 @@
+// fmt_flatten -- field flattening of the heat-map stream: z' = (z - offset) * gain.
+//
+// One heat-map row per beat (docs/ARCHITECTURE.md heat-map stream), all COLS columns
+// in parallel (COLS multipliers), a beat may come on every cycle.  Output is the same
+// stream format, delayed by exactly LATENCY = 4 cycles (valid, row, frame, data, eof
+// all delayed alike):
+//   s1: offset/gain RAM read (synchronous, address = row), input registered
+//   s2: d = z - offset, clamped at 0 (a cell below its baseline is noise, not flagged)
+//   s3: p = d * gain                          (HM_W + 16 bits, one DSP48E per column)
+//   s4: q = (p + 2^13) >> 14 (round half up); q > 2^HM_W - 1 -> 2^HM_W - 1, flagged
+// Formats: z, offset, z' unsigned HM_W bits; gain unsigned 16-bit Q2.14 (1.0 = 16384).
+// Bit-exact twin: sim/fmt/flatten.py flatten_fixed().
+//
+// Calibration memory: per cell offset and gain in inferred RAM, one memory per column
+// and kind (ROWS words of HM_W / 16 bits each); written one cell at a time through
+// cal_we_i / cal_sel_i / cal_row_i / cal_col_i / cal_data_i.  A write is seen by beats
+// that arrive at least one cycle after it (read-first RAM).  Power-on / reset does NOT
+// clear the RAM (block RAM has no reset); after configuration load offset 0 / gain
+// 16384 (identity) or a calibration: with INIT_IDENTITY = 1 (default) the memories are
+// initialised to the identity for simulation and FPGA configuration.
+// Saturation: sat_flag_o is sticky (cleared by rst or sat_clr_i), sat_count_o counts
+// saturated cells (saturating counter), one cycle behind the output beat.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_flatten #(
+    parameter ROWS          = `FMT_ROWS,         // heat-map rows
+    parameter COLS          = `FMT_COLS,         // heat-map columns (cells per beat)
+    parameter HM_W          = `FMT_HM_W,         // cell width, unsigned
+    parameter FRAME_W       = 16,                // frame number width
+    parameter CNT_W         = 16,                // saturation counter width
+    parameter INIT_IDENTITY = 1,                 // 1: memories start at offset 0, gain 1.0
+    parameter ROW_IDX_W     = (ROWS > 1) ? $clog2(ROWS) : 1,  // row index width
+    parameter COL_IDX_W     = (COLS > 1) ? $clog2(COLS) : 1   // column index width
+) (
+    input  wire                    clk,
+    input  wire                    rst,          // synchronous, active high
+    // heat-map stream in
+    input  wire                    hm_valid_i,   // one row this cycle
+    input  wire [ROW_IDX_W-1:0]    hm_row_i,     // row index
+    input  wire [FRAME_W-1:0]      hm_frame_i,   // frame number
+    input  wire [COLS*HM_W-1:0]    hm_data_i,    // column c at [c*HM_W +: HM_W]
+    input  wire                    hm_eof_i,     // end of frame marker
+    // heat-map stream out (LATENCY = 4 cycles)
+    output reg                     hm_valid_o,   // flattened row
+    output reg  [ROW_IDX_W-1:0]    hm_row_o,     // row index
+    output reg  [FRAME_W-1:0]      hm_frame_o,   // frame number
+    output reg  [COLS*HM_W-1:0]    hm_data_o,    // flattened cells
+    output reg  [COLS-1:0]         hm_sat_o,     // per column: this cell saturated
+    output reg                     hm_eof_o,     // end of frame marker
+    // calibration write port
+    input  wire                    cal_we_i,     // write one cell's offset or gain
+    input  wire                    cal_sel_i,    // 0 = offset (HM_W bits), 1 = gain (Q2.14)
+    input  wire [ROW_IDX_W-1:0]    cal_row_i,    // cell row
+    input  wire [COL_IDX_W-1:0]    cal_col_i,    // cell column
+    input  wire [15:0]             cal_data_i,   // value (offset uses the low HM_W bits)
+    // saturation monitor
+    input  wire                    sat_clr_i,    // clear flag and counter
+    output reg                     sat_flag_o,   // sticky: some cell saturated
+    output reg  [CNT_W-1:0]        sat_count_o   // saturated cells (stops at all ones)
+);
+
+    localparam GAIN_W = 16;
+    localparam GAIN_FRAC = 14;
+    localparam P_W = HM_W + GAIN_W;
+    localparam [P_W-1:0] HALF = {{(P_W-1){1'b0}}, 1'b1} << (GAIN_FRAC - 1);
+    localparam POP_W = $clog2(COLS + 1);
+
+    // ---- pipeline control -----------------------------------------------------------
+    reg                   v1_q, v2_q, v3_q;
+    reg                   e1_q, e2_q, e3_q;
+    reg [ROW_IDX_W-1:0]   r1_q, r2_q, r3_q;
+    reg [FRAME_W-1:0]     f1_q, f2_q, f3_q;
+    reg [COLS*HM_W-1:0]   z1_q;
+    reg [COLS*HM_W-1:0]   d2_q;
+    reg [COLS*GAIN_W-1:0] g2_q;
+    reg [COLS*P_W-1:0]    p3_q;
+    wire [COLS*HM_W-1:0]  q4;
+    wire [COLS-1:0]       sat4;
+
+    genvar c;
+    generate
+        for (c = 0; c < COLS; c = c + 1) begin : g_col
+            reg [HM_W-1:0]   off_mem  [0:ROWS-1];
+            reg [GAIN_W-1:0] gain_mem [0:ROWS-1];
+            reg [HM_W-1:0]   off_rd_q;
+            reg [GAIN_W-1:0] gain_rd_q;
+            integer i;
+            initial begin
+                for (i = 0; i < ROWS; i = i + 1) begin
+                    off_mem[i]  = {HM_W{1'b0}};
+                    gain_mem[i] = (INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0;
+                end
+            end
+            wire we_col = cal_we_i && (cal_col_i == c);
+            always @(posedge clk) begin
+                if (we_col && !cal_sel_i) off_mem[cal_row_i] <= cal_data_i[HM_W-1:0];
+                if (we_col &&  cal_sel_i) gain_mem[cal_row_i] <= cal_data_i;
+                off_rd_q  <= off_mem[hm_row_i];
+                gain_rd_q <= gain_mem[hm_row_i];
+            end
+
+            // s2: subtract, clamp at zero
+            wire [HM_W:0] diff = {1'b0, z1_q[c*HM_W +: HM_W]} - {1'b0, off_rd_q};
+            always @(posedge clk) begin
+                d2_q[c*HM_W +: HM_W]     <= diff[HM_W] ? {HM_W{1'b0}} : diff[HM_W-1:0];
+                g2_q[c*GAIN_W +: GAIN_W] <= gain_rd_q;
+                // s3: multiply
+                p3_q[c*P_W +: P_W] <= d2_q[c*HM_W +: HM_W] * g2_q[c*GAIN_W +: GAIN_W];
+            end
+            // s4: round half up, saturate (p + HALF cannot overflow P_W: p <= (2^HM_W-1)(2^16-1))
+            /* verilator lint_off UNUSEDSIGNAL */ // the 14 fraction bits are dropped by the rounding
+            wire [P_W-1:0] rnd = p3_q[c*P_W +: P_W] + HALF;
+            /* verilator lint_on UNUSEDSIGNAL */
+            wire [P_W-GAIN_FRAC-1:0] qfull = rnd[P_W-1:GAIN_FRAC];
+            assign sat4[c] = |qfull[P_W-GAIN_FRAC-1:HM_W];
+            assign q4[c*HM_W +: HM_W] = sat4[c] ? {HM_W{1'b1}} : qfull[HM_W-1:0];
+        end
+    endgenerate
+
+    // population count of the saturated cells of the output beat
+    reg [POP_W-1:0] pop;
+    integer k;
+    always @(*) begin
+        pop = {POP_W{1'b0}};
+        for (k = 0; k < COLS; k = k + 1)
+            pop = pop + {{(POP_W-1){1'b0}}, hm_sat_o[k]};
+    end
+    wire [CNT_W:0] cnt_sum = {1'b0, sat_count_o} + {{(CNT_W+1-POP_W){1'b0}}, pop};
+
+    always @(posedge clk) begin
+        z1_q <= hm_data_i;
+        r1_q <= hm_row_i;   f1_q <= hm_frame_i;
+        r2_q <= r1_q;       f2_q <= f1_q;
+        r3_q <= r2_q;       f3_q <= f2_q;
+        hm_row_o   <= r3_q;
+        hm_frame_o <= f3_q;
+        hm_data_o  <= q4;
+        if (rst) begin
+            v1_q <= 1'b0; v2_q <= 1'b0; v3_q <= 1'b0; hm_valid_o <= 1'b0;
+            e1_q <= 1'b0; e2_q <= 1'b0; e3_q <= 1'b0; hm_eof_o   <= 1'b0;
+            hm_sat_o    <= {COLS{1'b0}};
+            sat_flag_o  <= 1'b0;
+            sat_count_o <= {CNT_W{1'b0}};
+        end else begin
+            v1_q <= hm_valid_i; v2_q <= v1_q; v3_q <= v2_q; hm_valid_o <= v3_q;
+            e1_q <= hm_eof_i;   e2_q <= e1_q; e3_q <= e2_q; hm_eof_o   <= e3_q;
+            hm_sat_o <= v3_q ? sat4 : {COLS{1'b0}};
+            if (sat_clr_i) begin
+                sat_flag_o  <= 1'b0;
+                sat_count_o <= {CNT_W{1'b0}};
+            end else begin
+                if (|hm_sat_o) sat_flag_o <= 1'b1;
+                sat_count_o <= cnt_sum[CNT_W] ? {CNT_W{1'b1}} : cnt_sum[CNT_W-1:0];
+            end
+        end
+    end
+
+endmodule
+
+`default_nettype wire
