@@ -1,0 +1,119 @@
+// fmt_pair_split -- separates the spectra of two real columns a, b that share one
+// complex FFT (z = a + j b), at the comb bins only.
+//
+// For comb bin k = BIN_LO + r * BIN_STEP (row r) and its mirror N - k:
+//   2 A[k] = Z[k] + conj(Z[N-k])        = (Zr[k] + Zr[N-k]) + j (Zi[k] - Zi[N-k])
+//   2 B[k] = (Z[k] - conj(Z[N-k])) / j  = (Zi[k] + Zi[N-k]) + j (Zr[N-k] - Zr[k])
+// The outputs are 2A and 2B, EXACT (no rounding): the /2 is not done here but folded
+// into the heat-map scaling of fmt_accum (HM_SHIFT includes it).  Width: W + 1 signed.
+//
+// The bins arrive in any order (bit-reversed from fmt_fft_r22sdf), one per ce cycle.
+// The first of a pair to arrive is held in a ROWS-entry memory (distributed RAM, with
+// a bit saying whether it was k or N-k); when its partner arrives, (2A, 2B) of row r
+// leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
+// clears it.  Twin: sim/fmt/rx_fixed.py pair_split_fixed.
+// Requires BIN_LO >= 1 and BIN_LO + (ROWS-1)*BIN_STEP < N/2 (checked by params.py), so
+// a bin and its mirror are never the same bin.  BIN_STEP that is not a power of two
+// costs a constant divider on the bin index.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_pair_split #(
+    parameter LOG2_N   = `FMT_LOG2_N,    // FFT size N = 2^LOG2_N
+    parameter ROWS     = `FMT_ROWS,      // comb bins (rows)
+    parameter BIN_LO   = `FMT_BIN_LO,    // bin of row 0
+    parameter BIN_STEP = `FMT_BIN_STEP,  // bins between rows
+    parameter W        = 18,             // FFT output width (signed)
+    parameter TAG_W    = 4,              // side band carried from the second bin to the output
+    parameter ROW_W    = (ROWS > 1) ? $clog2(ROWS) : 1  // row index width
+) (
+    input  wire                 clk,
+    input  wire                 rst,       // synchronous, active high
+    input  wire                 ce,        // sample strobe
+    input  wire                 in_valid,  // FFT output bin valid
+    input  wire [LOG2_N-1:0]    in_bin,    // its bin index 0..N-1
+    input  wire signed [W-1:0]  in_re,     // Z[bin] real
+    input  wire signed [W-1:0]  in_im,     // Z[bin] imaginary
+    input  wire [TAG_W-1:0]     in_tag,    // side band (taken with the second bin of a pair)
+    output reg                  out_valid, // one row's (2A, 2B) this ce cycle
+    output reg  [ROW_W-1:0]     out_row,   // row index r
+    output reg  signed [W:0]    a_re,      // 2 Re A[k]
+    output reg  signed [W:0]    a_im,      // 2 Im A[k]
+    output reg  signed [W:0]    b_re,      // 2 Re B[k]
+    output reg  signed [W:0]    b_im,      // 2 Im B[k]
+    output reg  [TAG_W-1:0]     out_tag    // in_tag of the second bin
+);
+
+    localparam N   = 1 << LOG2_N;
+    localparam DW  = LOG2_N + 2;           // signed width for bin differences
+    localparam SPAN = ROWS * BIN_STEP;
+
+    // ---- decode: is in_bin a comb bin (k) or a mirror (N-k), and of which row ----
+    wire signed [DW-1:0] bin_s  = {2'b00, in_bin};
+    wire signed [DW-1:0] d_k    = bin_s - BIN_LO;                 // k - BIN_LO
+    wire signed [DW-1:0] d_m    = N - bin_s - BIN_LO;             // (N - bin) - BIN_LO
+    wire                 hit_k  = (d_k >= 0) && (d_k < SPAN) && ((d_k % BIN_STEP) == 0);
+    wire                 hit_m  = (d_m >= 0) && (d_m < SPAN) && ((d_m % BIN_STEP) == 0);
+    // the quotients are < ROWS when they are used: only their low ROW_W bits matter
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire signed [DW-1:0] r_k    = d_k / BIN_STEP;
+    wire signed [DW-1:0] r_m    = d_m / BIN_STEP;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [ROW_W-1:0]     row    = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
+    wire                 hit    = in_valid && (hit_k || hit_m);
+
+    // ---- held first-of-pair memory ----
+    reg [2*W:0]   mem [0:ROWS-1];          // {is_mirror, re, im}
+    reg [ROWS-1:0] held_q;
+
+    wire [2*W:0]        rd       = mem[row];
+    wire                held     = held_q[row];
+    wire signed [W-1:0] h_re     = rd[2*W-1:W];
+    wire signed [W-1:0] h_im     = rd[W-1:0];
+    // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
+    wire signed [W:0]   p_re = hit_m ? {h_re[W-1], h_re}   : {in_re[W-1], in_re};
+    wire signed [W:0]   p_im = hit_m ? {h_im[W-1], h_im}   : {in_im[W-1], in_im};
+    wire signed [W:0]   q_re = hit_m ? {in_re[W-1], in_re} : {h_re[W-1], h_re};
+    wire signed [W:0]   q_im = hit_m ? {in_im[W-1], in_im} : {h_im[W-1], h_im};
+
+    // the second arrival of a pair: the other member is held
+    wire                second   = held && (rd[2*W] != hit_m);
+
+    always @(posedge clk) begin
+        if (ce && hit && !second) begin
+            mem[row] <= {hit_m, in_re, in_im};
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            held_q    <= {ROWS{1'b0}};
+            out_valid <= 1'b0;
+        end else if (ce) begin
+            out_valid <= 1'b0;
+            if (hit) begin
+                // the second arrival must be the other member of the pair
+                if (second) begin
+                    held_q[row] <= 1'b0;
+                    out_valid   <= 1'b1;
+                end else begin
+                    held_q[row] <= 1'b1;   // first arrival (or a repeat: keep the newest)
+                end
+            end
+        end
+    end
+
+    always @(posedge clk) begin
+        if (ce) begin
+            out_row <= row;
+            a_re    <= p_re + q_re;
+            a_im    <= p_im - q_im;
+            b_re    <= p_im + q_im;
+            b_im    <= q_re - p_re;
+            out_tag <= in_tag;
+        end
+    end
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,212 @@
+"""Fixed-point receive back end: the bit-exact twin of ``fmt_pair_split``,
+``fmt_magnitude``, ``fmt_accum``, ``fmt_col_pair_rx`` and ``fmt_rx_array``, plus the
+floating-point receiver it is measured against.
+
+Chain per column pair (columns 2p, 2p+1; COLS must be even):
+  despread  x = adc * (+1/-1 from rx_sign)                   (ADC_BITS + 1 bits)
+  FFT       Z = fft_fixed(x_a + j x_b) per window of N samples, Z = X * 2^-SHIFT, OUT_W bits
+  split     2A[k] = Z[k] + conj(Z[N-k]),  2B[k] = (Z[k] - conj(Z[N-k])) / j   (exact, OUT_W+1)
+  magnitude CORDIC vectoring, ITER = 12, GUARD = 4, gain compensated, round half up
+  accum     sum over M = 2^m windows, cell = (sum + 2^(s-1)) >> s, s = m + HM_SHIFT,
+            saturated to HM_W bits (sticky flag)
+With HM_SHIFT = 1 a cell is |A[k]| * 2^-SHIFT (FFT output LSBs), averaged over M.
+
+Rounding: everything is exact except (1) the FFT's own rounding (``fft_fixed``), (2) the
+CORDIC (arithmetic right shifts = floor inside the iterations, final round half up),
+(3) the accumulator's round half up.  Integer arithmetic is numpy int64 throughout.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import params as _params
+
+MAG_ITER = 12        # CORDIC iterations (fmt_magnitude ITER)
+MAG_GUARD = 4        # CORDIC guard bits (fmt_magnitude GUARD)
+MAG_GAIN_BITS = 16   # fractional bits of the gain-compensation constant
+M_LOG2_MAX = 3       # fmt_accum M_LOG2_MAX: M in 1, 2, 4, 8
+HM_SHIFT = 1         # fmt_accum HM_SHIFT: undo the factor 2 of the pair split
+
+
+def cordic_gain(iters: int = MAG_ITER) -> float:
+    """CORDIC vectoring gain K = prod sqrt(1 + 2^-2i), i = 0..iters-1."""
+    return float(np.prod([math.sqrt(1.0 + 2.0 ** (-2 * i)) for i in range(iters)]))
+
+
+def cordic_gain_const(iters: int = MAG_ITER, gain_bits: int = MAG_GAIN_BITS) -> int:
+    """fmt_magnitude GAIN_C = round(2^gain_bits / K)."""
+    return int(round(2 ** gain_bits / cordic_gain(iters)))
+
+
+# ---- magnitude -----------------------------------------------------------------------
+def magnitude_float(re, im) -> np.ndarray:
+    return np.hypot(np.asarray(re, dtype=float), np.asarray(im, dtype=float))
+
+
+def magnitude_fixed(re, im, iters: int = MAG_ITER, guard: int = MAG_GUARD,
+                    gain_bits: int = MAG_GAIN_BITS) -> np.ndarray:
+    """Bit-exact twin of fmt_magnitude (any input width: the RTL sizes itself)."""
+    x = np.abs(np.asarray(re, dtype=np.int64)) << guard
+    y = np.asarray(im, dtype=np.int64) << guard
+    for i in range(iters):
+        neg = y < 0
+        dx = y >> i
+        dy = x >> i
+        x, y = np.where(neg, x - dx, x + dx), np.where(neg, y + dy, y - dy)
+    gc = cordic_gain_const(iters, gain_bits)
+    sh = gain_bits + guard
+    return (x * gc + (1 << (sh - 1))) >> sh
+
+
+# ---- pair split ----------------------------------------------------------------------
+def comb_bins(cfg) -> np.ndarray:
+    return np.asarray(cfg.bins, dtype=np.int64)
+
+
+def pair_split_fixed(z_re, z_im, cfg):
+    """(2A, 2B) per comb bin from natural-order FFT bins z (..., N): exact integers.
+
+    Returns a_re, a_im, b_re, b_im of shape (..., rows)."""
+    z_re = np.asarray(z_re, dtype=np.int64)
+    z_im = np.asarray(z_im, dtype=np.int64)
+    k = comb_bins(cfg)
+    m = cfg.n_fft - k
+    a_re = z_re[..., k] + z_re[..., m]
+    a_im = z_im[..., k] - z_im[..., m]
+    b_re = z_im[..., k] + z_im[..., m]
+    b_im = z_re[..., m] - z_re[..., k]
+    return a_re, a_im, b_re, b_im
+
+
+def pair_split_float(z):
+    """A, B spectra (complex, natural order, full length) of z = a + j b."""
+    z = np.asarray(z, dtype=complex)
+    n = z.shape[-1]
+    zm = np.conj(z[..., (-np.arange(n)) % n])
+    return (z + zm) / 2, (z - zm) / 2j
+
+
+def bitrev(i: int, bits: int) -> int:
+    return int(f"{i:0{bits}b}"[::-1], 2) if bits else 0
+
+
+def completion_slots(cfg) -> np.ndarray:
+    """Bit-reversed output slot at which row r's pair (k, N-k) is complete."""
+    b = cfg.log2_n
+    return np.array([max(bitrev(k, b), bitrev(cfg.n_fft - k, b)) for k in cfg.bins])
+
+
+def row_order(cfg) -> np.ndarray:
+    """Rows in the order the heat-map stream emits them (order of completion)."""
+    return np.argsort(completion_slots(cfg), kind="stable")
+
+
+# ---- accumulation --------------------------------------------------------------------
+def accum_fixed(mags, m_log2: int, hm_w: int, hm_shift: int = HM_SHIFT):
+    """mags (windows, ...) unsigned ints -> (cells (frames, ...), saturated flag).
+
+    Frames are consecutive groups of M = 2^m_log2 windows from window 0; a trailing
+    partial frame is dropped (the RTL never emits it)."""
+    mags = np.asarray(mags, dtype=np.int64)
+    m = 1 << m_log2
+    frames = mags.shape[0] // m
+    s = mags[:frames * m].reshape((frames, m) + mags.shape[1:]).sum(axis=1)
+    sh = m_log2 + hm_shift
+    cell = (s + ((1 << sh) >> 1)) >> sh
+    top = (1 << hm_w) - 1
+    sat = bool((cell > top).any())
+    return np.minimum(cell, top), sat
+
+
+# ---- the whole receive path ----------------------------------------------------------
+@dataclass(frozen=True)
+class RxFlags:
+    fft_ovf: bool
+    sat: bool
+
+    @property
+    def any(self) -> bool:
+        return self.fft_ovf or self.sat
+
+
+def despread_fixed(adc, rx_sign) -> np.ndarray:
+    """adc (samples, cols) x (+1/-1): rx_sign 1 = invert.  ADC_BITS + 1 bits."""
+    adc = np.asarray(adc, dtype=np.int64)
+    s = 1 - 2 * np.asarray(rx_sign, dtype=np.int64)
+    return adc * s[:, None]
+
+
+def _default_fft():
+    from . import fft_fixed as _f   # the FFT engineer's twin of fmt_fft_r22sdf
+    return _f
+
+
+def fft_windows_fixed(x_re, x_im, cfg, fft_kw=None):
+    """Per-window natural-order fixed-point FFT of (windows, N) int arrays -> (re, im, ovf)."""
+    f = _default_fft()
+    fft_kw = dict(fft_kw or {})
+    out_re = np.empty(x_re.shape, dtype=np.int64)
+    out_im = np.empty(x_re.shape, dtype=np.int64)
+    ovf = False
+    for w in range(x_re.shape[0]):
+        r, i, o = f.fft_fixed(x_re[w], x_im[w], cfg.log2_n, cfg.adc_bits + 1, **fft_kw)
+        out_re[w] = r
+        out_im[w] = i
+        ovf = ovf or bool(o)
+    return out_re, out_im, ovf
+
+
+def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHIFT,
+                      fft_kw=None, fft_fn=None):
+    """Bit-exact twin of fmt_rx_array.
+
+    adc (samples, cols) int (ADC_BITS two's complement values), rx_sign (samples,) 0/1
+    (the receive PN sign of each sample, as fmt_pn_gen rx_sign_o).  Windows start at
+    sample 0 (the first ce after reset); only complete frames of M = 2^m_log2 windows are
+    returned.  Returns (heatmaps (frames, rows, cols) int64, row_order (rows,), RxFlags).
+    ``fft_fn(x_re, x_im) -> (Z_re, Z_im, ovf)`` on (windows, N) arrays replaces the
+    default fft_fixed (tests of the blocks without the FFT).
+    """
+    adc = np.asarray(adc, dtype=np.int64)
+    n, cols = cfg.n_fft, adc.shape[1]
+    if cols % 2:
+        raise ValueError("COLS must be even (columns are received in pairs)")
+    x = despread_fixed(adc, rx_sign)
+    wins = x.shape[0] // n
+    x = x[:wins * n].reshape(wins, n, cols)
+    mags = np.zeros((wins, cfg.rows, cols), dtype=np.int64)
+    ovf = False
+    for p in range(cols // 2):
+        xr, xi = x[:, :, 2 * p], x[:, :, 2 * p + 1]
+        if fft_fn is None:
+            zr, zi, o = fft_windows_fixed(xr, xi, cfg, fft_kw)
+        else:
+            zr, zi, o = fft_fn(xr, xi)
+        ovf = ovf or bool(o)
+        a_re, a_im, b_re, b_im = pair_split_fixed(zr, zi, cfg)
+        mags[:, :, 2 * p] = magnitude_fixed(a_re, a_im)
+        mags[:, :, 2 * p + 1] = magnitude_fixed(b_re, b_im)
+    hm, sat = accum_fixed(mags, m_log2, cfg.hm_width, hm_shift)
+    return hm, row_order(cfg), RxFlags(fft_ovf=ovf, sat=sat)
+
+
+def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, fft_shift: float = 0.0):
+    """Floating-point receiver of the same despread samples: numpy FFT per real column,
+    exact magnitude at the comb bins, mean over M windows, in the fixed path's units
+    (|X[k]| * 2^-fft_shift, fft_shift = the FFT's output scaling SHIFT)."""
+    x = despread_fixed(adc, rx_sign).astype(float)
+    n = cfg.n_fft
+    wins = x.shape[0] // n
+    x = x[:wins * n].reshape(wins, n, -1)
+    X = np.fft.fft(x, axis=1)[:, comb_bins(cfg), :]          # (wins, rows, cols)
+    mag = np.abs(X) * 2.0 ** (-fft_shift)
+    m = 1 << m_log2
+    frames = wins // m
+    return mag[:frames * m].reshape(frames, m, cfg.rows, -1).mean(axis=1)
+
+
+def get_cfg(name: str):
+    return _params.get(name)

@@ -1,0 +1,116 @@
+"""Model tests of sim/fmt/rx_fixed.py: the fixed-point receive back end against exact
+references (pair split, magnitude error bound, accumulation, row order)."""
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fmt import params
+from fmt import rx_fixed as R
+
+RTL = Path(__file__).resolve().parents[2] / "rtl"
+
+
+def test_gain_constant_matches_rtl_default():
+    """fmt_magnitude's GAIN_C default equals round(2^16 / K(12))."""
+    src = (RTL / "fmt_magnitude.v").read_text()
+    m = re.search(r"parameter\s+GAIN_C\s*=\s*(\d+)", src)
+    assert m and int(m.group(1)) == R.cordic_gain_const(R.MAG_ITER, R.MAG_GAIN_BITS)
+    assert abs(R.cordic_gain(12) - 1.6467602) < 1e-6
+
+
+@pytest.mark.parametrize("w", [13, 16, 19, 21])
+def test_magnitude_error_bound(w):
+    """|mag - hypot| <= 1 LSB + 6.3e-6 * hypot (the second term is the rounding of the
+    16-bit gain constant, a fixed relative gain error); mean bias < 0.1 LSB + that gain."""
+    rng = np.random.default_rng(w)
+    re_ = rng.integers(-(1 << (w - 1)), 1 << (w - 1), 100_000)
+    im_ = rng.integers(-(1 << (w - 1)), 1 << (w - 1), 100_000)
+    # plus the corners: extremes and axes
+    lo, hi = -(1 << (w - 1)), (1 << (w - 1)) - 1
+    re_ = np.concatenate([re_, [lo, lo, hi, hi, 0, 0, lo, 1, -1]])
+    im_ = np.concatenate([im_, [lo, hi, lo, hi, lo, hi, 0, 0, 0]])
+    ex = np.hypot(re_, im_)
+    m = R.magnitude_fixed(re_, im_)
+    gain_err = abs(R.cordic_gain_const() / 2 ** R.MAG_GAIN_BITS * R.cordic_gain() - 1)
+    assert gain_err < 6.3e-6
+    e = m - ex
+    assert np.all(np.abs(e) <= 1.0 + gain_err * ex), np.abs(e).max()
+    assert np.all(m < (1 << w)), "output fits IN_W bits unsigned"
+    assert abs(e.mean()) < 0.1 + gain_err * ex.mean()
+
+
+def test_magnitude_small_values_exactish():
+    """Small magnitudes (weak touches): error within 0.8 LSB."""
+    g = np.arange(-64, 65)
+    re_, im_ = np.meshgrid(g, g)
+    e = R.magnitude_fixed(re_, im_) - np.hypot(re_, im_)
+    assert np.abs(e).max() <= 0.8
+
+
+@pytest.mark.parametrize("name", ["small", "medium", "default"])
+def test_pair_split_exact(name):
+    """(2A, 2B) from the shared complex FFT equal twice the real columns' own spectra."""
+    cfg = params.get(name)
+    rng = np.random.default_rng(3)
+    a = rng.integers(-2048, 2048, (5, cfg.n_fft))
+    b = rng.integers(-2048, 2048, (5, cfg.n_fft))
+    z = np.fft.fft(a + 1j * b, axis=-1)
+    # integer-valued test spectra: round the float FFT (the split itself is exact)
+    zr, zi = np.round(z.real).astype(np.int64), np.round(z.imag).astype(np.int64)
+    ar, ai, br, bi = R.pair_split_fixed(zr, zi, cfg)
+    A, B = R.pair_split_float(zr + 1j * zi)
+    k = R.comb_bins(cfg)
+    assert np.array_equal(ar, np.round(2 * A[:, k].real)) and np.array_equal(ai, np.round(2 * A[:, k].imag))
+    assert np.array_equal(br, np.round(2 * B[:, k].real)) and np.array_equal(bi, np.round(2 * B[:, k].imag))
+    # and the float split recovers the real FFTs
+    A0, B0 = R.pair_split_float(z)
+    assert np.allclose(A0, np.fft.fft(a, axis=-1), atol=1e-6)
+    assert np.allclose(B0, np.fft.fft(b, axis=-1), atol=1e-6)
+
+
+def test_completion_slots_default():
+    """N = 256: the last comb pair completes at slot 251 (bin 33 and its mirror 223)."""
+    cfg = params.DEFAULT
+    s = R.completion_slots(cfg)
+    assert s.max() == 251 and cfg.bins[int(np.argmax(s))] == 33
+    assert R.bitrev(223, 8) == 251
+    order = R.row_order(cfg)
+    assert sorted(order.tolist()) == list(range(cfg.rows))
+    assert np.all(np.diff(s[order]) > 0), "one completion per slot"
+
+
+@pytest.mark.parametrize("m_log2", [0, 1, 2, 3])
+def test_accum_rounding_and_saturation(m_log2):
+    rng = np.random.default_rng(m_log2)
+    mags = rng.integers(0, 1 << 18, (4 << m_log2, 3, 2))
+    cell, sat = R.accum_fixed(mags, m_log2, 16)
+    m = 1 << m_log2
+    mean_half = mags.reshape(4, m, 3, 2).sum(1) / (2 * m)
+    exact = np.floor(mean_half + 0.5)
+    assert np.array_equal(cell, np.minimum(exact, 65535))
+    assert sat == bool((exact > 65535).any())
+    small, sat2 = R.accum_fixed(mags >> 4, m_log2, 16)
+    assert not sat2 and np.all(np.abs(small - (mags >> 4).reshape(4, m, 3, 2).sum(1) / (2 * m)) <= 0.5)
+
+
+def test_accum_drops_partial_frame():
+    cell, _ = R.accum_fixed(np.ones((7, 2, 2), dtype=np.int64) * 10, 2, 16)
+    assert cell.shape[0] == 1 and np.all(cell == 5)
+
+
+def test_float_receiver_tone():
+    """The float reference sees a pure tone on bin k of column 0 as N/2 * amplitude."""
+    cfg = params.SMALL
+    n = cfg.n_fft
+    t = np.arange(2 * n)
+    adc = np.zeros((2 * n, cfg.cols), dtype=np.int64)
+    adc[:, 0] = np.round(1000 * np.cos(2 * math.pi * cfg.bins[1] * t / n))
+    hm = R.rx_heatmaps_float(adc, np.zeros(2 * n, dtype=np.uint8), cfg, m_log2=1)
+    assert hm.shape == (1, cfg.rows, cfg.cols)
+    assert abs(hm[0, 1, 0] - 1000 * n / 2) < 2
+    assert hm[0, 0, 0] < 1 and hm[0, 1, 1] < 1e-6
