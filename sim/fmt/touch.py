@@ -1,0 +1,122 @@
+"""The touch-processing pipeline: heat maps -> touch events (twin of ``rtl/fmt_touch.v``).
+
+    flatten (fmt.flatten) -> 3x3 local maxima above the threshold (fmt.localmax)
+    [-> blobs (fmt.blobs), model only, off by default] -> paraboloid fits (fmt.interp)
+    -> frame matching (fmt.tracking)
+
+``fixed=True`` runs the bit-exact twins of the RTL blocks (integer heat maps); the
+events then equal the RTL's event stream (without time stamps).  ``fixed=False`` runs
+the floating-point references (flatten without rounding, float fits); the fine touches
+are then quantised to the event format (Q8.8 round half up, angle to pi/256) only to
+enter the tracker, whose arithmetic is integer anyway.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import flatten as _flatten
+from . import interp as _interp
+from . import localmax as _localmax
+from .params import SensorConfig
+from .settings import TouchSettings
+from .tracking import Touch, TouchEvent, Tracker, TrackParams
+
+
+def _touch_from_fixed(tp) -> Touch:
+    return Touch(int(tp.x), int(tp.y), int(tp.strength), int(tp.axis_major),
+                 int(tp.axis_minor), int(tp.angle), int(tp.flags))
+
+
+def _touch_from_float(tp) -> Touch:
+    q = 256.0
+    rq = lambda v: int(math.floor(v * q + 0.5))
+    ang = int(math.floor(tp.angle / math.pi * 256 + 0.5)) & 255
+    return Touch(rq(tp.x), rq(tp.y), int(round(tp.strength)), rq(tp.axis_major),
+                 rq(tp.axis_minor), ang, int(tp.flags))
+
+
+def _float3x3(z, r: int, c: int) -> np.ndarray:
+    """3x3 float neighbourhood (0 outside the sensor)."""
+    rows, cols = z.shape
+    z3 = np.zeros((3, 3))
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if 0 <= r + dy < rows and 0 <= c + dx < cols:
+                z3[dy + 1, dx + 1] = z[r + dy, c + dx]
+    return z3
+
+
+class TouchPipeline:
+    """Stateful pipeline (the tracker keeps contacts across calls)."""
+
+    def __init__(self, cfg: SensorConfig, settings: TouchSettings | None = None,
+                 fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
+                 track_params: TrackParams | None = None, blobs: bool = False):
+        self.cfg = cfg
+        self.s = settings or TouchSettings()
+        self.fixed = fixed
+        self.offset, self.gain = flatten_cal if flatten_cal is not None else _flatten.identity(cfg)
+        self.tp = track_params or TrackParams.from_settings(cfg, self.s, frame_period_s)
+        self.tracker = Tracker(self.tp)
+        self.blobs = blobs
+        self.max_touches = self.s.max_touches if self.s.max_touches is not None else cfg.max_touches
+        self.moore = self.s.neighbourhood == "moore"
+
+    def touches(self, hm_flat, frame: int) -> tuple[list, list]:
+        """Fine touches (tracker input) and blobs of one flattened heat map."""
+        s = self.s
+        zi = np.rint(hm_flat).astype(np.int64) if not self.fixed else hm_flat
+        cands, _, _ = _localmax.local_maxima_fixed(zi, s.threshold, s.neighbourhood,
+                                                   self.max_touches)
+        blobs = []
+        if self.blobs:
+            from . import blobs as _blobs
+            cands, blobs = _blobs.split_touches(zi, cands, s.blob_threshold, s.blob_min_cells)
+        if self.fixed:
+            tps = _interp.interp_frame_fixed(cands, self.cfg, self.moore, s.bias_correction, frame)
+            return [_touch_from_fixed(t) for t in tps], blobs
+        fc = []
+        for c in cands:
+            fc.append(_localmax.Candidate(c.row, c.col, _float3x3(hm_flat, c.row, c.col),
+                                          c.missing))
+        tps = _interp.interp_frame(fc, self.cfg, self.moore, s.bias_correction, frame)
+        return [_touch_from_float(t) for t in tps], blobs
+
+    def flatten(self, heatmaps):
+        if self.fixed:
+            out, _ = _flatten.flatten_fixed(np.asarray(heatmaps, dtype=np.int64), self.offset,
+                                            self.gain, self.cfg)
+            return out
+        return _flatten.flatten(heatmaps, self.offset, self.gain, self.cfg)
+
+    def run(self, heatmaps, first_frame: int = 0) -> list[list[TouchEvent]]:
+        flat = self.flatten(heatmaps)          # vectorised over the frames
+        out = []
+        for k in range(flat.shape[0]):
+            fr = (first_frame + k) & 0xFFFF
+            ts, blobs = self.touches(flat[k], fr)
+            evs = self.tracker.step(fr, ts)
+            for b in blobs:                    # model only: one 'blob' event per blob
+                evs.append(TouchEvent(fr, 0xFF, "blob", b.cx_q, b.cy_q, b.peak))
+            out.append(evs)
+        return out
+
+
+def process_frames(heatmaps, cfg: SensorConfig, settings: TouchSettings | None = None,
+                   fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
+                   first_frame: int = 0, blobs: bool = False) -> list[list[TouchEvent]]:
+    """Heat maps (frames, rows, cols) -> list (per frame) of TouchEvent lists.
+
+    ``flatten_cal`` = (offset, gain) arrays (default: identity).  ``frame_period_s``
+    converts the tracking settings (default one window, M = 1).  ``blobs=True`` adds the
+    blob stage (model only, no RTL twin): maxima inside a blob are not fingers, each
+    blob gives a 'blob' event (id 0xFF, x/y = centroid, strength = peak) after the
+    tracker's events.  With ``fixed=True, blobs=False`` the events are bit-exact with
+    ``rtl/fmt_touch.v`` (per frame, in the RTL's order)."""
+    hm = np.asarray(heatmaps)
+    if hm.ndim == 2:
+        hm = hm[None]
+    p = TouchPipeline(cfg, settings, fixed, flatten_cal, frame_period_s, blobs=blobs)
+    return p.run(hm, first_frame)
