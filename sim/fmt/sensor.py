@@ -150,15 +150,36 @@ def _to_unit(ct: np.ndarray, x, y):
 
 
 def _disk_maps(cfg: SensorConfig, ct: np.ndarray) -> np.ndarray:
-    x0, x1, y0, y1 = _cell_edges(cfg)
-    # corners CCW (math orientation): (x0,y0) (x1,y0) (x1,y1) (x0,y1); shape (K, R, C, 4)
-    X = np.stack(np.broadcast_arrays(x0[None, :], x1[None, :], x1[None, :], x0[None, :]), -1)
-    Y = np.stack(np.broadcast_arrays(y0[:, None], y0[:, None], y1[:, None], y1[:, None]), -1)
-    X = np.broadcast_to(X, (cfg.rows, cfg.cols, 4))[None]
-    Y = np.broadcast_to(Y, (cfg.rows, cfg.cols, 4))[None]
+    """Exact touched areas.  Only the cells of each contact's bounding box are evaluated
+    (a box of the largest contact's size, positioned per contact; cells outside the
+    ellipse's bounding circle are exactly 0)."""
+    p = cfg.pitch_mm
+    k = ct.shape[0]
+    rad = np.maximum(ct[:, 2], ct[:, 4])
+    c_lo = np.clip(np.floor((ct[:, 0] - rad) / p + 0.5).astype(np.int64), 0, cfg.cols - 1)
+    c_hi = np.clip(np.floor((ct[:, 0] + rad) / p + 0.5).astype(np.int64), 0, cfg.cols - 1)
+    r_lo = np.clip(np.floor((ct[:, 1] - rad) / p + 0.5).astype(np.int64), 0, cfg.rows - 1)
+    r_hi = np.clip(np.floor((ct[:, 1] + rad) / p + 0.5).astype(np.int64), 0, cfg.rows - 1)
+    sc = int((c_hi - c_lo).max()) + 1
+    sr = int((r_hi - r_lo).max()) + 1
+    ci = c_lo[:, None] + np.arange(sc)[None, :]            # (K, sc) column indices
+    ri = r_lo[:, None] + np.arange(sr)[None, :]            # (K, sr)
+    ok = (ci[:, None, :] < cfg.cols) & (ri[:, :, None] < cfg.rows)   # (K, sr, sc)
+    x0 = ((ci - 0.5) * p)[:, None, :, None]
+    x1 = x0 + p
+    y0 = ((ri - 0.5) * p)[:, :, None, None]
+    y1 = y0 + p
+    shp = (k, sr, sc, 1)
+    X = np.concatenate([np.broadcast_to(v, shp) for v in (x0, x1, x1, x0)], axis=-1)
+    Y = np.concatenate([np.broadcast_to(v, shp) for v in (y0, y0, y1, y1)], axis=-1)
     ux, uy = _to_unit(ct, X, Y)
     area = np.abs(_circle_polygon_area(ux, uy)) * (ct[:, 2] * ct[:, 4])[:, None, None]
-    return area / cfg.pitch_mm ** 2
+    out = np.zeros((k, cfg.rows, cfg.cols))
+    kk = np.broadcast_to(np.arange(k)[:, None, None], ok.shape)
+    rr = np.broadcast_to(ri[:, :, None], ok.shape)
+    cc = np.broadcast_to(ci[:, None, :], ok.shape)
+    out[kk[ok], rr[ok], cc[ok]] = area[ok]
+    return out / p ** 2
 
 
 _ERF = np.frompyfunc(math.erf, 1, 1)

@@ -1,0 +1,287 @@
+"""``make sim``: a scene through the floating-point model, with an accuracy report.
+
+    python -m fmt.run_sim --scene sim/scenes/default.json [--out build/sim] [--frames F]
+                          [--render] [--no-plot] [--quiet]
+
+1. Calibration of the field flattening from the model itself (``fmt.flatten.calibrate``):
+   untouched frames and frames with a uniform calibration sheet (coupling 0.25 on every
+   cell), both rendered noiselessly with the scene's baseline, attenuation and tones.
+2. ADC streams -> float receiver -> heat maps (``fmt.chain.heatmaps_float``), or the
+   render without signal synthesis with ``--render``.
+3. Post-processing: ``fmt.touch.process_frames(heatmaps, cfg, settings, fixed=False)``
+   (with the calibration and the frame period when it accepts them).
+4. ``<out>/<scene>/report.json`` and ``<out>/<scene>/heatmap.png``.
+
+Report fields: ``frames``; ``touches`` (detected contacts per frame: min/mean/max, and
+the true count's mean); ``position_error_mm`` against the scene's truth at each frame's
+centre time (detections matched to true contacts, nearest first, within
+``MATCH_MM``): ``rms`` and ``max`` over contacts more than 3.5 mm from every edge,
+``rms_edge`` / ``max_edge`` over contacts centred 1.5 - 3.5 mm from an edge, the counts;
+frames whose windows hold a contact's onset or lift (partial coupling) are left out of
+the errors, and a detection of such a contact there counts neither as false nor missed;
+``missed`` (true contacts touching the whole frame without a detection) / ``false``
+(detections matching no contact); ``jitter_mm`` (RMS distance about the mean position
+of each stationary, always-touching contact; the worst one and per contact);
+``tap_latency_us`` (tap onset sample -> end of the first frame that reports the contact,
+i.e. the model's window-alignment latency, without the RTL's processing time);
+``model_frames_per_s`` (the signal chain alone) and ``total_frames_per_s``;
+``clipped_samples``; ``noise_sigma_lsb``.
+"""
+from __future__ import annotations
+
+import argparse
+import inspect
+import json
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import chain as _chain
+from . import scene as _scene
+from .settings import TouchSettings
+
+MATCH_MM = 10.0          # a detection farther than this from every true contact is false
+EDGE_LO_MM, EDGE_HI_MM = 1.5, 3.5
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def calibration(scene: _scene.Scene, sheet: float = 0.25):
+    """(offset, gain) of the field flattening from noiseless renders of the scene's sensor:
+    untouched, and covered by a uniform sheet of coupling ``sheet`` (see the module
+    docstring).  Uses ``fmt.flatten.calibrate``."""
+    from . import flatten as _flatten
+    cfg = scene.cfg
+    eff = {k: v for k, v in scene.effects.items() if k != "noise"}
+    base = scene.replace(contacts=[], effects=eff, frames=1, m=1)
+    # a disk far larger than the sensor covers every cell: coupling = strength exactly
+    big = 4.0 * math.hypot(cfg.width_mm, cfg.height_mm)
+    sheet_sc = scene.replace(contacts=[{"name": "sheet", "diameter_mm": big, "strength": sheet,
+                                        "path": [[0.0, cfg.width_mm / 2, cfg.height_mm / 2]]}],
+                             effects=eff, frames=1, m=1)
+    u = _chain.render_heatmaps(base, noise=False)
+    c = _chain.render_heatmaps(sheet_sc, noise=False)
+    return _flatten.calibrate(u, c, None, cfg)
+
+
+def default_processor(heatmaps, scene: _scene.Scene, settings: TouchSettings, flatten_cal):
+    """fmt.touch.process_frames (float), given the calibration and frame period when its
+    signature takes them."""
+    from . import touch as _touch
+    fn = _touch.process_frames
+    kw = {}
+    sig = inspect.signature(fn).parameters
+    if "flatten_cal" in sig:
+        kw["flatten_cal"] = flatten_cal
+    if "frame_period_s" in sig:
+        kw["frame_period_s"] = scene.frame_period_s
+    return fn(heatmaps, scene.cfg, settings, fixed=False, **kw)
+
+
+def _ev(e, name, default=None):
+    if isinstance(e, dict):
+        return e.get(name, default)
+    return getattr(e, name, default)
+
+
+def detections(frame_events, cfg) -> list:
+    """Per frame: list of (id, x_mm, y_mm) of the live contacts (events 'new'/'move')."""
+    q = float(1 << cfg.frac_bits)
+    out = []
+    for evs in frame_events:
+        d = []
+        for e in evs:
+            if _ev(e, "type") in ("new", "move"):
+                d.append((int(_ev(e, "id")), _ev(e, "x_q") / q * cfg.pitch_mm,
+                          _ev(e, "y_q") / q * cfg.pitch_mm))
+        out.append(d)
+    return out
+
+
+def _match(truth, det):
+    """Greedy nearest matching -> list of (truth index, det index, distance mm)."""
+    pairs = []
+    for i, t in enumerate(truth):
+        for j, d in enumerate(det):
+            pairs.append((math.hypot(t["x_mm"] - d[1], t["y_mm"] - d[2]), i, j))
+    pairs.sort()
+    ti, dj, out = set(), set(), []
+    for dist, i, j in pairs:
+        if dist > MATCH_MM or i in ti or j in dj:
+            continue
+        ti.add(i)
+        dj.add(j)
+        out.append((i, j, dist))
+    return out
+
+
+def _rms(v):
+    return float(math.sqrt(np.mean(np.square(v)))) if len(v) else None
+
+
+def evaluate(scene: _scene.Scene, det: list) -> dict:
+    """Accuracy, jitter, misses and tap latency of per-frame detections against the truth."""
+    cfg = scene.cfg
+    fs, spf = cfg.fs_hz, scene.samples_per_frame
+    frames = len(det)
+    edges = np.arange(frames + 1, dtype=np.int64) * spf
+    partial = [np.asarray([(0 < f < 1) for f in c.active_fraction(edges, fs)]) for c in scene.contacts]
+    err_in, err_edge, missed, false = [], [], 0, 0
+    pos = {i: [] for i in range(len(scene.contacts))}
+    truth_count = []
+    for f in range(frames):
+        tc = (f + 0.5) * spf / fs
+        truth = scene.truth(tc)
+        truth_count.append(len(truth))
+        # contacts touching for part of this frame's windows may or may not be reported
+        have = {t["index"] for t in truth}
+        for i, c in enumerate(scene.contacts):
+            if partial[i][f] and i not in have:
+                x, y = c.position(tc)
+                truth.append({"index": i, "name": c.name, "x_mm": float(x), "y_mm": float(y),
+                              "edge_mm": float(_scene.edge_distance_mm(cfg, x, y))})
+        m = _match(truth, det[f])
+        false += len(det[f]) - len(m)
+        matched = {truth[i]["index"] for i, _, _ in m}
+        missed += sum(1 for t in truth if not partial[t["index"]][f] and t["index"] not in matched)
+        for i, j, dist in m:
+            t = truth[i]
+            if partial[t["index"]][f]:
+                continue
+            pos[t["index"]].append((det[f][j][1], det[f][j][2]))
+            if t["edge_mm"] > EDGE_HI_MM:
+                err_in.append(dist)
+            elif t["edge_mm"] >= EDGE_LO_MM:
+                err_edge.append(dist)
+    jit = {}
+    for i, c in enumerate(scene.contacts):
+        if c.stationary and c.active is None and len(pos[i]) > 1:
+            p = np.asarray(pos[i])
+            jit[c.name or str(i)] = float(math.sqrt(np.mean(np.sum((p - p.mean(0)) ** 2, axis=1))))
+    # tap latency: onset sample -> end of the first frame with a matched detection
+    lat = []
+    for i, c in enumerate(scene.contacts):
+        if c.active is None:
+            continue
+        for on, off in c.intervals_samples(fs):
+            f0 = int(on // spf)
+            for f in range(max(0, f0), min(frames, int(min(off, frames * spf) // spf) + 1)):
+                x, y = c.position((f + 0.5) * spf / fs)
+                hit = any(math.hypot(x - d[1], y - d[2]) <= MATCH_MM for d in det[f])
+                if hit:
+                    lat.append(((f + 1) * spf - on) / fs * 1e6)
+                    break
+    return {
+        "position_error_mm": {
+            "rms": _rms(err_in), "max": float(max(err_in)) if err_in else None, "n": len(err_in),
+            "rms_edge": _rms(err_edge), "max_edge": float(max(err_edge)) if err_edge else None,
+            "n_edge": len(err_edge)},
+        "missed": missed, "false": false,
+        "truth_touches_mean": float(np.mean(truth_count)) if truth_count else 0.0,
+        "jitter_mm": {"max": max(jit.values()) if jit else None, "per_contact": jit},
+        "tap_latency_us": {"n": len(lat), "mean": float(np.mean(lat)) if lat else None,
+                           "max": float(np.max(lat)) if lat else None,
+                           "values": [round(v, 3) for v in lat]},
+    }
+
+
+def tracks(frame_events, cfg) -> dict:
+    """{id: [(frame, x_cells, y_cells), ...]} from the events."""
+    q = float(1 << cfg.frac_bits)
+    tr = {}
+    for f, evs in enumerate(frame_events):
+        for e in evs:
+            if _ev(e, "type") in ("new", "move"):
+                tr.setdefault(int(_ev(e, "id")), []).append((f, _ev(e, "x_q") / q, _ev(e, "y_q") / q))
+    return tr
+
+
+def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None,
+        processor=None, render: bool = False, plot: bool = True, quiet: bool = False,
+        frames: int | None = None) -> dict:
+    """Run a scene; returns the report (and writes it under ``out_dir/<name>/``)."""
+    settings = settings or TouchSettings()
+    processor = processor or default_processor
+    cfg = scene.cfg
+    if frames is not None:
+        scene = scene.replace(frames=frames)
+    t0 = time.perf_counter()
+
+    def progress(done, total):
+        if not quiet and total >= 1000:
+            print(f"\r  {scene.name}: {done}/{total} frames", end="", file=sys.stderr, flush=True)
+
+    if render:
+        hm = _chain.render_heatmaps(scene)
+        res = _chain.ChainResult(hm, 0, scene.n_samples, 0.0)
+    else:
+        res = _chain.heatmaps_float(scene, progress=progress)
+        if not quiet and scene.frames >= 1000:
+            print(file=sys.stderr)
+    t1 = time.perf_counter()
+    cal = calibration(scene)
+    evs = processor(res.heatmaps, scene, settings, cal)
+    t2 = time.perf_counter()
+    det = detections(evs, cfg)
+    n_det = [len(d) for d in det]
+    rep = {
+        "scene": scene.name, "sensor": cfg.name, "frames": scene.frames, "m": scene.m,
+        "frame_period_us": scene.frame_period_s * 1e6,
+        "signal_path": "render" if render else "adc",
+        "touches": {"min": int(min(n_det)), "mean": float(np.mean(n_det)), "max": int(max(n_det))},
+        "model_frames_per_s": scene.frames / max(t1 - t0, 1e-9),
+        "total_frames_per_s": scene.frames / max(t2 - t0, 1e-9),
+        "clipped_samples": int(res.clipped),
+        "noise_sigma_lsb": float(res.noise_sigma),
+        "events": int(sum(len(e) for e in evs)),
+    }
+    rep.update(evaluate(scene, det))
+    rep["touches"]["truth_mean"] = rep.pop("truth_touches_mean")
+    if out_dir is not None:
+        d = Path(out_dir) / scene.name
+        d.mkdir(parents=True, exist_ok=True)
+        if plot:
+            from . import plots as _plots
+            from . import flatten as _flatten
+            flat = _flatten.flatten(res.heatmaps, cal[0], cal[1], cfg)
+            png = d / "heatmap.png"
+            _plots.heatmap_with_tracks(flat, scene, tracks(evs, cfg), png)
+            rep["png"] = str(png)
+        (d / "report.json").write_text(json.dumps(rep, indent=1) + "\n")
+        rep["report"] = str(d / "report.json")
+    return rep
+
+
+def _summary(rep: dict) -> str:
+    pe = rep["position_error_mm"]
+    f = lambda v: "n/a" if v is None else f"{v:.3f}"
+    return (f"{rep['scene']}: {rep['frames']} frames ({rep['signal_path']}), "
+            f"touches/frame {rep['touches']['mean']:.2f} (truth {rep['touches']['truth_mean']:.2f}), "
+            f"position error rms {f(pe['rms'])} mm max {f(pe['max'])} mm, "
+            f"edge rms {f(pe['rms_edge'])} mm, jitter {f(rep['jitter_mm']['max'])} mm, "
+            f"missed {rep['missed']} false {rep['false']}, tap latency mean "
+            f"{f(rep['tap_latency_us']['mean'])} us, model {rep['model_frames_per_s']:.0f} frames/s, "
+            f"clipped {rep['clipped_samples']}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="Run a scene through the FMT model (make sim).")
+    ap.add_argument("--scene", default=str(ROOT / "sim" / "scenes" / "default.json"))
+    ap.add_argument("--out", default=str(ROOT / "build" / "sim"))
+    ap.add_argument("--frames", type=int, default=None, help="override the scene's length")
+    ap.add_argument("--render", action="store_true",
+                    help="heat maps by render_heatmaps (no ADC synthesis)")
+    ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--quiet", action="store_true")
+    a = ap.parse_args(argv)
+    sc = _scene.load(a.scene)
+    rep = run(sc, a.out, render=a.render, plot=not a.no_plot, quiet=a.quiet, frames=a.frames)
+    print(_summary(rep))
+    print(f"report: {rep['report']}" + (f", plot: {rep['png']}" if "png" in rep else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,369 @@
+"""Scenes: contacts moving over the sensor, effects of the channel, and the truth.
+
+A scene is a :class:`Scene` object and a JSON (or YAML) file with the same fields::
+
+    {"name": "demo", "sensor": "default", "frames": 300, "m": 1, "seed": 1,
+     "effects": {"noise": {"snr_db": 30}, "pn": {"enable": true, "chip_len": 1}},
+     "contacts": [
+        {"name": "still", "diameter_mm": 8, "path": [[0, 52.3, 41.7]]},
+        {"name": "drag", "path": [[0, 20, 20], [0.0018, 24, 22]]},
+        {"name": "tap", "path": [[0, 100, 30]], "active": [[1e-4, 3e-4]]},
+        {"name": "taps", "path": [[0, 60, 100]],
+         "active": {"repeat": {"first_s": 5e-5, "period_s": 2.5e-4, "on_s": 1.2e-4,
+                               "count": 6, "step_samples": 37}}},
+        {"name": "thumb", "diameter_mm": 14, "minor_diameter_mm": 9, "angle_deg": 30,
+         "profile": "gaussian", "strength": 0.8, "path": [[0, 80, 70]]}]}
+
+Time: sample n of the ADC stream is at t = n / fs; frame f is windows f*M .. f*M+M-1,
+samples [f*M*N, (f+1)*M*N); its centre time is (f + 1/2) M N / fs.
+
+Contacts
+  ``path``: waypoints ``[t_s, x_mm, y_mm]`` (x = column, y = row, mm from the centre of
+  cell (0, 0)); the position is linearly interpolated between waypoints and held before
+  the first / after the last.  One waypoint = stationary; two = a linear drag; pinches and
+  crossings are two contacts with two waypoints each; any path is a list of waypoints.
+  ``active``: absent = touching the whole time; a list of ``[onset, lift]`` intervals
+  (lift ``null`` = never lifts) in seconds, or in samples with ``"active_units":
+  "samples"``; or ``{"repeat": {...}}`` = ``count`` taps, tap i touching from
+  ``first + i*period`` (+ ``i*step_samples`` samples, to spread the onsets over the
+  window phase) for ``on_s``.  An interval [on, off) in seconds touches samples
+  n with round(on * fs) <= n < round(off * fs): the onset falls on that exact sample,
+  anywhere inside a window (``onset_samples`` lists them).
+  ``diameter_mm`` (8 = the default finger), ``strength`` (1), ``profile`` ("disk" or
+  "gaussian"), optional ``minor_diameter_mm`` and ``angle_deg`` (elliptical contact).
+
+Effects (every one costs nothing when absent)
+  ``noise``: ``{"snr_db": s}`` (white Gaussian ADC noise set from the model so that a
+  default finger centred on a cell gives s dB at M = 1; see
+  :func:`fmt.channel.noise_sigma_for_snr`) or ``{"rms_lsb": sigma}``.
+  ``enob``: effective bits (the low ADC_BITS - enob bits of every sample are cleared).
+  ``dc_lsb``: DC offset added before quantisation.  ``interferer``: ``{"freq_hz": f}`` or
+  ``{"bin": b}`` (fractional bins allowed), ``"amp_lsb"``, ``"phase_rad"``; a list of them
+  is allowed.  ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
+  ``baseline``: untouched coupling (default ``sensor.BASELINE``).  ``fringe_mm``: the
+  disk profile's Gaussian fringe.  ``delay_samples``: channel delay.  ``pn``:
+  ``{"enable": bool, "chip_len": L, "rx_delay": d}`` (rx_delay defaults to the channel
+  delay: matched).  ``tone_phases``: "zero" (the DDS: every row starts at phase 0, a
+  sine) or "schroeder" (low crest factor).  Clipping at the ADC range is always modelled.
+
+The DEFAULT PHYSICS: a finger is an 8 mm disk-profile contact of strength 1; the ADC
+noise is white Gaussian, set so that a finger centred on a cell gives 30 dB SNR (peak
+cell's noiseless heat-map value over the RMS noise of that cell) in one 6.144 us window
+(M = 1); each doubling of M adds 3 dB.  ``default_physics_effects()`` returns that.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import params as _params
+from .params import SensorConfig
+
+FINGER_MM = 8.0
+DEFAULT_SNR_DB = 30.0
+
+
+def default_physics_effects() -> dict:
+    """Effects of the default physics: 30 dB SNR noise (clipping is always on)."""
+    return {"noise": {"snr_db": DEFAULT_SNR_DB}}
+
+
+@dataclass
+class Contact:
+    """One contact (see the module docstring for the fields)."""
+
+    path: list                      # [[t_s, x_mm, y_mm], ...]
+    name: str = ""
+    diameter_mm: float = FINGER_MM
+    strength: float = 1.0
+    profile: str = "disk"
+    minor_diameter_mm: float | None = None
+    angle_deg: float = 0.0
+    active: object = None           # None, [[on, off], ...] or {"repeat": {...}}
+    active_units: str = "s"         # "s" or "samples"
+
+    def __post_init__(self):
+        p = np.asarray(self.path, dtype=np.float64)
+        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 1:
+            raise ValueError(f"contact '{self.name}': path must be [[t, x, y], ...]")
+        if np.any(np.diff(p[:, 0]) < 0):
+            raise ValueError(f"contact '{self.name}': waypoint times must not decrease")
+        self._p = p
+        if self.profile not in ("disk", "gaussian"):
+            raise ValueError(f"contact '{self.name}': unknown profile '{self.profile}'")
+
+    # -- geometry ---------------------------------------------------------------------
+    @property
+    def stationary(self) -> bool:
+        """True when every waypoint is at the same position."""
+        return bool(np.all(self._p[:, 1:] == self._p[0, 1:]))
+
+    @property
+    def elliptical(self) -> bool:
+        return self.minor_diameter_mm is not None
+
+    def shape_row(self) -> tuple:
+        """(diameter, strength, minor_diameter, angle_rad) for ``sensor.contact_maps``."""
+        minor = self.diameter_mm if self.minor_diameter_mm is None else self.minor_diameter_mm
+        return (self.diameter_mm, self.strength, minor, math.radians(self.angle_deg))
+
+    def position(self, t) -> np.ndarray:
+        """(..., 2) x, y in mm at time(s) t (seconds)."""
+        t = np.asarray(t, dtype=np.float64)
+        p = self._p
+        if p.shape[0] == 1:
+            return np.broadcast_to(p[0, 1:], t.shape + (2,)).copy()
+        x = np.interp(t, p[:, 0], p[:, 1])
+        y = np.interp(t, p[:, 0], p[:, 2])
+        return np.stack([x, y], axis=-1)
+
+    # -- activity -----------------------------------------------------------------------
+    def intervals_samples(self, fs: float) -> np.ndarray:
+        """Touching intervals as int64 (K, 2) sample indices [onset, lift); lift = 2**62
+        for "never lifts"; an always-touching contact gives [[-2**62, 2**62]]."""
+        BIG = 1 << 62
+        a = self.active
+        if a is None:
+            return np.array([[-BIG, BIG]], dtype=np.int64)
+        scale = 1.0 if self.active_units == "samples" else fs
+        if isinstance(a, dict):
+            r = a["repeat"]
+            out = []
+            for i in range(int(r["count"])):
+                on = round((r["first_s"] + i * r["period_s"]) * fs) + i * int(r.get("step_samples", 0))
+                out.append([on, on + round(r["on_s"] * fs)])
+            return np.array(out, dtype=np.int64).reshape(-1, 2)
+        out = []
+        for on, off in a:
+            on_n = round(on * scale)
+            off_n = BIG if off is None else round(off * scale)
+            out.append([on_n, off_n])
+        return np.array(out, dtype=np.int64).reshape(-1, 2)
+
+    def active_mask(self, n0: int, n1: int, fs: float) -> np.ndarray:
+        """bool mask of samples n0 .. n1-1 where the contact touches."""
+        n = np.arange(n0, n1, dtype=np.int64)
+        m = np.zeros(n.size, dtype=bool)
+        for on, off in self.intervals_samples(fs):
+            m |= (n >= on) & (n < off)
+        return m
+
+    def active_fraction(self, edges: np.ndarray, fs: float) -> np.ndarray:
+        """Fraction of samples touching in each span [edges[i], edges[i+1])."""
+        edges = np.asarray(edges, dtype=np.int64)
+        cover = np.zeros(edges.size - 1, dtype=np.float64)
+        lo, hi = edges[:-1], edges[1:]
+        for on, off in self.intervals_samples(fs):
+            cover += np.clip(np.minimum(hi, off) - np.maximum(lo, on), 0, None)
+        return cover / (hi - lo)
+
+    def to_dict(self) -> dict:
+        d = {"name": self.name, "diameter_mm": self.diameter_mm, "strength": self.strength,
+             "profile": self.profile, "path": [list(map(float, w)) for w in self._p]}
+        if self.minor_diameter_mm is not None:
+            d["minor_diameter_mm"] = self.minor_diameter_mm
+            d["angle_deg"] = self.angle_deg
+        if self.active is not None:
+            d["active"] = self.active
+            if self.active_units != "s":
+                d["active_units"] = self.active_units
+        return d
+
+
+@dataclass
+class Scene:
+    """A scene: sensor, length, M, contacts, effects (see the module docstring)."""
+
+    name: str = "scene"
+    sensor: str = "default"
+    frames: int = 100
+    m: int = 1
+    contacts: list = field(default_factory=list)
+    effects: dict = field(default_factory=dict)
+    seed: int = 1
+    duration_s: float | None = None   # alternative to frames (rounded up to whole frames)
+    description: str = ""
+
+    def __post_init__(self):
+        self.contacts = [c if isinstance(c, Contact) else Contact(**c) for c in self.contacts]
+        if self.m < 1:
+            raise ValueError("m (windows per frame) must be >= 1")
+        if self.duration_s is not None:
+            fr = self.cfg.n_fft * self.m / self.cfg.fs_hz
+            self.frames = int(math.ceil(self.duration_s / fr - 1e-9))
+        unknown = set(self.effects) - EFFECT_KEYS
+        if unknown:
+            raise ValueError(f"scene '{self.name}': unknown effects {sorted(unknown)}")
+
+    # -- sizes and times ------------------------------------------------------------------
+    @property
+    def cfg(self) -> SensorConfig:
+        return _params.get(self.sensor)
+
+    @property
+    def samples_per_frame(self) -> int:
+        return self.cfg.n_fft * self.m
+
+    @property
+    def n_samples(self) -> int:
+        return self.frames * self.samples_per_frame
+
+    @property
+    def frame_period_s(self) -> float:
+        return self.samples_per_frame / self.cfg.fs_hz
+
+    def frame_centre_s(self, frames=None) -> np.ndarray:
+        f = np.arange(self.frames) if frames is None else np.asarray(frames)
+        return (f + 0.5) * self.frame_period_s
+
+    def onset_samples(self) -> dict:
+        """{contact name or index: [onset samples]} of contacts that tap."""
+        fs = self.cfg.fs_hz
+        out = {}
+        for i, c in enumerate(self.contacts):
+            if c.active is not None:
+                iv = c.intervals_samples(fs)
+                out[c.name or str(i)] = [int(v) for v in iv[:, 0]]
+        return out
+
+    # -- truth --------------------------------------------------------------------------
+    def truth(self, t) -> list:
+        """True contacts touching at time t (seconds): a list of dicts with ``index``,
+        ``name``, ``x_mm``, ``y_mm``, ``diameter_mm``, ``x_cells``, ``y_cells`` and
+        ``edge_mm`` (distance of the centre from the nearest sensor edge)."""
+        cfg = self.cfg
+        n = int(round(t * cfg.fs_hz))
+        out = []
+        for i, c in enumerate(self.contacts):
+            if not c.active_mask(n, n + 1, cfg.fs_hz)[0]:
+                continue
+            x, y = c.position(t)
+            out.append({"index": i, "name": c.name, "x_mm": float(x), "y_mm": float(y),
+                        "diameter_mm": c.diameter_mm, "x_cells": float(x / cfg.pitch_mm),
+                        "y_cells": float(y / cfg.pitch_mm),
+                        "edge_mm": float(edge_distance_mm(cfg, x, y))})
+        return out
+
+    def truth_frames(self) -> list:
+        """``truth`` at every frame's centre time."""
+        return [self.truth(t) for t in self.frame_centre_s()]
+
+    # -- I/O ------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d = {"name": self.name, "description": self.description, "sensor": self.sensor,
+             "frames": self.frames, "m": self.m, "seed": self.seed,
+             "effects": copy.deepcopy(self.effects),
+             "contacts": [c.to_dict() for c in self.contacts]}
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scene":
+        d = dict(d)
+        return cls(**d)
+
+    def save(self, path) -> None:
+        path = Path(path)
+        if path.suffix in (".yaml", ".yml"):
+            import yaml
+            path.write_text(yaml.safe_dump(self.to_dict(), sort_keys=False))
+        else:
+            path.write_text(json.dumps(self.to_dict(), indent=1) + "\n")
+
+    def replace(self, **kw) -> "Scene":
+        d = self.to_dict()
+        d.update(kw)
+        return Scene.from_dict(d)
+
+
+EFFECT_KEYS = {"noise", "enob", "dc_lsb", "interferer", "row_db_per_cell", "col_db_per_cell",
+               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases"}
+
+
+def edge_distance_mm(cfg: SensorConfig, x, y):
+    """Distance of (x, y) from the nearest sensor edge (the sensor spans -pitch/2 ..
+    cols*pitch - pitch/2 in x, likewise in y)."""
+    p = cfg.pitch_mm
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    return np.minimum.reduce([x + p / 2, (cfg.cols - 0.5) * p - x, y + p / 2,
+                              (cfg.rows - 0.5) * p - y])
+
+
+def load(path) -> Scene:
+    """Load a scene from a .json or .yaml file."""
+    path = Path(path)
+    text = path.read_text()
+    if path.suffix in (".yaml", ".yml"):
+        import yaml
+        d = yaml.safe_load(text)
+    else:
+        d = json.loads(text)
+    return Scene.from_dict(d)
+
+
+# ---- the scenes shipped in sim/scenes/ ----------------------------------------------------
+SCENES_DIR = Path(__file__).resolve().parents[1] / "scenes"
+
+
+def default_scene() -> Scene:
+    """The ``make sim`` scene on the 30 x 40 sensor (sim/scenes/default.json)."""
+    cfg = _params.DEFAULT
+    fs, N = cfg.fs_hz, cfg.n_fft
+    frames = 360
+    T = frames * N / fs
+    # taps: 15 frames (92 us) down, 45 frames (276 us, longer than the tracker's 200 us
+    # hold-off) up; onsets 43 samples later in the window each time (0 .. 215)
+    taps = {"repeat": {"first_s": 20 * N / fs, "period_s": 60 * N / fs, "on_s": 15 * N / fs,
+                       "count": 6, "step_samples": 43}}
+    return Scene(
+        name="default", sensor="default", frames=frames, m=1, seed=1,
+        description=("stationary finger (jitter), stationary finger 2.0 mm from the left edge, "
+                     "a fast drag (5.4 mm in 2.2 ms, 2.4 m/s), and 6 taps whose onsets step 43 "
+                     "samples through the window phase; default physics (8 mm disk, 30 dB "
+                     "SNR, PN on, chip length 1)"),
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 61.3, 43.8]]),
+            Contact(name="edge", path=[[0.0, -0.5, 112.0]]),
+            Contact(name="drag", path=[[0.0, 110.0, 20.0], [T, 115.0, 22.0]]),
+            Contact(name="taps", path=[[0.0, 150.0, 120.0]], active=taps),
+        ])
+
+
+def small_scene() -> Scene:
+    """A few frames on the 4 x 6 sensor for fast tests (sim/scenes/small.json)."""
+    cfg = _params.SMALL
+    fs, N = cfg.fs_hz, cfg.n_fft
+    frames = 40
+    T = frames * N / fs
+    return Scene(
+        name="small", sensor="small", frames=frames, m=1, seed=2,
+        description="one stationary finger and one short drag on the 4 x 6 sensor",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 6.3, 6.9]]),
+            Contact(name="drag", path=[[0.0, 19.0, 8.0], [T, 21.0, 9.0]],
+                    active=[[5 * N / fs + 17 / fs, None]]),
+        ])
+
+
+def write_shipped(directory=SCENES_DIR) -> list:
+    """Regenerate sim/scenes/default.json, small.json and an example YAML."""
+    directory = Path(directory)
+    out = []
+    for sc, fn in ((default_scene(), "default.json"), (small_scene(), "small.json"),
+                   (small_scene(), "small.yaml")):
+        p = directory / fn
+        sc.save(p)
+        out.append(p)
+    return out
+
+
+if __name__ == "__main__":
+    for p in write_shipped():
+        print(f"wrote {p}")

@@ -1,0 +1,155 @@
+"""Channel and ADC: orthogonal comb, exact onset sample, clipping, ENOB, DC, PN."""
+import numpy as np
+import pytest
+
+from fmt import channel as ch
+from fmt import params, pn, receiver
+from fmt import scene as S
+from fmt.sensor import TONE_LSB
+
+
+@pytest.mark.parametrize("cfg", [params.DEFAULT, params.SMALL, params.MEDIUM], ids=lambda c: c.name)
+@pytest.mark.parametrize("kind,delay", [("zero", 0), ("schroeder", 13)])
+def test_comb_orthogonal(cfg, kind, delay):
+    T = ch.tone_table(cfg, ch.tone_phases(cfg, kind), delay)
+    X = np.abs(np.fft.rfft(T, axis=0))[np.asarray(cfg.bins)]      # (bins, rows)
+    own = np.diag(X)
+    assert np.allclose(own, cfg.n_fft / 2, rtol=1e-12)
+    leak = X - np.diag(own)
+    assert 20 * np.log10(leak.max() / own.min()) < -200
+
+
+def _finger(cfg, **eff):
+    r, c = cfg.rows // 2, cfg.cols // 2
+    return S.Scene(sensor=cfg.name, frames=4, effects=eff,
+                   contacts=[{"path": [[0, c * cfg.pitch_mm, r * cfg.pitch_mm]]}])
+
+
+def test_onset_on_exact_sample():
+    cfg = params.MEDIUM
+    n0 = 3 * cfg.n_fft + 77
+    tap = S.Scene(sensor="medium", frames=6, contacts=[
+        {"path": [[0, 22.0, 17.0]], "active": [[n0, None]], "active_units": "samples"}])
+    none = S.Scene(sensor="medium", frames=6, contacts=[])
+    g = ch.coupling_per_sample(tap, 6 * cfg.n_fft)
+    assert np.allclose(g[:n0], g[0]) and g[n0, 3, 4] > g[n0 - 1, 3, 4] + 0.5
+    a = ch.adc_streams(tap).adc.astype(int)
+    b = ch.adc_streams(none).adc.astype(int)
+    assert np.array_equal(a[:n0], b[:n0])
+    assert np.abs(a[n0] - b[n0]).max() > 100   # the coupling is on at sample n0 itself
+
+
+def test_scale_and_unit_cell():
+    cfg = params.MEDIUM
+    sc = _finger(cfg)
+    hm = receiver.receive(ch.adc_streams(sc).adc, cfg)
+    r, c = cfg.rows // 2, cfg.cols // 2
+    expect = receiver.unit_cell_counts(cfg) * (1 + 1 / 32)
+    assert receiver.unit_cell_counts(cfg) == TONE_LSB * 16
+    assert np.abs(hm[:, r, c] - expect).max() < 16      # ADC rounding bound, see test_chain
+
+
+def test_pn_stream_matches_pn_model():
+    for chip, d in ((1, 0), (3, 5), (7, 40)):
+        tx, rx = pn.pn_signs(5000, chip_len=chip, rx_delay=d)
+        assert np.array_equal(ch.pn_stream(0, 5000, chip, True, 0), tx)
+        assert np.array_equal(ch.pn_stream(0, 5000, chip, True, d), rx)
+        assert np.array_equal(ch.pn_stream(1000, 5000, chip, True, d), rx[1000:])
+
+
+def test_pn_on_equals_off_when_matched():
+    # matched delay: the despread signal is bit-identical (the sign flip is exact, the
+    # rounding symmetric), so the heat maps are identical: bound 0
+    cfg = params.MEDIUM
+    base = dict(contacts=[{"path": [[0, 12.0, 8.0], [1e-5, 14.0, 9.0]]},
+                          {"path": [[0, 30.0, 22.0]], "active": [[300, None]], "active_units": "samples"}],
+                sensor="medium", frames=8)
+    hm = {}
+    for on in (False, True):
+        sc = S.Scene(effects={"delay_samples": 9, "pn": {"enable": on, "chip_len": 2}}, **base)
+        r = ch.adc_streams(sc)
+        hm[on] = receiver.receive(r.adc, cfg, r.rx_sign)
+        assert r.clipped == 0
+    assert np.array_equal(hm[True], hm[False])
+    # misaligned receive delay (hard case): chip_len 2 and one sample off halves the
+    # correlation on average; with chip_len 1 the signal is destroyed
+    sc = S.Scene(effects={"delay_samples": 9, "pn": {"enable": True, "chip_len": 1, "rx_delay": 10}}, **base)
+    r = ch.adc_streams(sc)
+    bad = receiver.receive(r.adc, cfg, r.rx_sign)
+    assert bad[-1].max() < 0.25 * hm[True][-1].max()
+
+
+def pn_rejection_db(cfg, chip_len, frames=64, bin_offset=0.0):
+    """Mean heat-map value of an interferer on a comb bin with PN on over PN off, dB."""
+    k = cfg.bins[cfg.rows // 2] + bin_offset
+    out = {}
+    for on in (False, True):
+        sc = S.Scene(sensor=cfg.name, frames=frames, contacts=[],
+                     effects={"baseline": 0.0, "interferer": {"bin": k, "amp_lsb": 300.0},
+                              "pn": {"enable": on, "chip_len": chip_len}})
+        r = ch.adc_streams(sc)
+        out[on] = receiver.receive(r.adc, cfg, r.rx_sign)[:, cfg.rows // 2, :].mean()
+    return 20 * np.log10(out[True] / out[False])
+
+
+def test_interferer_spread_by_pn():
+    # white spreading (chip_len 1) leaves sqrt(2/N) of the amplitude per bin in RMS
+    # (-19.1 dB at N = 256), the mean of a Rayleigh magnitude sqrt(pi)/2 of that: -20.2 dB
+    rej = pn_rejection_db(params.DEFAULT, 1)
+    assert -21.5 < rej < -19.0
+    # longer chips spread less (chip_len 8: about fs/8 wide): less rejection
+    assert pn_rejection_db(params.DEFAULT, 8) > rej + 3
+
+
+def test_clipping_reported():
+    cfg = params.DEFAULT
+    finger = ch.adc_streams(_finger(cfg))
+    assert finger.clipped == 0
+    assert np.abs(finger.adc.astype(int)).max() < 0.75 * 2048      # headroom for the noise
+    # every row touched on one column: a 6 mm wide strip along column 20
+    strip = S.Scene(sensor="default", frames=2, contacts=[
+        {"diameter_mm": 400.0, "minor_diameter_mm": 6.0, "angle_deg": 90.0, "path": [[0, 100.0, 72.5]]}])
+    r = ch.adc_streams(strip)
+    assert r.clipped > 0 and r.adc.max() == 2047 and r.adc.min() == -2048
+    palm = S.Scene(sensor="default", frames=2, contacts=[{"diameter_mm": 40.0, "path": [[0, 100.0, 70.0]]}])
+    assert ch.adc_streams(palm).clipped > 0
+
+
+def test_enob_and_dc():
+    cfg = params.SMALL
+    sc = _finger(cfg)
+    a = ch.adc_streams(sc).adc
+    e = ch.adc_streams(_finger(cfg, enob=8)).adc
+    assert np.all(e % 16 == 0) and np.abs(e.astype(int) - a).max() <= 16
+    d = ch.adc_streams(_finger(cfg, dc_lsb=100.0)).adc
+    assert np.array_equal(d.astype(int) - a, np.full(a.shape, 100))
+    # DC never reaches a comb bin
+    assert np.allclose(receiver.receive(d, cfg), receiver.receive(a, cfg), atol=1e-9)
+
+
+def test_chunking_does_not_change_the_stream():
+    sc = S.load(S.SCENES_DIR / "small.json")
+    a = ch.adc_streams(sc, chunk_windows=7).adc
+    b = ch.adc_streams(sc, chunk_windows=1000).adc
+    assert np.array_equal(a, b)
+
+
+def _snr_db(cfg, m, frames):
+    r, c = cfg.rows // 2, cfg.cols // 2
+    sc = S.Scene(sensor=cfg.name, frames=frames, m=m, seed=5, effects={"noise": {"snr_db": 30.0}},
+                 contacts=[{"path": [[0, c * cfg.pitch_mm, r * cfg.pitch_mm]]}])
+    hm = receiver.receive(ch.adc_streams(sc).adc, cfg, m=m)
+    clean = receiver.unit_cell_counts(cfg) * ch.finger_peak_coupling(cfg)
+    # the peak cell and its 4 neighbours (all >> noise): the same in-phase noise RMS
+    cells = [(r, c), (r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)]
+    noise = np.concatenate([hm[:, i, j] - hm[:, i, j].mean() for i, j in cells])
+    return 20 * np.log10(clean / noise.std())
+
+
+def test_snr_calibration_default_physics():
+    cfg = params.DEFAULT
+    assert ch.noise_sigma_for_snr(cfg) == pytest.approx(188.9, abs=0.1)
+    s1 = _snr_db(cfg, 1, 600)
+    s2 = _snr_db(cfg, 2, 400)
+    assert abs(s1 - 30.0) < 0.5
+    assert abs(s2 - 33.0) < 0.5
