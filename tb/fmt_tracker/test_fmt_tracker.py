@@ -1,0 +1,318 @@
+"""cocotb testbench of rtl/fmt_tracker.v against its twin sim/fmt/tracking.py.
+
+Every frame's events (id, type, x, y, strength, axes, angle, flags, ev_last, in order)
+must equal Tracker.step's, for: random touch streams (wandering fingers that appear,
+vanish and flicker, random order, more than MAX_TOUCHES touches, random settings) and
+scripted scenarios on a scaled timeline (drumroll, merge/split, fast crossing,
+flicker, hold-off expiry, 17 touches with 16 slots), plus a reset in the middle of a
+frame.  Also measures and checks the tail latency: the frame's last event is on the
+output exactly n_events + n_noslot + 5 cycles after the tp_eof cycle
+(n_noslot = new touches dropped for want of a slot, one cycle each).
+"""
+from __future__ import annotations
+
+import math
+import random
+from pathlib import Path
+
+import cocotb
+import pytest
+from cocotb.triggers import ReadOnly, RisingEdge
+
+from common.runner import rtl_sources, run_cocotb
+from common.tb_util import ClockedTB, env_int
+from fmt import params
+from fmt.tracking import EV_TYPES, Touch, Tracker, TrackParams
+
+TAIL_FIXED = 5
+
+
+class TB(ClockedTB):
+    def __init__(self, dut):
+        super().__init__(dut)
+        self.mt = env_int("MAX_TOUCHES", 16)
+        self.hm_w = env_int("HM_W", 16)
+        self.cycle = 0
+        self.events = []          # (cycle, tuple)
+        self.eof_cycles = []
+        self.idle()
+        cocotb.start_soon(self._count())
+        cocotb.start_soon(self._monitor())
+
+    def idle(self):
+        d = self.dut
+        d.tp_valid_i.value = 0
+        d.tp_eof_i.value = 0
+        for n in ("tp_frame_i", "tp_x_i", "tp_y_i", "tp_strength_i", "tp_axis_major_i",
+                  "tp_axis_minor_i", "tp_angle_i", "tp_flags_i"):
+            getattr(d, n).value = 0
+
+    def set_params(self, p: TrackParams):
+        d = self.dut
+        d.max_jump_i.value = p.max_jump_q
+        d.hold_jump_i.value = p.hold_jump_q
+        d.hold_off_i.value = p.hold_off_frames
+        d.vel_shift_i.value = p.vel_shift
+        d.max_speed_i.value = p.max_speed_v
+
+    async def _count(self):
+        while True:
+            await RisingEdge(self.clk)
+            self.cycle += 1
+
+    async def _monitor(self):
+        d = self.dut
+        while True:
+            await RisingEdge(self.clk)
+            await ReadOnly()
+            rst, v = d.rst.value, d.ev_valid_o.value
+            if not (rst.is_resolvable and v.is_resolvable):
+                continue                      # before the first reset
+            if int(rst) == 0 and int(v):
+                self.events.append((self.cycle, (
+                    int(d.ev_frame_o.value), int(d.ev_id_o.value), int(d.ev_type_o.value),
+                    int(d.ev_x_o.value), int(d.ev_y_o.value), int(d.ev_strength_o.value),
+                    int(d.ev_axis_major_o.value), int(d.ev_axis_minor_o.value),
+                    int(d.ev_angle_o.value), int(d.ev_flags_o.value)),
+                    int(d.ev_last_o.value)))
+
+    async def send_frame(self, frame: int, touches, rng: random.Random | None = None):
+        """Drive one frame's touches (random gaps when rng) then tp_eof; wait until the
+        tracker is idle.  Returns the cycle of tp_eof."""
+        d = self.dut
+        await self.writable()
+        for t in touches:
+            d.tp_valid_i.value = 1
+            d.tp_frame_i.value = frame
+            d.tp_x_i.value = t.x_q
+            d.tp_y_i.value = t.y_q
+            d.tp_strength_i.value = t.strength
+            d.tp_axis_major_i.value = t.axis_major_q
+            d.tp_axis_minor_i.value = t.axis_minor_q
+            d.tp_angle_i.value = t.angle
+            d.tp_flags_i.value = t.flags
+            await RisingEdge(self.clk)
+            await self.writable()
+            if rng and rng.random() < 0.3:
+                d.tp_valid_i.value = 0
+                for _ in range(rng.randrange(1, 3)):
+                    await RisingEdge(self.clk)
+                await self.writable()
+        d.tp_valid_i.value = 0
+        d.tp_eof_i.value = 1
+        d.tp_frame_i.value = frame
+        await RisingEdge(self.clk)
+        await ReadOnly()
+        eof = self.cycle               # the edge that samples tp_eof
+        await self.writable()
+        d.tp_eof_i.value = 0
+        while True:
+            await RisingEdge(self.clk)
+            await ReadOnly()
+            if int(d.busy_o.value) == 0:
+                break
+        await RisingEdge(self.clk)
+        await RisingEdge(self.clk)
+        return eof
+
+
+def ev_tuple(e):
+    return (e.frame, e.id, e.type_code, e.x_q, e.y_q, e.strength, e.axis_major_q,
+            e.axis_minor_q, e.angle, e.flags)
+
+
+async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=None):
+    """Drive frames and compare every frame's events with the model's."""
+    model = model or Tracker(p)
+    tail = []
+    for k, touches in enumerate(frames):
+        fr = (start_frame + k) & 0xFFFF
+        n0 = len(tb.events)
+        eof = await tb.send_frame(fr, touches, rng)
+        got = tb.events[n0:]
+        ns0 = model.stats.no_slot
+        exp = model.step(fr, touches)
+        noslot = model.stats.no_slot - ns0
+        g = [x[1] for x in got]
+        e = [ev_tuple(x) for x in exp]
+        assert g == e, f"frame {fr}: RTL {g}\nmodel {e}"
+        if got:
+            assert [x[2] for x in got] == [0] * (len(got) - 1) + [1], "ev_last"
+            # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
+            # cycle c + lat (a plain register would be lat = 1)
+            lat = got[-1][0] - eof + 1
+            assert lat == len(got) + noslot + TAIL_FIXED, f"tail latency {lat} for {len(got)} events"
+            tail.append((len(got), lat))
+    return model, tail
+
+
+def q(mm):
+    return int(round(mm * 256 / 5))
+
+
+def rand_touch(rng, x, y):
+    return Touch(max(0, min(0xFFFF, x)), max(0, min(0xFFFF, y)), rng.randrange(1 << 16),
+                 rng.randrange(1 << 10), rng.randrange(1 << 10), rng.randrange(256),
+                 rng.randrange(16))
+
+
+@cocotb.test()
+async def random_streams(dut):
+    """Wandering fingers appearing / vanishing / flickering, random settings."""
+    tb = TB(dut)
+    rng = random.Random(env_int("SEED", 1))
+    mt = tb.mt
+    for trial in range(3):
+        p = TrackParams(max_jump_q=rng.choice([300, 768, 2000]),
+                        hold_jump_q=rng.choice([100, 192, 400]),
+                        hold_off_frames=rng.choice([1, 2, 4, 7]),
+                        vel_shift=rng.choice([0, 1, 3, 8, 12]),
+                        max_speed_v=rng.choice([1000, 1 << 16, (1 << 21) - 1]),
+                        max_touches=mt)
+        tb.set_params(p)
+        await tb.reset()
+        nf = mt + 3
+        fingers = [[rng.randrange(100, 12000), rng.randrange(100, 8000),
+                    rng.randrange(-40, 40), rng.randrange(-40, 40), rng.random() < 0.5]
+                   for _ in range(nf)]
+        frames = []
+        for k in range(60 if mt > 8 else 80):
+            ts = []
+            for f in fingers:
+                f[0] += f[2] + rng.randrange(-3, 4)
+                f[1] += f[3] + rng.randrange(-3, 4)
+                if rng.random() < 0.05:
+                    f[4] = not f[4]
+                if f[4] and rng.random() < 0.85:
+                    ts.append(rand_touch(rng, f[0], f[1]))
+            rng.shuffle(ts)
+            if rng.random() < 0.05:
+                ts = []
+            frames.append(ts)
+        _, tail = await run_frames(tb, p, frames, rng, start_frame=rng.randrange(1 << 16))
+        dut._log.info(f"trial {trial}: tail latency (events, cycles) max "
+                      f"{max(tail) if tail else None}")
+
+
+def two_finger_frames(pa, pb, merge_q, merged_at="mid"):
+    frames = []
+    for (xa, ya), (xb, yb) in zip(pa, pb):
+        if abs(xa - xb) + abs(ya - yb) < merge_q:
+            if merged_at == "mid":
+                frames.append([Touch((xa + xb) // 2, (ya + yb) // 2, 5000)])
+            else:
+                frames.append([Touch(xa + (xb - xa) // 3, ya + (yb - ya) // 3, 5000)])
+        else:
+            frames.append([Touch(xa, ya, 5000), Touch(xb, yb, 4000)])
+    return frames
+
+
+@cocotb.test()
+async def scripted_scenarios(dut):
+    """Drumroll, merge/split, crossing, flicker, hold-off expiry on a scaled timeline
+    (fingers move ~100x faster per frame than at 162.76 kHz)."""
+    tb = TB(dut)
+    rng = random.Random(7)
+    mt = tb.mt
+    base = dict(max_jump_q=q(15), hold_jump_q=q(15) // 4, max_touches=mt)
+    # drumroll A B A B 10 mm apart, off-time shorter and longer than the hold-off
+    for on, off, hold in ((4, 2, 10), (3, 6, 3)):
+        p = TrackParams(hold_off_frames=hold, vel_shift=2, max_speed_v=1 << 16, **base)
+        tb.set_params(p)
+        await tb.reset()
+        frames = []
+        for k in range(6):
+            pos = (q(40), q(40)) if k % 2 == 0 else (q(50), q(40))
+            frames += [[Touch(pos[0], pos[1], 3000)]] * on + [[]] * off
+        n0 = len(tb.events)
+        model, _ = await run_frames(tb, p, frames)
+        ids = {x[1][1] for x in tb.events[n0:]}
+        assert len(ids) == (2 if 2 * off + on < hold else 6), ids
+    # merge / split (pinch with slow-down) and crossing at speed
+    p = TrackParams(hold_off_frames=12, vel_shift=2, max_speed_v=1 << 20, **base)
+    tb.set_params(p)
+    await tb.reset()
+    n = 60
+    sep = [13 + 7 * math.cos(2 * math.pi * k / n) for k in range(n)]
+    pa = [(q(50 - s / 2), q(40)) for s in sep]
+    pb = [(q(50 + s / 2), q(40)) for s in sep]
+    await run_frames(tb, p, two_finger_frames(pa, pb, q(8)))
+    await tb.reset()
+    pa = [(q(30 + 1.5 * k), q(40)) for k in range(30)]
+    pb = [(q(70 - 1.5 * k), q(40)) for k in range(30)]
+    model, _ = await run_frames(tb, p, two_finger_frames(pa, pb, q(8)))
+    # flicker: one touch on 60 % of frames (off runs < hold-off), then gone
+    p = TrackParams(hold_off_frames=5, vel_shift=3, max_speed_v=1 << 16, **base)
+    tb.set_params(p)
+    await tb.reset()
+    frames, run_len = [], 0
+    for k in range(50):
+        on = rng.random() < 0.6 or run_len >= 3
+        run_len = 0 if on else run_len + 1
+        frames.append([Touch(q(77) + rng.randrange(-3, 4), q(33), 2100)] if on else [])
+    frames += [[]] * 6
+    n0 = len(tb.events)
+    await run_frames(tb, p, frames)
+    types = [x[1][2] for x in tb.events[n0:]]
+    assert types.count(0) == 1 and types.count(2) == 1      # one new, one lift
+
+
+@cocotb.test()
+async def over_limit_touches(dut):
+    """MAX_TOUCHES + 1 touches in a frame, then a new touch while all slots are taken."""
+    tb = TB(dut)
+    mt = tb.mt
+    p = TrackParams(hold_off_frames=3, vel_shift=4, max_touches=mt)
+    tb.set_params(p)
+    await tb.reset()
+    full = [Touch(q(10 + 9 * (i % 8)), q(10 + 9 * (i // 8)), 1000 + i) for i in range(mt + 1)]
+    frames = [full, full, full[:mt - 1], full[:mt - 1] + [Touch(q(190), q(140), 77)], [], [], []]
+    await run_frames(tb, p, frames)
+    assert int(dut.drop_flag_o.value) == 1
+    assert int(dut.noslot_flag_o.value) == 1
+    assert int(dut.overrun_flag_o.value) == 0
+
+
+@cocotb.test()
+async def reset_mid_frame(dut):
+    """A reset while the tracker is matching: afterwards it behaves like a fresh one."""
+    tb = TB(dut)
+    mt = tb.mt
+    p = TrackParams(hold_off_frames=2, vel_shift=2, max_touches=mt)
+    tb.set_params(p)
+    await tb.reset()
+    ts = [Touch(q(10 + 9 * i), q(20), 500) for i in range(min(mt, 6))]
+    await run_frames(tb, p, [ts, ts])
+    # third frame: cut by a reset right after tp_eof
+    d = tb.dut
+    await tb.writable()
+    for t in ts:
+        d.tp_valid_i.value = 1
+        d.tp_x_i.value = t.x_q
+        d.tp_y_i.value = t.y_q
+        await RisingEdge(tb.clk)
+        await tb.writable()
+    d.tp_valid_i.value = 0
+    d.tp_eof_i.value = 1
+    await RisingEdge(tb.clk)
+    await tb.writable()
+    d.tp_eof_i.value = 0
+    await RisingEdge(tb.clk)
+    await RisingEdge(tb.clk)
+    await tb.reset(cycles=1)
+    await run_frames(tb, p, [ts, ts[:2], [], [], []], start_frame=100)
+
+
+# ---- pytest entry ------------------------------------------------------------------
+@pytest.mark.parametrize("cfg_name,max_touches", [("small", 5), ("medium", 16)])
+def test_fmt_tracker(sim, cfg_name, max_touches):
+    cfg = params.get(cfg_name)
+    run_cocotb(
+        sim=sim,
+        toplevel="fmt_tracker",
+        sources=rtl_sources("fmt_tracker", "fmt_tracker_vel"),
+        test_module="test_fmt_tracker",
+        test_dir=Path(__file__).parent,
+        parameters={"MAX_TOUCHES": max_touches, "HM_W": cfg.hm_width},
+        extra_env={"MAX_TOUCHES": max_touches, "HM_W": cfg.hm_width, "SEED": 1},
+    )
