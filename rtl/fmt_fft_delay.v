@@ -1,0 +1,67 @@
+// fmt_fft_delay -- delay line of DEPTH samples for the SDF FFT stages.
+//
+// dout_o is din_i of DEPTH ce-steps earlier: the value written on the ce cycle t is
+// read on the ce cycle t + DEPTH (dout_o is valid during that cycle, before its edge).
+// Only ce cycles count.  The contents are not reset (a datapath memory; the FFT's valid
+// flags mask what is read before it was written); rst only clears the ring pointer.
+//
+// DEPTH < RAM_MIN: a shift register (maps to SRLC32E with clock enable, or to flip-flops
+//   when tiny).
+// DEPTH >= RAM_MIN: a ring of DEPTH words (DEPTH a power of two) with one write port and
+//   one registered read port whose read address runs one ahead of the write address,
+//   so ring + read register = DEPTH steps; it maps to block RAM (simple dual port).
+// Latency: exactly DEPTH ce-steps (no extra register).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_fft_delay #(
+    parameter W       = 16,   // word width (bits)
+    parameter DEPTH   = 8,    // delay in samples, >= 1; a power of two when >= RAM_MIN
+    parameter RAM_MIN = 64    // depth from which the ring-buffer (block RAM) form is used, >= 2
+) (
+    input  wire         clk,
+    input  wire         rst,    // synchronous, active high: clears the ring pointer only
+    input  wire         ce,     // sample strobe: one step per ce
+    input  wire [W-1:0] din_i,  // word written this step
+    output wire [W-1:0] dout_o  // word written DEPTH steps ago
+);
+
+    generate
+        if (DEPTH >= RAM_MIN) begin : g_ram
+            localparam AW = $clog2(DEPTH);
+            reg [W-1:0]  mem [0:DEPTH-1];
+            reg [AW-1:0] wptr_q;
+            reg [W-1:0]  rd_q;
+            wire [AW-1:0] rptr = wptr_q + 1'b1;   // the oldest word: written DEPTH-1 steps ago
+            always @(posedge clk) begin
+                if (ce) begin
+                    mem[wptr_q] <= din_i;
+                    rd_q        <= mem[rptr];
+                end
+            end
+            always @(posedge clk) begin
+                if (rst)
+                    wptr_q <= {AW{1'b0}};
+                else if (ce)
+                    wptr_q <= rptr;
+            end
+            assign dout_o = rd_q;
+        end else if (DEPTH == 1) begin : g_reg
+            reg [W-1:0] r_q;
+            always @(posedge clk)
+                if (ce) r_q <= din_i;
+            assign dout_o = r_q;
+        end else begin : g_srl
+            reg [W*DEPTH-1:0] sr_q;   // sr_q[k*W +: W] = word written k+1 steps ago
+            always @(posedge clk)
+                if (ce) sr_q <= {sr_q[W*(DEPTH-1)-1:0], din_i};
+            assign dout_o = sr_q[W*(DEPTH-1) +: W];
+        end
+    endgenerate
+
+    // rst is only used by the ring form
+    wire unused_ok = &{1'b0, rst};
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,131 @@
+// fmt_fft_twiddle -- twiddle multiplier between the stage pairs of fmt_fft_r22sdf.
+//
+// Element idx of the window sits at i = idx mod M in its M-block (M = 2^LOG2_M); it is
+// multiplied by W_M^e(i), e(i) = r(q) n, q = i div (M/4), n = i mod (M/4),
+// r = (0, 2, 1, 3), W_M = exp(-j 2 pi / M).  The ROM holds {cos, -sin} of W_M^e(i) per i
+// (TW_W bits each, scale 2^(TW_W-2), so +1 and -1 are exact), read from the hex file
+// TW_DIR + "fmt_fft_twMMMM.hex" that sim/fmt/fft_fixed.py generates.
+//
+// Arithmetic: four exact DW x TW_W products (one DSP48E each, DW <= 25), then
+//   re = (a c - b s + 2^(SH-1)) >>> SH,  im = (a s + b c + 2^(SH-1)) >>> SH
+// (round half up), saturated to OW bits; ovf_o is sticky and set when a valid element
+// saturated (the FFT's growth plan makes that impossible; the flag is there anyway).
+// Latency: 4 ce-steps (ROM/data register, products, sums, rounded output).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_fft_twiddle #(
+    parameter LOG2_N = `FMT_LOG2_N,  // window length N = 2^LOG2_N
+    parameter LOG2_M = `FMT_LOG2_N,  // block size M = 2^LOG2_M (8..1024)
+    parameter DW     = 15,           // input width (signed), <= 25 for one DSP48E per product
+    parameter OW     = 19,           // output width (signed)
+    parameter TW_W   = 18,           // twiddle width (signed), scale 2^(TW_W-2)
+    parameter SH     = 13,           // right shift after the products (>= 1)
+    parameter TW_DIR = "rtl/"        // directory of the twiddle hex files (with trailing /)
+) (
+    input  wire              clk,
+    input  wire              rst,          // synchronous, active high
+    input  wire              ce,           // sample strobe
+    input  wire              in_valid_i,   // input element valid
+    input  wire [LOG2_N-1:0] in_idx_i,     // its position in the window
+    input  wire signed [DW-1:0] in_re_i,   // real part
+    input  wire signed [DW-1:0] in_im_i,   // imaginary part
+    output reg               out_valid_o,  // output element valid (4 steps later)
+    output reg  [LOG2_N-1:0] out_idx_o,    // its position
+    output reg  signed [OW-1:0] out_re_o,  // rotated real part, OW bits
+    output reg  signed [OW-1:0] out_im_o,  // rotated imaginary part
+    output reg               ovf_o         // sticky: a valid element saturated since reset
+);
+
+    localparam M  = 1 << LOG2_M;
+    localparam PW = DW + TW_W;         // product width
+    localparam SW = PW + 1;            // sum width
+    localparam RW = SW - SH;           // width after the shift
+
+    // file name "fmt_fft_twMMMM.hex" (M as four decimal digits, ASCII '0' = 48)
+    localparam [31:0] DIG3 = 48 + (M / 1000) % 10;
+    localparam [31:0] DIG2 = 48 + (M / 100) % 10;
+    localparam [31:0] DIG1 = 48 + (M / 10) % 10;
+    localparam [31:0] DIG0 = 48 + M % 10;
+    localparam [8*18-1:0] TW_NAME = {"fmt_fft_tw", DIG3[7:0], DIG2[7:0], DIG1[7:0], DIG0[7:0], ".hex"};
+
+    reg [2*TW_W-1:0] rom [0:M-1];
+    initial $readmemh({TW_DIR, TW_NAME}, rom);
+
+    // step 1: twiddle and data registers
+    reg [2*TW_W-1:0]    tw_q;
+    reg signed [DW-1:0] a_q, b_q;
+    // step 2: products
+    reg signed [PW-1:0] p_ac_q, p_bs_q, p_as_q, p_bc_q;
+    // step 3: rounded sums (the low SH bits only carry the rounding into the kept bits)
+    /* verilator lint_off UNUSEDSIGNAL */
+    reg signed [SW-1:0] s_re_q, s_im_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [LOG2_N-1:0]    idx1_q, idx2_q, idx3_q;
+    reg                 v1_q, v2_q, v3_q;
+
+    wire signed [TW_W-1:0] tw_c = tw_q[2*TW_W-1:TW_W];
+    wire signed [TW_W-1:0] tw_s = tw_q[TW_W-1:0];
+    wire signed [SW-1:0]   half = {{(SW-1){1'b0}}, 1'b1} <<< (SH - 1);
+
+    always @(posedge clk) begin
+        if (ce) begin
+            tw_q   <= rom[in_idx_i[LOG2_M-1:0]];
+            a_q    <= in_re_i;
+            b_q    <= in_im_i;
+            p_ac_q <= a_q * tw_c;
+            p_bs_q <= b_q * tw_s;
+            p_as_q <= a_q * tw_s;
+            p_bc_q <= b_q * tw_c;
+            s_re_q <= p_ac_q - p_bs_q + half;
+            s_im_q <= p_as_q + p_bc_q + half;
+        end
+    end
+
+    // step 4: shift and saturate
+    wire signed [RW-1:0] r_re = s_re_q[SW-1:SH];
+    wire signed [RW-1:0] r_im = s_im_q[SW-1:SH];
+    wire signed [OW-1:0] q_re, q_im;
+    wire                 sat_re, sat_im;
+
+    generate
+        if (RW > OW) begin : g_sat
+            // fits when the bits above OW-1 all equal the sign bit
+            wire hi_re_ok = (r_re[RW-1:OW-1] == {(RW-OW+1){r_re[RW-1]}});
+            wire hi_im_ok = (r_im[RW-1:OW-1] == {(RW-OW+1){r_im[RW-1]}});
+            assign sat_re = ~hi_re_ok;
+            assign sat_im = ~hi_im_ok;
+            assign q_re = hi_re_ok ? r_re[OW-1:0] : {r_re[RW-1], {(OW-1){~r_re[RW-1]}}};
+            assign q_im = hi_im_ok ? r_im[OW-1:0] : {r_im[RW-1], {(OW-1){~r_im[RW-1]}}};
+        end else begin : g_nosat
+            assign sat_re = 1'b0;
+            assign sat_im = 1'b0;
+            assign q_re = {{(OW-RW){r_re[RW-1]}}, r_re};
+            assign q_im = {{(OW-RW){r_im[RW-1]}}, r_im};
+        end
+    endgenerate
+
+    always @(posedge clk) begin
+        if (ce) begin
+            out_re_o <= q_re;
+            out_im_o <= q_im;
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            v1_q <= 1'b0; v2_q <= 1'b0; v3_q <= 1'b0; out_valid_o <= 1'b0;
+            idx1_q <= {LOG2_N{1'b0}}; idx2_q <= {LOG2_N{1'b0}}; idx3_q <= {LOG2_N{1'b0}};
+            out_idx_o <= {LOG2_N{1'b0}};
+            ovf_o <= 1'b0;
+        end else if (ce) begin
+            v1_q <= in_valid_i;  v2_q <= v1_q;  v3_q <= v2_q;  out_valid_o <= v3_q;
+            idx1_q <= in_idx_i;  idx2_q <= idx1_q;  idx3_q <= idx2_q;  out_idx_o <= idx3_q;
+            if (v3_q && (sat_re || sat_im))
+                ovf_o <= 1'b1;
+        end
+    end
+
+endmodule
+
+`default_nettype wire
