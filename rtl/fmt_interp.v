@@ -1,0 +1,514 @@
+// fmt_interp -- fine touches: Von Neumann / Moore paraboloid fits of each coarse-touch
+// candidate's 3x3 neighbourhood (paper Eq. 3-7), ellipse of the half-height contour,
+// bias correction.  Bit-exact twin: fmt.interp.interp_fixed (sim/fmt/interp.py, whose
+// docstring is the full arithmetic specification; summary below).
+//
+// Fully pipelined: one candidate per clock in, touches out in the same order after
+// LAT = 23 clock cycles (cand_valid -> tp_valid, cand_eof -> tp_eof likewise).
+//
+// Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
+// neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
+// (z[0][+1] - z[0][-1]) / (2 (2 z00 - z[0][+1] - z[0][-1])) when both neighbours exist
+// and its denominator is > 0; else 0 (cell centre).  |offset| = round half up of a
+// 9-bit truncating quotient (fmt_div) in 1/256 cell, clamped to 128 (0.5 cell) when
+// >= 257/512; optional bias table (fmt_interp_bias_rom).  tp_x = col * 256 + offset
+// clamped to [0, (COLS-1) * 256], tp_y likewise: cells, 8 fractional bits.
+// Ellipse (Moore fit only): coefficients normalised to ~10-bit cells, G = F_v * 36 dm,
+// CORDIC (fmt_interp_cordic) for |(2(a-c), 3b)| and 1/2 atan2(B, A - C), log2 ROMs
+// (fmt_interp_lg) and an exp2 ROM (fmt_interp_exp) for the semi-axes
+// sqrt(F_v / (2 |lambda|)): tp_axis_major / tp_axis_minor in cells Q8.8 (0xFFFF =
+// saturated), tp_angle in pi/256 (0..255 = 0..pi).  0 when not defined.
+// tp_strength = the centre cell z00.  tp_flags: bit 0 fallback (Moore fit rejected,
+// Von Neumann denominator <= 0, or offset clamped), bit 1 saturated cell (2^HM_W - 1) in
+// the 3x3, bit 2 edge (a neighbour missing), bit 3 Moore fit used; bits 7:4 zero.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_interp #(
+    parameter ROWS    = `FMT_ROWS,      // sensor rows (y)
+    parameter COLS    = `FMT_COLS,      // sensor columns (x)
+    parameter HM_W    = `FMT_HM_W,      // heat-map cell width (unsigned), >= 10
+    parameter FRAME_W = 16,             // frame number width
+    parameter CNT_W   = 8,              // candidate count width (passed through)
+    parameter ROW_W   = (ROWS > 1) ? $clog2(ROWS) : 1,  // row index width
+    parameter COL_W   = (COLS > 1) ? $clog2(COLS) : 1   // column index width
+) (
+    input  wire                 clk,            // processing clock
+    input  wire                 rst,            // synchronous active-high reset
+    // run-time settings (sampled with each candidate)
+    input  wire                 moore_i,        // 1 = Moore fit (Eq. 5-6), 0 = Von Neumann (Eq. 3-4)
+    input  wire                 bias_en_i,      // 1 = bias correction on
+    // candidate stream (fmt_localmax)
+    input  wire                 cand_valid,     // one candidate this cycle
+    input  wire [FRAME_W-1:0]   cand_frame,     // frame number (with cand_valid and cand_eof)
+    input  wire [ROW_W-1:0]     cand_row,       // row of the centre cell
+    input  wire [COL_W-1:0]     cand_col,       // column of the centre cell
+    input  wire [9*HM_W-1:0]    cand_z,         // z[dy][dx] at [((dy+1)*3+dx+1)*HM_W +: HM_W]
+    input  wire [8:0]           cand_missing,   // bit k = neighbour k outside the sensor
+    input  wire                 cand_eof,       // end of the frame's candidates (pulse)
+    input  wire [CNT_W-1:0]     cand_count,     // candidates of the frame (with cand_eof)
+    input  wire                 cand_overflow,  // contact limit hit (with cand_eof)
+    // touch stream (fmt_tracker)
+    output wire                 tp_valid,       // one touch this cycle
+    output wire [FRAME_W-1:0]   tp_frame,       // frame number (with tp_valid and tp_eof)
+    output wire [15:0]          tp_x,           // column position, cells Q8.8 from cell (0,0)'s centre
+    output wire [15:0]          tp_y,           // row position, cells Q8.8
+    output wire [HM_W-1:0]      tp_strength,    // centre (peak) cell value
+    output wire [15:0]          tp_axis_major,  // semi-major axis of the half-height contour, Q8.8
+    output wire [15:0]          tp_axis_minor,  // semi-minor axis, Q8.8
+    output wire [7:0]           tp_angle,       // major-axis angle, pi/256 units
+    output wire [7:0]           tp_flags,       // see header
+    output wire                 tp_eof,         // cand_eof delayed by LAT
+    output wire [CNT_W-1:0]     tp_count,       // cand_count delayed by LAT
+    output wire                 tp_overflow     // cand_overflow delayed by LAT
+);
+    // ---- constants shared with the model (sim/tests/test_interp.py checks them) ----
+    localparam integer KQ = 6745;
+    localparam integer LC_MAJ = 58592;
+    localparam integer LC_MIN = 45608;
+    localparam integer ZN  = 10;        // normalised cell width of the ellipse path
+    localparam integer QW  = 9;         // offset quotient bits
+    localparam integer LAT = 23;        // total latency
+
+    // ---- widths ---------------------------------------------------------------------
+    localparam Z    = HM_W;
+    localparam CSW  = Z + 2;            // sum of three cells (unsigned)
+    localparam CW   = Z + 4;            // a, b, c, d, e (signed): |a| <= 6 (2^Z - 1)
+    localparam FW   = Z + 7;            // f (signed): -16 M .. 52 M
+    localparam VW   = Z + 4;            // Von Neumann num / den (signed)
+    localparam PRW  = 2 * CW;           // products of coefficients
+    localparam PW   = 2 * Z + 11;       // 6be - 8cd, 16ac - 9b^2 (signed): <= 612 M^2
+    localparam NW   = 15;               // normalised a..e (signed, |.| <= 6 * 2^10)
+    localparam FNW  = 18;               // normalised f
+    localparam N2W  = 2 * NW;           // normalised products
+    localparam DMW  = 32;               // normalised dm (signed, < 6.4e8)
+    localparam N3W  = NW + N2W;         // cn * dn^2 etc.
+    localparam QNW  = N3W + 1;          // qn (signed, < 2.9e11)
+    localparam GW   = 50;               // G (signed, < 3.8e13)
+    localparam IW   = 21;               // CORDIC input (signed, <= 393216)
+    localparam PPW  = 32;               // pp (signed, < 3.4e8)
+    localparam LW   = 22;               // log sums (signed)
+    localparam SHW  = 6;                // normalisation shift
+
+    // =================================================================================
+    // s1: input registers (missing neighbours forced to 0)
+    // =================================================================================
+    reg [Z-1:0]         s1_z [0:8];
+    reg [8:0]           s1_miss;
+    reg [ROW_W-1:0]     s1_row;
+    reg [COL_W-1:0]     s1_col;
+    reg                 s1_moore, s1_bias;
+    integer k;
+    always @(posedge clk) begin
+        for (k = 0; k < 9; k = k + 1)
+            s1_z[k] <= cand_missing[k] ? {Z{1'b0}} : cand_z[k*Z +: Z];
+        s1_miss  <= cand_missing;
+        s1_row   <= cand_row;
+        s1_col   <= cand_col;
+        s1_moore <= moore_i;
+        s1_bias  <= bias_en_i;
+    end
+
+    // valid pipeline and the pass-through of frame / eof / count / overflow
+    wire [1:0] ctl_q;
+    fmt_interp_dly #(.W(2), .N(LAT), .RST(1)) u_dly_ctl (
+        .clk(clk), .rst(rst), .d_i({cand_valid, cand_eof}), .q_o(ctl_q));
+    fmt_interp_dly #(.W(FRAME_W + CNT_W + 1), .N(LAT), .RST(0)) u_dly_frm (
+        .clk(clk), .rst(rst), .d_i({cand_frame, cand_count, cand_overflow}),
+        .q_o({tp_frame, tp_count, tp_overflow}));
+    assign tp_valid = ctl_q[1];
+    assign tp_eof   = ctl_q[0];
+
+    // =================================================================================
+    // s2: sums, Von Neumann terms, flags, normalisation shift
+    // =================================================================================
+    // z index k = (dy+1)*3 + (dx+1): 0 = (-1,-1), 1 = (-1,0), 2 = (-1,+1), 3 = (0,-1),
+    // 4 = centre, 5 = (0,+1), 6 = (+1,-1), 7 = (+1,0), 8 = (+1,+1)
+    wire [CSW-1:0] cs0 = {2'b0, s1_z[0]} + {2'b0, s1_z[3]} + {2'b0, s1_z[6]};
+    wire [CSW-1:0] cs1 = {2'b0, s1_z[1]} + {2'b0, s1_z[4]} + {2'b0, s1_z[7]};
+    wire [CSW-1:0] cs2 = {2'b0, s1_z[2]} + {2'b0, s1_z[5]} + {2'b0, s1_z[8]};
+    wire [CSW-1:0] rs0 = {2'b0, s1_z[0]} + {2'b0, s1_z[1]} + {2'b0, s1_z[2]};
+    wire [CSW-1:0] rs1 = {2'b0, s1_z[3]} + {2'b0, s1_z[4]} + {2'b0, s1_z[5]};
+    wire [CSW-1:0] rs2 = {2'b0, s1_z[6]} + {2'b0, s1_z[7]} + {2'b0, s1_z[8]};
+    wire [Z:0]     dg  = {1'b0, s1_z[8]} + {1'b0, s1_z[0]};     // xy = +1 corners
+    wire [Z:0]     ad  = {1'b0, s1_z[2]} + {1'b0, s1_z[6]};     // xy = -1 corners
+    wire [Z+1:0]   edg = {2'b0, s1_z[1]} + {2'b0, s1_z[3]} + {2'b0, s1_z[5]} + {2'b0, s1_z[7]};
+    wire [Z+1:0]   crn = {1'b0, dg} + {1'b0, ad};
+    wire signed [VW-1:0] z4s = {{(VW-Z){1'b0}}, s1_z[4]};
+    wire signed [VW-1:0] z3s = {{(VW-Z){1'b0}}, s1_z[3]};
+    wire signed [VW-1:0] z5s = {{(VW-Z){1'b0}}, s1_z[5]};
+    wire signed [VW-1:0] z1s = {{(VW-Z){1'b0}}, s1_z[1]};
+    wire signed [VW-1:0] z7s = {{(VW-Z){1'b0}}, s1_z[7]};
+
+    reg [Z-1:0] orv;
+    reg         sat_d;
+    reg [SHW-1:0] sh_d;
+    integer j;
+    /* verilator lint_off UNUSEDSIGNAL */ // jt: only its low SHW bits are the shift
+    integer jt;
+    /* verilator lint_on UNUSEDSIGNAL */
+    always @(*) begin
+        jt = 0;
+        orv = {Z{1'b0}};
+        sat_d = 1'b0;
+        for (j = 0; j < 9; j = j + 1) begin
+            orv = orv | s1_z[j];
+            if (!s1_miss[j] && (&s1_z[j])) sat_d = 1'b1;
+        end
+        // sh = max(0, bitlen(orv) - ZN)
+        sh_d = {SHW{1'b0}};
+        for (j = ZN; j < Z; j = j + 1)
+            if (orv[j]) begin
+                jt = j - ZN + 1;
+                sh_d = jt[SHW-1:0];
+            end
+    end
+
+    reg [CSW-1:0]        s2_cs0, s2_cs1, s2_cs2, s2_rs0, s2_rs1, s2_rs2;
+    reg [Z:0]            s2_dg, s2_ad;
+    reg [Z+1:0]          s2_edg, s2_crn;
+    reg [Z-1:0]          s2_z4;
+    reg signed [VW-1:0]  s2_nvx, s2_dvx, s2_nvy, s2_dvy;
+    reg                  s2_mx, s2_my, s2_edge, s2_sat, s2_moore, s2_bias;
+    reg [SHW-1:0]        s2_sh;
+    always @(posedge clk) begin
+        s2_cs0 <= cs0; s2_cs1 <= cs1; s2_cs2 <= cs2;
+        s2_rs0 <= rs0; s2_rs1 <= rs1; s2_rs2 <= rs2;
+        s2_dg  <= dg;  s2_ad  <= ad;  s2_edg <= edg; s2_crn <= crn;
+        s2_z4  <= s1_z[4];
+        s2_nvx <= z5s - z3s;
+        s2_dvx <= (((z4s <<< 1) - z5s) - z3s) <<< 1;
+        s2_nvy <= z7s - z1s;
+        s2_dvy <= (((z4s <<< 1) - z7s) - z1s) <<< 1;
+        s2_mx  <= s1_miss[3] | s1_miss[5];
+        s2_my  <= s1_miss[1] | s1_miss[7];
+        s2_edge <= |s1_miss;
+        s2_sat <= sat_d;
+        s2_sh  <= sh_d;
+        s2_moore <= s1_moore;
+        s2_bias  <= s1_bias;
+    end
+
+    // =================================================================================
+    // s3: coefficients a..f (x36 / x24 / x6 scaled, see fmt.interp.coeffs)
+    // =================================================================================
+    wire signed [CW-1:0] cs0s = {{(CW-CSW){1'b0}}, s2_cs0};
+    wire signed [CW-1:0] cs1s = {{(CW-CSW){1'b0}}, s2_cs1};
+    wire signed [CW-1:0] cs2s = {{(CW-CSW){1'b0}}, s2_cs2};
+    wire signed [CW-1:0] rs0s = {{(CW-CSW){1'b0}}, s2_rs0};
+    wire signed [CW-1:0] rs1s = {{(CW-CSW){1'b0}}, s2_rs1};
+    wire signed [CW-1:0] rs2s = {{(CW-CSW){1'b0}}, s2_rs2};
+    wire signed [FW-1:0] z4f  = {{(FW-Z){1'b0}}, s2_z4};
+    wire signed [FW-1:0] edgf = {{(FW-Z-2){1'b0}}, s2_edg};
+    wire signed [FW-1:0] crnf = {{(FW-Z-2){1'b0}}, s2_crn};
+
+    reg signed [CW-1:0]  s3_a, s3_b, s3_c, s3_d, s3_e;
+    reg signed [FW-1:0]  s3_f;
+    reg signed [VW-1:0]  s3_nvx, s3_dvx, s3_nvy, s3_dvy;
+    reg                  s3_mx, s3_my, s3_edge, s3_sat, s3_moore, s3_bias;
+    reg [SHW-1:0]        s3_sh;
+    always @(posedge clk) begin
+        s3_a <= cs0s + cs2s - (cs1s <<< 1);
+        s3_c <= rs0s + rs2s - (rs1s <<< 1);
+        s3_b <= $signed({{(CW-Z-1){1'b0}}, s2_dg}) - $signed({{(CW-Z-1){1'b0}}, s2_ad});
+        s3_d <= cs2s - cs0s;
+        s3_e <= rs2s - rs0s;
+        s3_f <= z4f * 20 + (edgf <<< 3) - (crnf <<< 2);
+        s3_nvx <= s2_nvx; s3_dvx <= s2_dvx; s3_nvy <= s2_nvy; s3_dvy <= s2_dvy;
+        s3_mx <= s2_mx; s3_my <= s2_my; s3_edge <= s2_edge; s3_sat <= s2_sat;
+        s3_moore <= s2_moore; s3_bias <= s2_bias; s3_sh <= s2_sh;
+    end
+
+    // =================================================================================
+    // s4: products (position path), normalised coefficients (ellipse path)
+    // =================================================================================
+    reg signed [PRW-1:0] s4_be, s4_cd, s4_bd, s4_ae, s4_ac, s4_bb;
+    reg signed [NW-1:0]  s4_an, s4_bn, s4_cn, s4_dn, s4_en;
+    reg signed [FNW-1:0] s4_fn;
+    reg signed [VW-1:0]  s4_nvx, s4_dvx, s4_nvy, s4_dvy;
+    reg                  s4_mx, s4_my, s4_edge, s4_sat, s4_moore, s4_bias, s4_aneg;
+    /* verilator lint_off WIDTHTRUNC */ // the shifted coefficients fit NW / FNW bits (see widths)
+    always @(posedge clk) begin
+        s4_be <= s3_b * s3_e;
+        s4_cd <= s3_c * s3_d;
+        s4_bd <= s3_b * s3_d;
+        s4_ae <= s3_a * s3_e;
+        s4_ac <= s3_a * s3_c;
+        s4_bb <= s3_b * s3_b;
+        s4_an <= s3_a >>> s3_sh;
+        s4_bn <= s3_b >>> s3_sh;
+        s4_cn <= s3_c >>> s3_sh;
+        s4_dn <= s3_d >>> s3_sh;
+        s4_en <= s3_e >>> s3_sh;
+        s4_fn <= s3_f >>> s3_sh;
+        s4_nvx <= s3_nvx; s4_dvx <= s3_dvx; s4_nvy <= s3_nvy; s4_dvy <= s3_dvy;
+        s4_mx <= s3_mx; s4_my <= s3_my; s4_edge <= s3_edge; s4_sat <= s3_sat;
+        s4_moore <= s3_moore; s4_bias <= s3_bias;
+        s4_aneg <= s3_a[CW-1];
+    end
+    /* verilator lint_on WIDTHTRUNC */
+
+    // CORDIC on (2 (an - cn), 3 bn) << 4: magnitude at s17, angle at s17
+    wire signed [NW-1:0] amc = s4_an - s4_cn;      // |an - cn| <= 12288 fits NW bits
+    wire signed [IW-1:0] cu = {{(IW-NW-1){amc[NW-1]}}, amc, 1'b0} <<< 4;
+    wire signed [IW-1:0] cv = ({{(IW-NW){s4_bn[NW-1]}}, s4_bn} * 3) <<< 4;
+    wire [IW+1:0] cor_mag;
+    wire [15:0]   cor_ang;
+    /* verilator lint_off PINCONNECTEMPTY */ // the LAT-long control delay carries valid
+    fmt_interp_cordic #(.IW(IW), .N(12)) u_cordic (
+        .clk(clk), .rst(rst), .valid_i(1'b0), .u_i(cu), .v_i(cv),
+        .valid_o(), .mag_o(cor_mag), .ang_o(cor_ang));
+    /* verilator lint_on PINCONNECTEMPTY */
+
+    // =================================================================================
+    // s5: numerators / denominator of the Moore fit; normalised products
+    // =================================================================================
+    wire signed [PW-1:0] be_w = {{(PW-PRW){s4_be[PRW-1]}}, s4_be};
+    wire signed [PW-1:0] cd_w = {{(PW-PRW){s4_cd[PRW-1]}}, s4_cd};
+    wire signed [PW-1:0] bd_w = {{(PW-PRW){s4_bd[PRW-1]}}, s4_bd};
+    wire signed [PW-1:0] ae_w = {{(PW-PRW){s4_ae[PRW-1]}}, s4_ae};
+    wire signed [PW-1:0] ac_w = {{(PW-PRW){s4_ac[PRW-1]}}, s4_ac};
+    wire signed [PW-1:0] bb_w = {{(PW-PRW){s4_bb[PRW-1]}}, s4_bb};
+
+    reg signed [PW-1:0]  s5_nmx, s5_nmy, s5_dm;
+    reg signed [N2W-1:0] s5_acn, s5_bbn, s5_ddn, s5_den, s5_een;
+    reg signed [NW-1:0]  s5_an, s5_bn, s5_cn;
+    reg signed [FNW-1:0] s5_fn;
+    reg signed [NW+2:0]  s5_p;
+    reg signed [VW-1:0]  s5_nvx, s5_dvx, s5_nvy, s5_dvy;
+    reg                  s5_mx, s5_my, s5_edge, s5_sat, s5_moore, s5_bias, s5_aneg;
+    always @(posedge clk) begin
+        s5_nmx <= (be_w * 6) - (cd_w <<< 3);
+        s5_nmy <= (bd_w * 6) - (ae_w <<< 3);
+        s5_dm  <= (ac_w <<< 4) - (bb_w * 9);
+        s5_acn <= s4_an * s4_cn;
+        s5_bbn <= s4_bn * s4_bn;
+        s5_ddn <= s4_dn * s4_dn;
+        s5_den <= s4_dn * s4_en;
+        s5_een <= s4_en * s4_en;
+        s5_an <= s4_an; s5_bn <= s4_bn; s5_cn <= s4_cn; s5_fn <= s4_fn;
+        s5_p  <= -(({{3{s4_an[NW-1]}}, s4_an} + {{3{s4_cn[NW-1]}}, s4_cn}) <<< 1);
+        s5_nvx <= s4_nvx; s5_dvx <= s4_dvx; s5_nvy <= s4_nvy; s5_dvy <= s4_dvy;
+        s5_mx <= s4_mx; s5_my <= s4_my; s5_edge <= s4_edge; s5_sat <= s4_sat;
+        s5_moore <= s4_moore; s5_bias <= s4_bias; s5_aneg <= s4_aneg;
+    end
+
+    // =================================================================================
+    // s6: fit selection per axis; ellipse products
+    // =================================================================================
+    wire moore_ok = s5_moore & ~s5_edge & s5_aneg & (s5_dm > 0);
+    wire vx_ok = ~s5_mx & (s5_dvx > 0);
+    wire vy_ok = ~s5_my & (s5_dvy > 0);
+    wire signed [PW-1:0] nvx_w = {{(PW-VW){s5_nvx[VW-1]}}, s5_nvx};
+    wire signed [PW-1:0] dvx_w = {{(PW-VW){s5_dvx[VW-1]}}, s5_dvx};
+    wire signed [PW-1:0] nvy_w = {{(PW-VW){s5_nvy[VW-1]}}, s5_nvy};
+    wire signed [PW-1:0] dvy_w = {{(PW-VW){s5_dvy[VW-1]}}, s5_dvy};
+    wire signed [PW-1:0] one_w = 1;
+    wire signed [PW-1:0] numx = moore_ok ? s5_nmx : (vx_ok ? nvx_w : {PW{1'b0}});
+    /* verilator lint_off UNUSEDSIGNAL */ // sign bits of den: only used when den > 0
+    wire signed [PW-1:0] denx = moore_ok ? s5_dm  : (vx_ok ? dvx_w : one_w);
+    wire signed [PW-1:0] numy = moore_ok ? s5_nmy : (vy_ok ? nvy_w : {PW{1'b0}});
+    wire signed [PW-1:0] deny = moore_ok ? s5_dm  : (vy_ok ? dvy_w : one_w);
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire fb_d = (s5_moore & ~s5_edge & ~moore_ok)
+              | (~moore_ok & ~s5_mx & ~(s5_dvx > 0))
+              | (~moore_ok & ~s5_my & ~(s5_dvy > 0));
+
+    wire signed [DMW-1:0] acn_w = {{(DMW-N2W){s5_acn[N2W-1]}}, s5_acn};
+    wire signed [DMW-1:0] bbn_w = {{(DMW-N2W){s5_bbn[N2W-1]}}, s5_bbn};
+    reg [PW-2:0]         s6_magx, s6_magy, s6_denx, s6_deny;
+    reg                  s6_sgx, s6_sgy, s6_fb, s6_mok, s6_edge, s6_sat, s6_bias;
+    reg signed [DMW-1:0] s6_dmn;
+    reg signed [N3W-1:0] s6_cdd, s6_bde, s6_aee;
+    reg signed [FNW-1:0] s6_fn;
+    /* verilator lint_off WIDTHTRUNC */ // |num|, den > 0 fit PW-1 bits; dm_n fits DMW bits
+    always @(posedge clk) begin
+        s6_magx <= numx[PW-1] ? -numx : numx;
+        s6_magy <= numy[PW-1] ? -numy : numy;
+        s6_denx <= denx;
+        s6_deny <= deny;
+        s6_sgx  <= numx[PW-1];
+        s6_sgy  <= numy[PW-1];
+        s6_fb   <= fb_d;
+        s6_mok  <= moore_ok;
+        s6_edge <= s5_edge;
+        s6_sat  <= s5_sat;
+        s6_bias <= s5_bias;
+        s6_dmn  <= (acn_w <<< 4) - (bbn_w * 9);
+        s6_cdd  <= s5_cn * s5_ddn;
+        s6_bde  <= s5_bn * s5_den;
+        s6_aee  <= s5_an * s5_een;
+        s6_fn   <= s5_fn;
+    end
+    /* verilator lint_on WIDTHTRUNC */
+
+    // ---- offset dividers: q = floor(|num| * 512 / den), s7 .. s16 ----
+    wire [QW-1:0] qx, qy;
+    wire          ovx, ovy;
+    /* verilator lint_off PINCONNECTEMPTY */ // valid travels in the control delay line
+    fmt_div #(.NUM_W(PW - 1 + QW), .DEN_W(PW - 1), .QW(QW)) u_divx (
+        .clk(clk), .rst(rst), .valid_i(1'b0), .num_i({s6_magx, {QW{1'b0}}}), .den_i(s6_denx),
+        .valid_o(), .quot_o(qx), .ovf_o(ovx));
+    fmt_div #(.NUM_W(PW - 1 + QW), .DEN_W(PW - 1), .QW(QW)) u_divy (
+        .clk(clk), .rst(rst), .valid_i(1'b0), .num_i({s6_magy, {QW{1'b0}}}), .den_i(s6_deny),
+        .valid_o(), .quot_o(qy), .ovf_o(ovy));
+    /* verilator lint_on PINCONNECTEMPTY */
+
+    // side information of the position path: s6 -> s16
+    wire s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias;
+    fmt_interp_dly #(.W(7), .N(QW + 1), .RST(0)) u_dly_pos (
+        .clk(clk), .rst(rst),
+        .d_i({s6_sgx, s6_sgy, s6_mok, s6_fb, s6_edge, s6_sat, s6_bias}),
+        .q_o({s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias}));
+
+    // =================================================================================
+    // ellipse path s7 .. s9: qn, G
+    // =================================================================================
+    wire signed [QNW-1:0] cdd_w = {{(QNW-N3W){s6_cdd[N3W-1]}}, s6_cdd};
+    wire signed [QNW-1:0] bde_w = {{(QNW-N3W){s6_bde[N3W-1]}}, s6_bde};
+    wire signed [QNW-1:0] aee_w = {{(QNW-N3W){s6_aee[N3W-1]}}, s6_aee};
+    reg signed [QNW-1:0] s7_qn;
+    reg signed [DMW-1:0] s7_dmn;
+    reg signed [FNW-1:0] s7_fn;
+    reg signed [GW-1:0]  s8_fdm, s8_q12;
+    reg signed [DMW-1:0] s8_dmn;
+    reg signed [GW-1:0]  s9_g;
+    reg signed [DMW-1:0] s9_dmn;
+    always @(posedge clk) begin
+        s7_qn  <= (cdd_w <<< 1) - (bde_w * 3) + (aee_w <<< 1);
+        s7_dmn <= s6_dmn;
+        s7_fn  <= s6_fn;
+        s8_fdm <= s7_fn * s7_dmn;
+        s8_q12 <= s7_qn * 12;
+        s8_dmn <= s7_dmn;
+        s9_g   <= s8_fdm - s8_q12;
+        s9_dmn <= s8_dmn;
+    end
+    wire g_pos9  = ~s9_g[GW-1] & (|s9_g);
+    wire dm_pos9 = ~s9_dmn[DMW-1] & (|s9_dmn);
+
+    wire [$clog2(GW)+11:0]  lg_g11;
+    wire [$clog2(DMW)+11:0] lg_dm11;
+    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(s9_g), .lg_o(lg_g11));
+    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(s9_dmn), .lg_o(lg_dm11));
+    wire [$clog2(GW)+11:0]  lg_g20;
+    wire [$clog2(DMW)+11:0] lg_dm20;
+    fmt_interp_dly #(.W($clog2(GW) + 12 + $clog2(DMW) + 12), .N(9), .RST(0)) u_dly_lg (
+        .clk(clk), .rst(rst), .d_i({lg_g11, lg_dm11}), .q_o({lg_g20, lg_dm20}));
+    wire pos_ok20;
+    fmt_interp_dly #(.W(1), .N(11), .RST(0)) u_dly_pos9 (
+        .clk(clk), .rst(rst), .d_i(g_pos9 & dm_pos9), .q_o(pos_ok20));
+
+    // ---- pp = p * KQ + (|s| K << 8) at s18 ----
+    wire signed [NW+2:0] p17;
+    fmt_interp_dly #(.W(NW + 3), .N(12), .RST(0)) u_dly_p (
+        .clk(clk), .rst(rst), .d_i(s5_p), .q_o(p17));
+    reg signed [PPW-1:0] s18_pp;
+    /* verilator lint_off WIDTHTRUNC */ // pp < 3.4e8 fits PPW bits
+    always @(posedge clk)
+        s18_pp <= {{(PPW-NW-3){p17[NW+2]}}, p17} * KQ
+                + $signed({{(PPW-IW-2){1'b0}}, cor_mag} << 8);
+    /* verilator lint_on WIDTHTRUNC */
+    wire pp_pos18 = ~s18_pp[PPW-1] & (|s18_pp);
+    wire [$clog2(PPW)+11:0] lg_pp20;
+    fmt_interp_lg #(.X_W(PPW)) u_lg_pp (.clk(clk), .x_i(s18_pp), .lg_o(lg_pp20));
+    reg pp_pos19, pp_pos20;
+    always @(posedge clk) begin
+        pp_pos19 <= pp_pos18;
+        pp_pos20 <= pp_pos19;
+    end
+
+    // ---- s21: log2 of the squared semi-axes ----
+    wire signed [LW-1:0] lgg = {{(LW-$clog2(GW)-12){1'b0}}, lg_g20};
+    wire signed [LW-1:0] lgd = {{(LW-$clog2(DMW)-12){1'b0}}, lg_dm20};
+    wire signed [LW-1:0] lgp = {{(LW-$clog2(PPW)-12){1'b0}}, lg_pp20};
+    localparam signed [LW-1:0] LCMAJ_W = LC_MAJ[LW-1:0];
+    localparam signed [LW-1:0] LCMIN_W = LC_MIN[LW-1:0];
+    reg signed [LW-1:0] s21_lmaj, s21_lmin;
+    reg                 s21_ok;
+    always @(posedge clk) begin
+        s21_lmaj <= lgg + lgp - (lgd <<< 1) - LCMAJ_W;
+        s21_lmin <= lgg - lgd - lgp + LCMIN_W;
+        s21_ok   <= pos_ok20 & pp_pos20;
+    end
+    wire [15:0] ax_maj23, ax_min23;
+    fmt_interp_exp #(.LW(LW)) u_exp_maj (.clk(clk), .l_i(s21_lmaj), .axis_o(ax_maj23));
+    fmt_interp_exp #(.LW(LW)) u_exp_min (.clk(clk), .l_i(s21_lmin), .axis_o(ax_min23));
+    wire ell_ok23;
+    fmt_interp_dly #(.W(1), .N(2), .RST(0)) u_dly_eok (
+        .clk(clk), .rst(rst), .d_i(s21_ok), .q_o(ell_ok23));
+
+    // ---- angle: ((z + 128) >> 8) mod 256 at s17 -> s23 ----
+    /* verilator lint_off UNUSEDSIGNAL */ // the low byte only rounds
+    wire [15:0] ang_r = cor_ang + 16'd128;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [7:0] ang23;
+    fmt_interp_dly #(.W(8), .N(6), .RST(0)) u_dly_ang (
+        .clk(clk), .rst(rst), .d_i(ang_r[15:8]), .q_o(ang23));
+
+    // =================================================================================
+    // position s17: round / clamp; s18: bias table; s19: coordinates
+    // =================================================================================
+    wire clx = ovx | (qx >= 257);
+    wire cly = ovy | (qy >= 257);
+    /* verilator lint_off UNUSEDSIGNAL */ // (q + 1) >> 1 for q <= 256: bits 8:1 only
+    wire [QW:0] qx1 = {1'b0, qx} + 1'b1;
+    wire [QW:0] qy1 = {1'b0, qy} + 1'b1;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [7:0] s17_rx, s17_ry;
+    reg       s17_sgx, s17_sgy, s17_mok, s17_bias;
+    reg [3:0] s17_flags;
+    always @(posedge clk) begin
+        s17_rx  <= clx ? 8'd128 : qx1[8:1];
+        s17_ry  <= cly ? 8'd128 : qy1[8:1];
+        s17_sgx <= s16_sgx;
+        s17_sgy <= s16_sgy;
+        s17_mok <= s16_mok;
+        s17_bias <= s16_bias;
+        s17_flags <= {s16_mok, s16_edge, s16_sat, s16_fb | clx | cly};
+    end
+    wire [7:0] bx18, by18;
+    fmt_interp_bias_rom u_bias_x (.clk(clk), .addr_i({s17_mok, s17_rx}), .data_o(bx18));
+    fmt_interp_bias_rom u_bias_y (.clk(clk), .addr_i({s17_mok, s17_ry}), .data_o(by18));
+    reg [7:0] s18_rx, s18_ry;
+    reg       s18_sgx, s18_sgy, s18_bias;
+    always @(posedge clk) begin
+        s18_rx <= s17_rx; s18_ry <= s17_ry;
+        s18_sgx <= s17_sgx; s18_sgy <= s17_sgy; s18_bias <= s17_bias;
+    end
+    wire [ROW_W-1:0] row18;
+    wire [COL_W-1:0] col18;
+    fmt_interp_dly #(.W(ROW_W + COL_W), .N(17), .RST(0)) u_dly_rc (
+        .clk(clk), .rst(rst), .d_i({s1_row, s1_col}), .q_o({row18, col18}));
+    wire [7:0] ox = s18_bias ? bx18 : s18_rx;
+    wire [7:0] oy = s18_bias ? by18 : s18_ry;
+    wire signed [18:0] colq = {{(11-COL_W){1'b0}}, col18, 8'd0};
+    wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, row18, 8'd0};
+    wire signed [18:0] oxs  = {11'd0, ox};
+    wire signed [18:0] oys  = {11'd0, oy};
+    wire signed [18:0] xs = s18_sgx ? colq - oxs : colq + oxs;
+    wire signed [18:0] ys = s18_sgy ? rowq - oys : rowq + oys;
+    localparam signed [18:0] XMAX = (COLS - 1) * 256;
+    localparam signed [18:0] YMAX = (ROWS - 1) * 256;
+    reg [15:0] s19_x, s19_y;
+    /* verilator lint_off WIDTHTRUNC */ // clamped values fit 16 bits
+    always @(posedge clk) begin
+        s19_x <= xs[18] ? 19'sd0 : (xs > XMAX ? XMAX : xs);
+        s19_y <= ys[18] ? 19'sd0 : (ys > YMAX ? YMAX : ys);
+    end
+    /* verilator lint_on WIDTHTRUNC */
+    fmt_interp_dly #(.W(32), .N(4), .RST(0)) u_dly_xy (
+        .clk(clk), .rst(rst), .d_i({s19_x, s19_y}), .q_o({tp_x, tp_y}));
+    wire [3:0] flags23;
+    fmt_interp_dly #(.W(4), .N(6), .RST(0)) u_dly_flg (
+        .clk(clk), .rst(rst), .d_i(s17_flags), .q_o(flags23));
+    fmt_interp_dly #(.W(Z), .N(LAT - 1), .RST(0)) u_dly_str (
+        .clk(clk), .rst(rst), .d_i(s1_z[4]), .q_o(tp_strength));
+
+    wire ell23 = flags23[3] & ell_ok23;
+    assign tp_flags      = {4'd0, flags23};
+    assign tp_axis_major = ell23 ? ax_maj23 : 16'd0;
+    assign tp_axis_minor = ell23 ? ax_min23 : 16'd0;
+    assign tp_angle      = ell23 ? ang23 : 8'd0;
+endmodule
+`default_nettype wire
