@@ -1,0 +1,400 @@
+// fmt_localmax -- coarse touches: strict 3x3 local maxima above a threshold, with the
+// raster-order tie rule, streamed out strongest first (twin: sim/fmt/localmax.py).
+//
+// Rule: cell p is a maximum iff z[p] >= threshold_i and, for every neighbour q on the
+// sensor (Moore 8 or Von Neumann 4, moore_i): z[p] > z[q] when q precedes p in raster
+// order (row above, or left), z[p] >= z[q] when q follows it (right, or row below).
+// Missing neighbours (edges, corners) do not disqualify.  Two equal neighbouring cells
+// give exactly one maximum (the first in raster order).
+//
+// Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most.
+// Storage: the rows are written into an inferred RAM of 2 x ROWS words of COLS*HM_W
+// bits (two frame buffers: the next frame's rows may arrive while the current frame is
+// still being finished) with 3 synchronous read ports (rows r-1, r, r+1).  An arrival
+// bitmap per buffer marks the rows present; row r is "ready" as soon as it and its
+// existing neighbour rows are present, so evaluation runs while the frame arrives:
+//   E0: pick the lowest ready row, read rows r-1, r, r+1          (1 row per cycle)
+//   E1: compare every cell of row r with its neighbours -> maxima mask (COLS bits)
+//   E2: serialise the maxima, one per cycle (lowest column first), gather the 3x3
+//   E3: insert the candidate into a sorted list of MAX_TOUCHES entries (z descending,
+//       ties by raster index ascending); the weakest falls off the end.
+// After the frame's hm_eof, once every row is evaluated, the list is emitted, one
+// candidate per cycle, then cand_eof.  Settings (threshold_i, moore_i, limit_i) are
+// used live: change them between frames.
+//
+// Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
+// hm_eof right after the last row): last row beat -> last candidate = 6 + n cycles
+// for n candidates (1 -> 7, 5 -> 11), plus one cycle per maximum that lies in the rows
+// completed by the last beat (16 maxima all in the last row: 41); hm_eof -> last
+// candidate is one cycle less; cand_eof follows the last candidate.  Throughput: one
+// row per cycle plus one cycle per maximum; a frame must be finished (cand_eof) before
+// the frame after the next one starts to arrive, else overrun_o is set (sticky).
+//
+// Candidate stream: cand_valid_o with cand_frame_o, cand_row_o, cand_col_o, cand_z_o
+// (the 3x3 neighbourhood, k = (dy+1)*3 + (dx+1) at [k*HM_W +: HM_W], 0 outside the
+// sensor) and cand_missing_o (bit k = neighbour outside); then a one-cycle cand_eof_o
+// (also for a frame without candidates) with cand_count_o (emitted), cand_found_o
+// (maxima before the limit), cand_overflow_o (found > limit) and cand_incomplete_o (the
+// frame missed rows, e.g. after a reset in its middle: no candidates are emitted).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_localmax #(
+    parameter ROWS        = `FMT_ROWS,          // heat-map rows
+    parameter COLS        = `FMT_COLS,          // heat-map columns
+    parameter HM_W        = `FMT_HM_W,          // cell width, unsigned
+    parameter MAX_TOUCHES = `FMT_MAX_TOUCHES,   // candidate list length (contact limit)
+    parameter FRAME_W     = 16,                 // frame number width
+    parameter CNT_W       = 16,                 // dropped-candidate counter width (>= FOUND_W)
+    parameter ROW_IDX_W   = (ROWS > 1) ? $clog2(ROWS) : 1,         // row index width
+    parameter COL_IDX_W   = (COLS > 1) ? $clog2(COLS) : 1,         // column index width
+    parameter LIM_W       = $clog2(MAX_TOUCHES + 1),               // limit / count width
+    parameter FOUND_W     = $clog2(ROWS * COLS + 1)                // maxima counter width
+) (
+    input  wire                   clk,
+    input  wire                   rst,              // synchronous, active high
+    // settings
+    input  wire [HM_W-1:0]        threshold_i,      // z >= threshold_i may be a touch
+    input  wire                   moore_i,          // 1 = Moore (8 neighbours), 0 = Von Neumann (4)
+    input  wire [LIM_W-1:0]       limit_i,          // contact limit (values > MAX_TOUCHES act as MAX_TOUCHES)
+    // heat-map stream in
+    input  wire                   hm_valid_i,       // one row this cycle
+    input  wire [ROW_IDX_W-1:0]   hm_row_i,         // row index
+    input  wire [FRAME_W-1:0]     hm_frame_i,       // frame number (taken with hm_eof_i)
+    input  wire [COLS*HM_W-1:0]   hm_data_i,        // column c at [c*HM_W +: HM_W]
+    input  wire                   hm_eof_i,         // end of frame
+    // candidate stream out
+    output reg                    cand_valid_o,     // one candidate
+    output reg  [FRAME_W-1:0]     cand_frame_o,     // frame number (with cand_valid_o and cand_eof_o)
+    output reg  [ROW_IDX_W-1:0]   cand_row_o,       // row of the maximum
+    output reg  [COL_IDX_W-1:0]   cand_col_o,       // column of the maximum
+    output reg  [9*HM_W-1:0]      cand_z_o,         // 3x3 neighbourhood
+    output reg  [8:0]             cand_missing_o,   // 1 = neighbour k outside the sensor
+    output reg                    cand_eof_o,       // after the frame's last candidate
+    output reg  [LIM_W-1:0]       cand_count_o,     // candidates emitted (with cand_eof_o)
+    output reg  [FOUND_W-1:0]     cand_found_o,     // maxima found (with cand_eof_o)
+    output reg                    cand_overflow_o,  // found > limit (with cand_eof_o)
+    output reg                    cand_incomplete_o,// frame had missing rows (with cand_eof_o)
+    // monitor
+    output reg                    overflow_flag_o,  // sticky: some frame exceeded the limit
+    output reg  [CNT_W-1:0]       drop_count_o,     // candidates dropped (saturating)
+    output reg                    overrun_o         // sticky: frames arrived faster than processed
+);
+
+    localparam K      = MAX_TOUCHES;
+    localparam ADDR_W = $clog2(2 * ROWS);
+    localparam RW     = COLS * HM_W;
+    localparam IDX_W  = ROW_IDX_W + COL_IDX_W;    // raster key {row, col}
+    localparam Z9_W   = 9 * HM_W;
+    localparam integer LAST_ROW_I = ROWS - 1;
+    localparam integer LAST_COL_I = COLS - 1;
+    localparam integer ROWS_I     = ROWS;
+    localparam integer K_I        = MAX_TOUCHES;
+    localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
+    localparam [COL_IDX_W-1:0] LAST_COL = LAST_COL_I[COL_IDX_W-1:0];
+    localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
+    localparam [LIM_W-1:0]     K_L      = K_I[LIM_W-1:0];
+
+    // ---- frame buffers and arrival bookkeeping ----------------------------------------
+    reg [RW-1:0]         mem [0:2*ROWS-1];
+    reg [ROWS-1:0]       arr_q [0:1];       // rows present, per buffer
+    reg [1:0]            eofs_q;            // hm_eof seen, per buffer
+    reg [FRAME_W-1:0]    frm_q [0:1];       // frame number, per buffer
+    reg                  wb_q;              // buffer receiving rows
+    reg                  pb_q;              // buffer being processed
+    reg [ROWS-1:0]       done_q;            // rows of pb issued for evaluation
+
+    wire [ADDR_W-1:0] wr_row  = {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
+    wire [ADDR_W-1:0] wr_addr = wb_q ? (ROWS_A + wr_row) : wr_row;
+    always @(posedge clk) begin
+        if (hm_valid_i) mem[wr_addr] <= hm_data_i;
+    end
+
+    // ready rows of the processing buffer
+    wire [ROWS-1:0] arr_p = arr_q[pb_q];
+    reg  [ROWS-1:0] ready;
+    integer i;
+    always @(*) begin
+        for (i = 0; i < ROWS; i = i + 1)
+            ready[i] = arr_p[i] & ~done_q[i]
+                     & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
+                     & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
+    end
+    reg [ROW_IDX_W-1:0] pick;
+    always @(*) begin
+        pick = {ROW_IDX_W{1'b0}};
+        for (i = ROWS - 1; i >= 0; i = i - 1)
+            if (ready[i]) pick = i[ROW_IDX_W-1:0];
+    end
+
+    // ---- state ------------------------------------------------------------------------
+    localparam S_RUN = 1'b0, S_EMIT = 1'b1;
+    reg state_q;
+
+    // pipeline valids
+    reg e1_v_q, e2_v_q, e3_v_q;
+    wire [COLS-1:0] mask_next;
+    reg  [COLS-1:0] mask_q;
+    wire e2_free = !e2_v_q || ((mask_q & (mask_q - 1'b1)) == {COLS{1'b0}});
+    wire e1_adv  = e1_v_q && e2_free;
+    wire issue   = (state_q == S_RUN) && (|ready) && (!e1_v_q || e1_adv);
+
+    // ---- E0 -> E1: three synchronous reads --------------------------------------------
+    reg [RW-1:0]        ra_q, rb_q, rc_q;       // rows r-1, r, r+1
+    reg [ROW_IDX_W-1:0] r1_q;
+    wire [ADDR_W-1:0] base  = pb_q ? ROWS_A : {ADDR_W{1'b0}};
+    wire [ADDR_W-1:0] a_mid = base + {{(ADDR_W-ROW_IDX_W){1'b0}}, pick};
+    wire [ADDR_W-1:0] a_up  = (pick == {ROW_IDX_W{1'b0}}) ? a_mid : a_mid - 1'b1;
+    wire [ADDR_W-1:0] a_dn  = (pick == LAST_ROW) ? a_mid : a_mid + 1'b1;
+    always @(posedge clk) begin
+        if (issue) begin
+            ra_q <= mem[a_up];
+            rb_q <= mem[a_mid];
+            rc_q <= mem[a_dn];
+            r1_q <= pick;
+        end
+    end
+    wire top1 = (r1_q == {ROW_IDX_W{1'b0}});
+    wire bot1 = (r1_q == LAST_ROW);
+
+    // ---- E1: maxima mask of row r1 ----------------------------------------------------
+    // gt_l[c] = B[c] > B[c-1]: cell c beats its left neighbour; the left one beats (>=)
+    // its right neighbour exactly when !gt_l[c].
+    genvar c;
+    generate
+        for (c = 0; c < COLS; c = c + 1) begin : g_cmp
+            wire [HM_W-1:0] p  = rb_q[c*HM_W +: HM_W];
+            wire [HM_W-1:0] u  = ra_q[c*HM_W +: HM_W];
+            wire [HM_W-1:0] d  = rc_q[c*HM_W +: HM_W];
+            wire ok_thr = (p >= threshold_i);
+            wire ok_u   = top1 || (p > u);
+            wire ok_d   = bot1 || (p >= d);
+            wire ok_l, ok_r, ok_ul, ok_ur, ok_dl, ok_dr;
+            if (c > 0) begin : g_l
+                wire [HM_W-1:0] l  = rb_q[(c-1)*HM_W +: HM_W];
+                wire [HM_W-1:0] ul = ra_q[(c-1)*HM_W +: HM_W];
+                wire [HM_W-1:0] dl = rc_q[(c-1)*HM_W +: HM_W];
+                assign ok_l  = (p > l);
+                assign ok_ul = top1 || !moore_i || (p > ul);
+                assign ok_dl = bot1 || !moore_i || (p >= dl);
+            end else begin : g_nl
+                assign ok_l = 1'b1;  assign ok_ul = 1'b1;  assign ok_dl = 1'b1;
+            end
+            if (c < COLS - 1) begin : g_r
+                wire [HM_W-1:0] rr = rb_q[(c+1)*HM_W +: HM_W];
+                wire [HM_W-1:0] ur = ra_q[(c+1)*HM_W +: HM_W];
+                wire [HM_W-1:0] dr = rc_q[(c+1)*HM_W +: HM_W];
+                assign ok_r  = (p >= rr);
+                assign ok_ur = top1 || !moore_i || (p > ur);
+                assign ok_dr = bot1 || !moore_i || (p >= dr);
+            end else begin : g_nr
+                assign ok_r = 1'b1;  assign ok_ur = 1'b1;  assign ok_dr = 1'b1;
+            end
+            assign mask_next[c] = ok_thr & ok_u & ok_d & ok_l & ok_r & ok_ul & ok_ur & ok_dl & ok_dr;
+        end
+    endgenerate
+
+    // ---- E2: serialise maxima, gather the 3x3 -----------------------------------------
+    reg [RW-1:0]        wa_q, wb2_q, wc_q;      // window rows r-1, r, r+1
+    reg [ROW_IDX_W-1:0] r2_q;
+    reg                 top2_q, bot2_q;
+    reg [COL_IDX_W-1:0] sel;                    // lowest set bit of mask_q
+    always @(*) begin
+        sel = {COL_IDX_W{1'b0}};
+        for (i = COLS - 1; i >= 0; i = i - 1)
+            if (mask_q[i]) sel = i[COL_IDX_W-1:0];
+    end
+    // column mux: the three cells (c-1, c, c+1) of each window row around column sel
+    reg [Z9_W-1:0] z9;
+    reg [8:0]      miss9;
+    integer j;
+    always @(*) begin
+        z9 = {Z9_W{1'b0}};
+        for (j = 0; j < COLS; j = j + 1) begin
+            if (sel == j[COL_IDX_W-1:0]) begin
+                if (j > 0) begin
+                    z9[0*HM_W +: HM_W] = wa_q [((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                    z9[3*HM_W +: HM_W] = wb2_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                    z9[6*HM_W +: HM_W] = wc_q [((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                end
+                z9[1*HM_W +: HM_W] = wa_q [j*HM_W +: HM_W];
+                z9[4*HM_W +: HM_W] = wb2_q[j*HM_W +: HM_W];
+                z9[7*HM_W +: HM_W] = wc_q [j*HM_W +: HM_W];
+                if (j < COLS - 1) begin
+                    z9[2*HM_W +: HM_W] = wa_q [((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                    z9[5*HM_W +: HM_W] = wb2_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                    z9[8*HM_W +: HM_W] = wc_q [((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                end
+            end
+        end
+        miss9 = 9'd0;
+        if (sel == {COL_IDX_W{1'b0}}) miss9 = miss9 | 9'b001_001_001;
+        if (sel == LAST_COL)          miss9 = miss9 | 9'b100_100_100;
+        if (top2_q)                   miss9 = miss9 | 9'b000_000_111;
+        if (bot2_q)                   miss9 = miss9 | 9'b111_000_000;
+        if (top2_q) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
+        if (bot2_q) z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
+    end
+
+    // E3 candidate register
+    reg [Z9_W-1:0]      n_z9_q;
+    reg [8:0]           n_miss_q;
+    reg [IDX_W-1:0]     n_idx_q;
+
+    // ---- the sorted list -------------------------------------------------------------
+    reg [K-1:0]     l_v_q;
+    reg [Z9_W-1:0]  l_z9_q   [0:K-1];
+    reg [8:0]       l_miss_q [0:K-1];
+    reg [IDX_W-1:0] l_idx_q  [0:K-1];
+    reg [FOUND_W-1:0] found_q;
+    reg [LIM_W-1:0]   left_q;                 // candidates still to emit
+
+    wire [HM_W-1:0] n_z = n_z9_q[4*HM_W +: HM_W];
+    reg  [K-1:0]    better;                   // entry i stays ahead of the new candidate
+    always @(*) begin
+        for (i = 0; i < K; i = i + 1)
+            better[i] = l_v_q[i] && ((l_z9_q[i][4*HM_W +: HM_W] > n_z) ||
+                                     ((l_z9_q[i][4*HM_W +: HM_W] == n_z) && (l_idx_q[i] < n_idx_q)));
+    end
+
+    wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
+    wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_eff};
+    wire             over     = (found_q > lim_ext);
+    wire [LIM_W-1:0] n_emit   = over ? lim_eff : found_q[LIM_W-1:0];
+    wire             complete = (arr_p == {ROWS{1'b1}});
+    wire             finish   = (state_q == S_RUN) && eofs_q[pb_q] && !(|ready)
+                              && !e1_v_q && !e2_v_q && !e3_v_q;
+    wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
+    wire             releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
+    wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
+
+    always @(posedge clk) begin
+        // ---- datapath registers (no reset needed) ----
+        if (e1_adv) begin
+            wa_q <= ra_q;  wb2_q <= rb_q;  wc_q <= rc_q;
+            r2_q <= r1_q;  top2_q <= top1;  bot2_q <= bot1;
+        end
+        n_z9_q   <= z9;
+        n_miss_q <= miss9;
+        n_idx_q  <= {r2_q, sel};
+
+        if (rst) begin
+            arr_q[0] <= {ROWS{1'b0}};
+            arr_q[1] <= {ROWS{1'b0}};
+            eofs_q   <= 2'b00;
+            wb_q     <= 1'b0;
+            pb_q     <= 1'b0;
+            done_q   <= {ROWS{1'b0}};
+            state_q  <= S_RUN;
+            e1_v_q   <= 1'b0;
+            e2_v_q   <= 1'b0;
+            e3_v_q   <= 1'b0;
+            mask_q   <= {COLS{1'b0}};
+            l_v_q    <= {K{1'b0}};
+            found_q  <= {FOUND_W{1'b0}};
+            left_q   <= {LIM_W{1'b0}};
+            cand_valid_o      <= 1'b0;
+            cand_eof_o        <= 1'b0;
+            cand_count_o      <= {LIM_W{1'b0}};
+            cand_found_o      <= {FOUND_W{1'b0}};
+            cand_overflow_o   <= 1'b0;
+            cand_incomplete_o <= 1'b0;
+            overflow_flag_o   <= 1'b0;
+            drop_count_o      <= {CNT_W{1'b0}};
+            overrun_o         <= 1'b0;
+        end else begin
+            // ---- arrivals ----
+            if (hm_valid_i) arr_q[wb_q][hm_row_i] <= 1'b1;
+            if (hm_eof_i) begin
+                eofs_q[wb_q] <= 1'b1;
+                frm_q[wb_q]  <= hm_frame_i;
+                wb_q         <= ~wb_q;
+                // the other buffer still holds an unfinished frame: it will be overwritten
+                if (pb_q != wb_q && !releasing) overrun_o <= 1'b1;
+            end
+
+            // ---- E0/E1 ----
+            if (issue) begin
+                done_q[pick] <= 1'b1;
+                e1_v_q <= 1'b1;
+            end else if (e1_adv) begin
+                e1_v_q <= 1'b0;
+            end
+
+            // ---- E2 ----
+            e3_v_q <= e2_v_q && (|mask_q);
+            if (e2_free) begin
+                e2_v_q <= e1_v_q;
+                mask_q <= e1_v_q ? mask_next : {COLS{1'b0}};
+            end else begin
+                mask_q <= mask_q & (mask_q - 1'b1);      // clear the lowest set bit
+            end
+
+            // ---- E3: sorted insertion ----
+            if (e3_v_q) begin
+                found_q <= found_q + 1'b1;
+                for (i = 0; i < K; i = i + 1) begin
+                    if (!better[i]) begin
+                        if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
+                            l_v_q[i]    <= 1'b1;
+                            l_z9_q[i]   <= n_z9_q;
+                            l_miss_q[i] <= n_miss_q;
+                            l_idx_q[i]  <= n_idx_q;
+                        end else begin
+                            l_v_q[i]    <= l_v_q[(i == 0) ? 0 : i - 1];
+                            l_z9_q[i]   <= l_z9_q[(i == 0) ? 0 : i - 1];
+                            l_miss_q[i] <= l_miss_q[(i == 0) ? 0 : i - 1];
+                            l_idx_q[i]  <= l_idx_q[(i == 0) ? 0 : i - 1];
+                        end
+                    end
+                end
+            end
+
+            // ---- finish and emit ----
+            cand_valid_o <= 1'b0;
+            cand_eof_o   <= 1'b0;
+            if (finish) begin
+                state_q <= S_EMIT;
+                left_q  <= complete ? n_emit : {LIM_W{1'b0}};
+                cand_count_o      <= complete ? n_emit : {LIM_W{1'b0}};
+                cand_found_o      <= complete ? found_q : {FOUND_W{1'b0}};
+                cand_overflow_o   <= complete && over;
+                cand_incomplete_o <= !complete;
+                if (complete && over) begin
+                    overflow_flag_o <= 1'b1;
+                    drop_count_o    <= drop_sum[CNT_W] ? {CNT_W{1'b1}} : drop_sum[CNT_W-1:0];
+                end
+            end
+            if (state_q == S_EMIT) begin
+                cand_frame_o <= frm_q[pb_q];
+                if (left_q != {LIM_W{1'b0}}) begin
+                    left_q         <= left_q - 1'b1;
+                    cand_valid_o   <= 1'b1;
+                    cand_row_o     <= l_idx_q[0][COL_IDX_W +: ROW_IDX_W];
+                    cand_col_o     <= l_idx_q[0][0 +: COL_IDX_W];
+                    cand_z_o       <= l_z9_q[0];
+                    cand_missing_o <= l_miss_q[0];
+                    for (i = 0; i < K - 1; i = i + 1) begin
+                        l_v_q[i]    <= l_v_q[i + 1];
+                        l_z9_q[i]   <= l_z9_q[i + 1];
+                        l_miss_q[i] <= l_miss_q[i + 1];
+                        l_idx_q[i]  <= l_idx_q[i + 1];
+                    end
+                    l_v_q[K-1] <= 1'b0;
+                end else begin
+                    cand_eof_o  <= 1'b1;
+                    state_q     <= S_RUN;
+                    l_v_q       <= {K{1'b0}};
+                    found_q     <= {FOUND_W{1'b0}};
+                    done_q      <= {ROWS{1'b0}};
+                    arr_q[pb_q] <= {ROWS{1'b0}};
+                    eofs_q[pb_q] <= 1'b0;
+                    pb_q        <= ~pb_q;
+                end
+            end
+        end
+    end
+
+endmodule
+
+`default_nettype wire
