@@ -1,0 +1,60 @@
+"""Model tests of sim/fmt/regmap.py: the generated files are up to date, the map is
+consistent, reset values come from the shared parameters/settings, and the register
+file model behaves as documented."""
+from __future__ import annotations
+
+from fmt import params, regmap
+from fmt.settings import TouchSettings
+
+
+def test_generated_files_fresh():
+    stale = regmap.stale_files()
+    assert not stale, f"stale generated files {stale}: run `python -m fmt.regmap --write`"
+
+
+def test_map_consistent():
+    regmap.validate()
+    names = [r.name for r in regmap.REGISTERS]
+    assert len(names) == len(set(names))
+    for w in regmap.WINDOWS:
+        assert 0 <= w.base and w.base + w.size <= 1 << 16
+    assert regmap.WINDOW_BY_NAME["HEATMAP"].size == params.DEFAULT.rows * params.DEFAULT.cols
+
+
+def test_resets_from_shared_defaults():
+    s = TouchSettings()
+    cfg = params.DEFAULT
+    r = regmap.BY_NAME
+    assert r["TOUCH_THRESHOLD"].reset == s.threshold
+    assert r["BLOB_THRESHOLD"].reset == s.blob_threshold
+    assert r["BLOB_MIN_CELLS"].reset == s.blob_min_cells
+    assert r["CONTACT_LIMIT"].reset == cfg.max_touches
+    conv = s.converted(cfg, regmap.FRAME_PERIOD_S)
+    assert r["TRACK_MAX_JUMP"].reset == conv["max_jump_q"]
+    assert r["TRACK_HOLD_OFF"].reset == conv["hold_off_frames"]
+    # report divider keeps the UART event rate at or below 250 Hz
+    assert 1.0 / regmap.FRAME_PERIOD_S / r["REPORT_DIV"].reset <= 250.0
+
+
+def test_regfile_model():
+    m = regmap.RegfileModel()
+    a = regmap.BY_NAME
+    m.write(a["PN_CHIP_LEN"].addr, 0xFFFFFFFF)
+    assert m.read(a["PN_CHIP_LEN"].addr) == 0x3FF               # masked to 10 bits
+    m.write(a["ID"].addr, 0)
+    assert m.read(a["ID"].addr) == a["ID"].reset                 # const ignores writes
+    m.val["STATUS"] = 0x1F
+    m.write(a["STATUS"].addr, 0x05)
+    assert m.read(a["STATUS"].addr) == 0x1A                      # w1c
+    assert m.read(0x7FF) == 0                                    # unmapped
+    assert m.read(a["FRAME_COUNT"].addr, {"FRAME_COUNT": 77}) == 77
+
+
+def test_regfile_ports_follow_map():
+    v = regmap.render_verilog()
+    for r in regmap.REGISTERS:
+        if r.access == "rw":
+            assert f"{r.port}_o" in v
+        if r.access == "ro":
+            assert f"{r.port}_i" in v
+    assert "`default_nettype none" in v and v.rstrip().endswith("`default_nettype wire")

@@ -1,0 +1,110 @@
+// fmt_ctrl_tb_top -- SIMULATION-ONLY test top (not part of rtl/): fmt_ctrl_port +
+// the generated fmt_regfile + small dummy core memories, so that the UART, the frame
+// protocol, the register bus, the windows and the block-read port are all exercised.
+//
+// Block space: words 0..63 are a RAM (a heat-map snapshot, e.g. 4 x 6 cells) that the
+// test preloads through mem_we_i/mem_addr_i/mem_wdata_i; any other word address A reads
+// {~A, A} (a pattern the test predicts).  Registered read, BLK_LAT = 1.
+// Tone-plan windows: TONE_TW / TONE_AMP write and read 32-entry memories at TONE_SEL.
+// Status inputs: FRAME_COUNT and STATUS set bits come from the test; CTRL_ERRORS and
+// CTRL_LAST_ERR from the port; STATUS bit 4 is set by every port error.
+// Other read-only registers read fixed patterns (see the localparams).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_ctrl_tb_top #(
+    parameter DIV          = 4,
+    parameter TIMEOUT_BITS = 20,
+    parameter PAYLOAD_MAX  = 64,
+    parameter FIFO_AW      = 4,
+    parameter REGMAP_ID    = 0,
+    parameter ROWS         = `FMT_ROWS,
+    parameter COLS         = `FMT_COLS,
+    parameter LOG2_N       = `FMT_LOG2_N,
+    parameter HM_W         = `FMT_HM_W,
+    parameter BIN_LO       = `FMT_BIN_LO,
+    parameter BIN_STEP     = `FMT_BIN_STEP
+) (
+    input  wire         clk,
+    input  wire         rst,
+    input  wire         rxd_i,
+    output wire         txd_o,
+    input  wire         mem_we_i,
+    input  wire [5:0]   mem_addr_i,
+    input  wire [31:0]  mem_wdata_i,
+    input  wire [31:0]  frame_count_i,
+    input  wire [7:0]   status_set_i,
+    input  wire         evs_valid_i,
+    input  wire [191:0] evs_data_i,
+    output wire         evs_ready_o,
+    output wire         stream_en_o,
+    output wire         lat_clear_o
+);
+    localparam [31:0] DROP_PATTERN = 32'hD5D5_0001;
+    localparam [15:0] LAT_LAST_PATTERN = 16'd111, LAT_MIN_PATTERN = 16'd100, LAT_MAX_PATTERN = 16'd140;
+    localparam [31:0] LAT_COUNT_PATTERN = 32'd4242;
+
+    wire        reg_we, reg_re, blk_req, err_pulse;
+    wire [15:0] reg_addr, blk_addr, err_count;
+    wire [31:0] reg_wdata, reg_rdata;
+    reg  [31:0] blk_rdata;
+    wire [7:0]  err_last;
+
+    fmt_ctrl_port #(
+        .DIV(DIV), .TIMEOUT_BITS(TIMEOUT_BITS), .PAYLOAD_MAX(PAYLOAD_MAX), .FIFO_AW(FIFO_AW),
+        .BLK_LAT(1), .EV_BYTES(24), .REGMAP_ID(REGMAP_ID), .ROWS(ROWS), .COLS(COLS),
+        .LOG2_N(LOG2_N), .HM_W(HM_W), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP)
+    ) u_port (
+        .clk(clk), .rst(rst), .rxd_i(rxd_i), .txd_o(txd_o),
+        .reg_we_o(reg_we), .reg_re_o(reg_re), .reg_addr_o(reg_addr), .reg_wdata_o(reg_wdata),
+        .reg_rdata_i(reg_rdata), .blk_req_o(blk_req), .blk_addr_o(blk_addr),
+        .blk_rdata_i(blk_rdata), .evs_valid_i(evs_valid_i), .evs_data_i(evs_data_i),
+        .evs_ready_o(evs_ready_o), .stream_en_o(stream_en_o), .err_count_o(err_count),
+        .err_last_o(err_last), .err_pulse_o(err_pulse));
+
+    // block RAM (heat-map snapshot)
+    reg [31:0] mem [0:63];
+    always @(posedge clk) begin
+        if (mem_we_i) mem[mem_addr_i] <= mem_wdata_i;
+        if (blk_req) blk_rdata <= (blk_addr < 16'd64) ? mem[blk_addr[5:0]] : {~blk_addr, blk_addr};
+    end
+
+    // tone-plan window memories
+    wire [4:0]  tone_sel;
+    wire        tone_tw_we, tone_amp_we, tone_tw_re, tone_amp_re;
+    wire [31:0] tone_tw_wdata;
+    wire [8:0]  tone_amp_wdata;
+    reg  [31:0] tone_tw_mem [0:31];
+    reg  [8:0]  tone_amp_mem [0:31];
+    always @(posedge clk) begin
+        if (tone_tw_we)  tone_tw_mem[tone_sel]  <= tone_tw_wdata;
+        if (tone_amp_we) tone_amp_mem[tone_sel] <= tone_amp_wdata;
+    end
+
+    /* verilator lint_off PINCONNECTEMPTY */  // unused rw outputs of the register file
+    fmt_regfile u_regs (
+        .clk(clk), .rst(rst), .reg_we_i(reg_we), .reg_re_i(reg_re), .reg_addr_i(reg_addr),
+        .reg_wdata_i(reg_wdata), .reg_rdata_o(reg_rdata),
+        .scratch_o(), .run_o(), .pn_enable_o(), .pn_chip_len_o(), .pn_rx_delay_o(),
+        .windows_m_o(), .tone_sel_o(tone_sel),
+        .tone_tw_we_o(tone_tw_we), .tone_tw_wdata_o(tone_tw_wdata), .tone_tw_re_o(tone_tw_re),
+        .tone_tw_rdata_i(tone_tw_mem[tone_sel]),
+        .tone_amp_we_o(tone_amp_we), .tone_amp_wdata_o(tone_amp_wdata), .tone_amp_re_o(tone_amp_re),
+        .tone_amp_rdata_i(tone_amp_mem[tone_sel]),
+        .touch_threshold_o(), .touch_mode_o(), .contact_limit_o(), .track_max_jump_o(),
+        .track_hold_off_o(), .track_vel_window_o(), .track_max_speed_o(), .blob_threshold_o(),
+        .blob_min_cells_o(), .cal_sel_o(),
+        .cal_offset_we_o(), .cal_offset_wdata_o(), .cal_offset_re_o(), .cal_offset_rdata_i(16'h0),
+        .cal_gain_we_o(), .cal_gain_wdata_o(), .cal_gain_re_o(), .cal_gain_rdata_i(16'h0),
+        .latency_dial_o(), .report_div_o(),
+        .frame_count_i(frame_count_i),
+        .status_set_i(status_set_i | {3'b000, err_pulse, 4'b0000}), .status_o(),
+        .ctrl_errors_i(err_count), .ctrl_last_err_i(err_last), .drop_count_i(DROP_PATTERN),
+        .lat_last_i(LAT_LAST_PATTERN), .lat_min_i(LAT_MIN_PATTERN), .lat_max_i(LAT_MAX_PATTERN),
+        .lat_count_i(LAT_COUNT_PATTERN), .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o());
+    /* verilator lint_on PINCONNECTEMPTY */
+
+    wire unused_ok = &{1'b0, tone_tw_re, tone_amp_re};
+
+endmodule
+`default_nettype wire
