@@ -153,3 +153,18 @@ def test_snr_calibration_default_physics():
     s2 = _snr_db(cfg, 2, 400)
     assert abs(s1 - 30.0) < 0.5
     assert abs(s2 - 33.0) < 0.5
+
+
+def test_returned_coupling_and_adc_consistent():
+    # noiseless, no PN, no delay: the ADC word is the rounded sum of the returned coupling
+    # times the tone table
+    sc = S.Scene(sensor="small", frames=5, contacts=[
+        {"path": [[0, 5.0, 5.0], [1e-5, 15.0, 9.0]]},
+        {"path": [[0, 20.0, 3.0]], "active": [[100, 250]], "active_units": "samples"}])
+    cfg = sc.cfg
+    r = ch.adc_streams(sc, return_coupling=True, chunk_windows=2)
+    assert np.allclose(r.coupling, ch.coupling_per_sample(sc, sc.n_samples), atol=1e-13)
+    T = ch.tone_table(cfg)
+    n = np.arange(sc.n_samples) % cfg.n_fft
+    v = TONE_LSB * np.einsum("nr,nrc->nc", T[n], r.coupling)
+    assert np.array_equal(r.adc.astype(int), np.rint(v).astype(int))

@@ -131,3 +131,17 @@ def test_baseline_and_attenuation():
     cp = coupling(CFG, [(100.0, 50.0, 8.0, 1.0)], row_db_per_cell=0.1)
     assert cp[10, 20] == pytest.approx((1 + BASELINE) * 10 ** (-2 / 20))
     assert TONE_LSB * (1 + BASELINE) < 2 ** (CFG.adc_bits - 1)
+
+
+def test_fringe_quadrature_converged(monkeypatch):
+    # doubling the quadrature order changes nothing: the default rule has converged
+    from fmt import sensor
+    c = [(101.3, 52.1, 8.0, 1.0), (60.0, 30.0, 12.0, 0.7, 6.0, 0.5)]
+    for s in (0.5, 1.5):
+        m = contact_map(CFG, c, fringe_mm=s)
+        monkeypatch.setattr(sensor, "FRINGE_NR", 2 * sensor.FRINGE_NR)
+        monkeypatch.setattr(sensor, "FRINGE_PER_SIGMA", 2 * sensor.FRINGE_PER_SIGMA)
+        monkeypatch.setattr(sensor, "FRINGE_MAX", 2 * sensor.FRINGE_MAX)
+        ref = contact_map(CFG, c, fringe_mm=s)
+        monkeypatch.undo()
+        assert np.abs(m - ref).max() < 1e-9
