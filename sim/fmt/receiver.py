@@ -9,8 +9,8 @@ Per column c and window w (samples wN .. wN+N-1 from sample 0):
 
 Scale (``hm_scale``): 2/N * 2**(HM_W - ADC_BITS), i.e. a heat-map count is 1/16 LSB of
 tone amplitude at the ADC for 16-bit cells and a 12-bit ADC: a tone of amplitude A LSB
-gives A * 2**(HM_W - ADC_BITS).  With the sensor's TONE_LSB = 512 a unit-coupling cell
-(a fully covered cell) reads ``unit_cell_counts(cfg)`` = 8192 counts, the baseline 256,
+gives A * 2**(HM_W - ADC_BITS).  With the sensor's TONE_LSB = 320 a unit-coupling cell
+(a fully covered cell) reads ``unit_cell_counts(cfg)`` = 5120 counts, the baseline 160,
 a full-scale ADC tone 32768 (within 16 bits).  The fixed-point receive chain
 (``rx_fixed``) has its own output scaling (|X| * 2^-SHIFT); pass ``scale=`` to compare.
 """

