@@ -119,7 +119,7 @@ REGISTERS: list[Reg] = [
       "A region of at least this many cells is reported as a blob."),
     R("CAL_SEL", 0x030, _CAL_SEL_W, "rw", 0, "Cell selector r * COLS + c of the calibration windows."),
     R("CAL_OFFSET", 0x031, CFG.hm_width, "window", 0, "Field-flattening offset of cell CAL_SEL (counts)."),
-    R("CAL_GAIN", 0x032, 16, "window", 0, "Field-flattening gain of cell CAL_SEL (unsigned, see fmt.flatten)."),
+    R("CAL_GAIN", 0x032, 16, "window", 0, "Field-flattening gain of cell CAL_SEL, unsigned Q2.14 (1.0 = 16384, fmt.flatten)."),
     # ---- outputs ----------------------------------------------------------------------------
     R("LATENCY_DIAL", 0x040, 24, "rw", 0, "Dial-a-latency: extra delay of the event port in processing cycles."),
     R("REPORT_DIV", 0x041, 16, "rw", math.ceil(1.0 / FRAME_PERIOD_S / HOST_REPORT_HZ),
@@ -142,7 +142,8 @@ REGISTERS: list[Reg] = [
 
 WINDOWS: list[Window] = [
     Window("HEATMAP", 0x0000, CFG.rows * CFG.cols,
-           "Heat-map snapshot: cell (r, c) at HEATMAP + r * COLS + c, unsigned, low HM_W bits."),
+           "Raw heat-map snapshot (before field flattening; what `fmtctl calibrate` needs): "
+           "cell (r, c) at HEATMAP + r * COLS + c, unsigned, low HM_W bits."),
     Window("LAT_HIST", 0x8000, 32,
            "Latency histograms (bin counts, 32 bits each), see fmt.latency."),
 ]
