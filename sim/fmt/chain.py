@@ -38,12 +38,13 @@ class ChainResult:
     noise_sigma: float       # LSB
 
 
-def heatmaps_float(scene: Scene, frames: int | None = None, chunk_frames: int | None = None,
+def heatmaps_float(scene: Scene, cfg=None, frames: int | None = None, chunk_frames: int | None = None,
                    progress=None) -> ChainResult:
     """Scene through the ADC and the float receiver -> heat maps (frames, rows, cols).
 
     The noise generator is drawn sequentially, so the result does not depend on the
     chunking.  ``progress(done, total)`` is called after every chunk."""
+    scene = scene.with_cfg(cfg)
     cfg = scene.cfg
     frames = scene.frames if frames is None else frames
     spf = scene.samples_per_frame
@@ -66,9 +67,10 @@ def heatmaps_float(scene: Scene, frames: int | None = None, chunk_frames: int | 
     return ChainResult(out, clipped, total, sigma)
 
 
-def frame_coupling(scene: Scene, frames: int | None = None) -> np.ndarray:
+def frame_coupling(scene: Scene, cfg=None, frames: int | None = None) -> np.ndarray:
     """Mean coupling of each window, (windows, rows, cols), attenuation included: the
     exact sample average of the channel's G[n] over each window."""
+    scene = scene.with_cfg(cfg)
     cfg = scene.cfg
     n = cfg.n_fft
     nw = (scene.frames if frames is None else frames) * scene.m
@@ -97,11 +99,12 @@ def _dft_mats(cfg, T: np.ndarray, weight=None):
     return c @ Tw + 1j * (s @ Tw), c @ Tj + 1j * (s @ Tj)
 
 
-def render_spectra(scene: Scene, frames: int | None = None) -> np.ndarray:
+def render_spectra(scene: Scene, cfg=None, frames: int | None = None) -> np.ndarray:
     """Noiseless comb-bin spectra (windows, rows, cols) complex of the unquantised, despread
     column signals, in heat-map units (|value| = the cell): EXACT for the coupling model
     (matched PN cancels), computed from the coupling at the window boundaries with
     precomputed DFT matrices instead of synthesising samples."""
+    scene = scene.with_cfg(cfg)
     cfg = scene.cfg
     nw = (scene.frames if frames is None else frames) * scene.m
     eff = scene.effects
@@ -119,12 +122,13 @@ def render_spectra(scene: Scene, frames: int | None = None) -> np.ndarray:
     return X * (_sensor.TONE_LSB * _rx.hm_scale(cfg))
 
 
-def render_heatmaps(scene: Scene, frames: int | None = None, noise: bool = True,
+def render_heatmaps(scene: Scene, cfg=None, frames: int | None = None, noise: bool = True,
                     rng: np.random.Generator | None = None) -> np.ndarray:
     """Scene -> heat maps (frames, rows, cols) float64 without signal synthesis (see the
     module docstring for what it models)."""
+    scene = scene.with_cfg(cfg)
     cfg = scene.cfg
-    X = render_spectra(scene, frames)
+    X = render_spectra(scene, None, frames)
     sigma = _ch.scene_noise_sigma(scene) if noise else 0.0
     if sigma > 0:
         var = sigma * sigma + 1.0 / 12.0

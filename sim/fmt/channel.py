@@ -212,16 +212,19 @@ def pn_stream(n0: int, n1: int, chip_len: int = 1, enable: bool = True, delay: i
     return np.where(t >= 0, out, 0).astype(np.uint8)
 
 
-def adc_streams(scene: Scene, n_samples: int | None = None, frames: int | None = None,
-                return_coupling: bool = False, chunk_windows: int = 128,
-                rng: np.random.Generator | None = None, start: int = 0) -> AdcResult:
+def adc_streams(scene: Scene, cfg: SensorConfig | None = None, n_samples: int | None = None,
+                frames: int | None = None, return_coupling: bool = False,
+                chunk_windows: int = 128, rng: np.random.Generator | None = None,
+                start: int = 0) -> AdcResult:
     """The scene's ADC words, (samples, cols) int16, from sample ``start`` (a multiple of
     N; default 0).
 
     Length: ``n_samples``, or ``frames`` whole frames, or the whole scene.  Chunked over
     ``chunk_windows`` windows (memory ~ chunk_windows * N * (rows + cols) * 8 bytes); the
     result does not depend on the chunking (the noise generator is drawn sequentially:
-    pass the same ``rng`` to consecutive calls to continue a stream)."""
+    pass the same ``rng`` to consecutive calls to continue a stream).  ``cfg`` (optional)
+    runs the scene on another sensor build than its named one (``Scene.with_cfg``)."""
+    scene = scene.with_cfg(cfg)
     cfg = scene.cfg
     n = cfg.n_fft
     if start % n:

@@ -188,6 +188,16 @@ class Scene:
     seed: int = 1
     duration_s: float | None = None   # alternative to frames (rounded up to whole frames)
     description: str = ""
+    cfg_override: SensorConfig | None = field(default=None, repr=False)  # not saved
+
+    def with_cfg(self, cfg: SensorConfig | None) -> "Scene":
+        """A copy that runs on ``cfg`` instead of the named sensor (e.g. a build with other
+        ADC or heat-map widths); ``None`` returns the scene itself."""
+        if cfg is None or cfg is self.cfg:
+            return self
+        out = self.replace()
+        out.cfg_override = cfg
+        return out
 
     def __post_init__(self):
         self.contacts = [c if isinstance(c, Contact) else Contact(**c) for c in self.contacts]
@@ -203,6 +213,8 @@ class Scene:
     # -- sizes and times ------------------------------------------------------------------
     @property
     def cfg(self) -> SensorConfig:
+        if self.cfg_override is not None:
+            return self.cfg_override
         return _params.get(self.sensor)
 
     @property
@@ -277,7 +289,9 @@ class Scene:
     def replace(self, **kw) -> "Scene":
         d = self.to_dict()
         d.update(kw)
-        return Scene.from_dict(d)
+        out = Scene.from_dict(d)
+        out.cfg_override = self.cfg_override
+        return out
 
 
 EFFECT_KEYS = {"noise", "enob", "dc_lsb", "interferer", "row_db_per_cell", "col_db_per_cell",

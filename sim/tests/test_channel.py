@@ -168,3 +168,17 @@ def test_returned_coupling_and_adc_consistent():
     n = np.arange(sc.n_samples) % cfg.n_fft
     v = TONE_LSB * np.einsum("nr,nrc->nc", T[n], r.coupling)
     assert np.array_equal(r.adc.astype(int), np.rint(v).astype(int))
+
+
+def test_other_sensor_build():
+    # a scene runs on another build of its sensor (here a 14-bit ADC): same physics in LSB
+    sc = _finger(params.SMALL)
+    cfg14 = params.SMALL.replace(adc_bits=14)
+    a = ch.adc_streams(sc).adc
+    b = ch.adc_streams(sc, cfg14).adc
+    assert np.array_equal(a, b)                     # nothing clips: identical words
+    strip = S.Scene(sensor="small", frames=1, contacts=[{"diameter_mm": 300.0, "strength": 3.0,
+                                                          "path": [[0, 12.0, 7.0]]}])
+    assert ch.adc_streams(strip).adc.max() == 2047
+    assert ch.adc_streams(strip, cfg14).adc.max() > 2047
+    assert strip.with_cfg(cfg14).replace(frames=2).cfg is cfg14
