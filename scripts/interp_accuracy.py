@@ -4,7 +4,8 @@
 Contacts of the disk profile (paper Eq. 2, touched area) and of the Gaussian profile
 (fmt.sensor) at random sub-cell positions inside the MEDIUM sensor (>= 2 cells from the
 edges), heat map z = round(SCALE * (coupling + noise)), noise N(0, sigma) per cell with
-sigma = 1 / 10^(snr/20) of a fully covered cell (30 dB: sigma = 0.0316).  The candidate
+sigma = (peak cell of a centred 8 mm disk finger) / 10^(snr/20), the definition of
+fmt.channel.noise_sigma_for_snr (30 dB per window at M = 1).  The candidate
 is the 3x3 around the strongest cell.  Reports the RMS position error in mm (pitch 5 mm)
 of both fits, float and fixed, with and without bias correction, and the angle error of
 elliptical contacts (Moore fit).
@@ -27,10 +28,16 @@ from fmt.localmax import Candidate, neighbourhood3x3  # noqa: E402
 SCALE = 4096
 
 
+def peak_coupling(cfg, diameter=8.0):
+    """Peak-cell coupling of a centred disk finger (the noise reference, as channel.py)."""
+    r, c = cfg.rows // 2, cfg.cols // 2
+    return float(sensor.contact_map(cfg, [(c * cfg.pitch_mm, r * cfg.pitch_mm, diameter, 1.0)])[r, c])
+
+
 def make_cands(cfg, ct, profile, snr_db, rng):
     maps = sensor.contact_maps(cfg, ct, profile=profile)
     if snr_db is not None:
-        maps = maps + rng.normal(0, 10 ** (-snr_db / 20), maps.shape)
+        maps = maps + rng.normal(0, peak_coupling(cfg) / 10 ** (snr_db / 20), maps.shape)
     z = np.clip(np.round(maps * SCALE), 0, (1 << cfg.hm_width) - 1).astype(np.int64)
     out = []
     for k in range(z.shape[0]):
