@@ -13,8 +13,8 @@
   (+ ENOB step^2 / 12)): the statistics of a DFT bin of white noise (bins and windows
   independent).  Not modelled by the render: clipping, interferers, DC (it never reaches a
   comb bin anyway), PN misalignment.  Noiseless, it differs from the ADC path only by the
-  ADC rounding: |error| <= 0.5 LSB * N * hm_scale = 2**(HM_W - ADC_BITS) counts (16) per
-  cell, RMS sqrt(N/24) * hm_scale (0.41 counts at N = 256); sim/tests/test_chain.py.
+  ADC rounding: |error| <= 0.5 LSB * N * hm_scale = 2**(HM_W - ADC_BITS + 1) counts (32)
+  per cell, RMS sqrt(N/24) * hm_scale (0.82 counts at N = 256); sim/tests/test_chain.py.
 * :func:`events` -- heat maps through ``fmt.touch.process_frames(hm, cfg, settings,
   fixed=False)``.
 """

@@ -7,12 +7,14 @@ Per column c and window w (samples wN .. wN+N-1 from sample 0):
     cell[r,c] = hm_scale * |X_w[k_r]|, k_r = cfg.bins[r]
     heat map  = mean of the cells over the M windows of a frame    (frames, rows, cols)
 
-Scale (``hm_scale``): 2/N * 2**(HM_W - ADC_BITS), i.e. a heat-map count is 1/16 LSB of
-tone amplitude at the ADC for 16-bit cells and a 12-bit ADC: a tone of amplitude A LSB
-gives A * 2**(HM_W - ADC_BITS).  With the sensor's TONE_LSB = 320 a unit-coupling cell
-(a fully covered cell) reads ``unit_cell_counts(cfg)`` = 5120 counts, the baseline 160,
-a full-scale ADC tone 32768 (within 16 bits).  The fixed-point receive chain
-(``rx_fixed``) has its own output scaling (|X| * 2^-SHIFT); pass ``scale=`` to compare.
+Scale (``hm_scale``): 4/N * 2**(HM_W - ADC_BITS): a tone of amplitude A LSB at the ADC
+reads A * 2**(HM_W - ADC_BITS + 1) counts (32 A for 16-bit cells and a 12-bit ADC), so a
+full-scale ADC tone (2048 LSB) just reaches the 16-bit limit.  This is the scale of the
+fixed-point receive chain (``rx_fixed.rx_heatmaps_fixed``: FFT growth schedule, pair
+split, CORDIC, accumulator), so float and fixed heat maps, and the touch thresholds, mean
+the same counts (sim/tests/test_receiver.py compares the two: ratio 1 within 0.5 %).  With
+the sensor's TONE_LSB = 320 a unit-coupling cell (a fully covered cell) reads
+``unit_cell_counts(cfg)`` = 10240 counts, the baseline 320.
 """
 from __future__ import annotations
 
@@ -24,12 +26,12 @@ from .params import SensorConfig
 
 def hm_scale(cfg: SensorConfig) -> float:
     """Heat-map counts per unit of |X[k]| (see the module docstring)."""
-    return 2.0 / cfg.n_fft * 2.0 ** (cfg.hm_width - cfg.adc_bits)
+    return 4.0 / cfg.n_fft * 2.0 ** (cfg.hm_width - cfg.adc_bits)
 
 
 def unit_cell_counts(cfg: SensorConfig) -> float:
     """Heat-map value of a unit-coupling cell (noiseless, no attenuation)."""
-    return _sensor.TONE_LSB * 2.0 ** (cfg.hm_width - cfg.adc_bits)
+    return _sensor.TONE_LSB * 2.0 ** (cfg.hm_width - cfg.adc_bits + 1)
 
 
 def despread(adc, rx_sign=None, dtype=np.float64) -> np.ndarray:

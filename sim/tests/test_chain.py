@@ -10,7 +10,7 @@ from fmt import scene as S
 
 def _bound(cfg):
     # ADC rounding: |e| <= 1/2 LSB per sample, so |dX| <= N/2 and a cell moves by at most
-    # N/2 * hm_scale = 2**(HM_W - ADC_BITS) counts; statistically sqrt(N/24) * hm_scale RMS
+    # N/2 * hm_scale = 2**(HM_W - ADC_BITS + 1) counts; statistically sqrt(N/24) * hm_scale RMS
     return cfg.n_fft / 2 * receiver.hm_scale(cfg), math.sqrt(cfg.n_fft / 24) * receiver.hm_scale(cfg)
 
 
