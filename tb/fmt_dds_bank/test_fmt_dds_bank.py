@@ -15,6 +15,7 @@ Checks, under both simulators:
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import random
@@ -210,6 +211,13 @@ async def exact_comb_and_purity(dut):
     dut._log.info("rows %d SINE_BITS %d DAC_BITS %d: worst row spur %.1f dBc (bound %.1f), "
                   "comb worst non-comb bin %.1f dBc at bin %d (bound %.1f), |rtl-float| %.3f LSB",
                   tb.rows, tb.sine_bits, tb.dac_bits, row_spur, row_bound, comb_spur, k, comb_bound, err)
+    out = os.environ.get("DDS_PURITY_OUT")
+    if out:     # scripts/dds_purity.py collects the measured numbers
+        Path(out).write_text(json.dumps({
+            "rows": tb.rows, "n_fft": N, "sine_bits": tb.sine_bits, "dac_bits": tb.dac_bits,
+            "row_spur_dbc": row_spur, "row_bound_dbc": row_bound, "comb_spur_dbc": comb_spur,
+            "comb_spur_bin": k, "comb_bound_dbc": comb_bound, "max_err_lsb": float(err),
+            "err_bound_lsb": bound}))
     assert row_spur <= row_bound, f"row spur {row_spur:.1f} dBc > {row_bound}"
     assert comb_spur <= comb_bound, f"comb spur {comb_spur:.1f} dBc > {comb_bound:.1f}"
 
