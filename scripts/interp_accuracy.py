@@ -91,7 +91,8 @@ def angle_table(cfg, n, seed, major=14.0, minor=7.0):
             ef = err([t.angle for t in fl])
             ex = err([t.angle * math.pi / 256 for t in fx])
             ratio = np.mean([t.axis_major / max(t.axis_minor, 1e-9) for t in fl if t.axis_minor > 0])
-            rows.append((profile, "noiseless" if snr is None else f"{snr:.0f} dB", ef, ex, ratio))
+            rows.append((f"{major:g} x {minor:g} mm", profile,
+                         "noiseless" if snr is None else f"{snr:.0f} dB", ef, ex, ratio))
     return rows
 
 
@@ -107,11 +108,13 @@ def main(argv=None):
     for r in position_table(cfg, a.n, a.seed):
         print(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.3f} | {r[5]:.3f} |")
     print()
-    print(f"Angle error (deg), 14 x 7 mm elliptical contacts at random angles, Moore fit, {a.n} contacts")
-    print("| profile | noise | float RMS | float max | fixed RMS | fixed max | mean axis ratio (float) |")
-    print("|---|---|---|---|---|---|---|")
-    for r in angle_table(cfg, a.n, a.seed):
-        print(f"| {r[0]} | {r[1]} | {r[2][0]:.2f} | {r[2][1]:.2f} | {r[3][0]:.2f} | {r[3][1]:.2f} | {r[4]:.2f} |")
+    print(f"Angle error (deg) of elliptical contacts at random angles, Moore fit, {a.n} contacts each")
+    print("| contact | profile | noise | float RMS | float max | fixed RMS | fixed max | mean axis ratio (float) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for major, minor in ((14.0, 7.0), (20.0, 10.0)):
+        for r in angle_table(cfg, a.n, a.seed, major, minor):
+            print(f"| {r[0]} | {r[1]} | {r[2]} | {r[3][0]:.2f} | {r[3][1]:.2f} | {r[4][0]:.2f} | "
+                  f"{r[4][1]:.2f} | {r[5]:.2f} |")
     return 0
 
 
