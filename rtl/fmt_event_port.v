@@ -78,6 +78,10 @@ module fmt_event_port #(
     output reg                  overflow_o         // sticky: a frame was dropped
 );
 
+    localparam integer ROOM_I  = DEPTH - MAX_EV;
+    localparam integer DEPTH_I = DEPTH;
+    localparam [AW:0]  ROOM    = ROOM_I[AW:0];      // count <= ROOM: a whole frame fits
+    localparam [AW:0]  FULL    = DEPTH_I[AW:0];
     localparam RW = FRAME_W + TIME_W + ID_W + 2 + 16 + 16 + HM_W + 16 + 16 + 8 + 8 + 1;
 
     reg [RW-1:0]     mem [0:DEPTH-1];
@@ -98,13 +102,13 @@ module fmt_event_port #(
     wire              pop       = eligible && (!ev_valid_o || ev_ready_i);
 
     wire              first     = in_valid_i && !in_frame_q;
-    wire              room      = (count_q <= DEPTH - MAX_EV);
+    wire              room      = (count_q <= ROOM);
     wire [TIME_W-1:0] since     = now_q - last_admit_q;
     wire              decim_ok  = (report_period_i == {TIME_W{1'b0}}) || !have_admit_q ||
                                   (since >= report_period_i);
     wire              decide    = room && decim_ok;
     wire              admit_cur = first ? decide : admit_q;
-    wire              wr        = in_valid_i && admit_cur && (count_q < DEPTH);
+    wire              wr        = in_valid_i && admit_cur && (count_q < FULL);
     wire [AW-1:0]     rd_addr   = rd_ptr_q + {{(AW-1){1'b0}}, pop};
     wire [RW-1:0]     din       = {in_frame_i, now_q, in_id_i, in_type_i, in_x_i, in_y_i,
                                    in_strength_i, in_axis_major_i, in_axis_minor_i,

@@ -125,7 +125,9 @@ class TrackParams:
     def from_settings(cls, cfg: SensorConfig, settings: TouchSettings | None = None,
                       frame_period_s: float | None = None, **kw) -> "TrackParams":
         """Convert the physical settings once.  ``frame_period_s`` defaults to one
-        window (M = 1).  ``hold_jump_q`` = max_jump_q / 4 (no shared setting yet)."""
+        window (M = 1).  ``hold_jump_q`` = max_jump_q / 4 (no shared setting yet).
+        ``max_touches`` (slots) is the sensor's ``max_touches`` (an RTL parameter);
+        ``settings.max_touches`` limits the candidates upstream."""
         s = settings or TouchSettings()
         T = frame_period_s if frame_period_s is not None else cfg.window_s
         c = s.converted(cfg, T)
@@ -136,7 +138,8 @@ class TrackParams:
         vmax = int(round(s.max_speed_mm_s * T / cfg.pitch_mm * (1 << (cfg.frac_bits + vf))))
         vmax = min(vmax, (1 << (v_w - 1)) - 1)
         hold = min(c["hold_off_frames"], (1 << 12) - 1)   # HOLD_W = 12
-        mt = s.max_touches if s.max_touches is not None else cfg.max_touches
+        mt = cfg.max_touches           # slots = the RTL parameter; the run-time limit is
+                                       # applied to the candidates (fmt.localmax)
         args = dict(max_jump_q=min(c["max_jump_q"], 0xFFFF), hold_jump_q=c["max_jump_q"] // 4,
                     hold_off_frames=hold, vel_shift=shift, max_speed_v=vmax, max_touches=mt)
         args.update(kw)

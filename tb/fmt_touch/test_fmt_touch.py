@@ -1,0 +1,259 @@
+"""cocotb testbench of rtl/fmt_touch.v (flatten -> localmax -> interp -> tracker ->
+event port) against sim/fmt/touch.py process_frames(fixed=True).
+
+Heat maps: random (noise plus random bumps: many maxima, the contact limit) and
+rendered from moving finger contacts (fmt.sensor, disk profile), rows in random order,
+a random calibration (offset / gain) loaded through the calibration port.  Every
+frame's events (all fields, in order, ev_last) must equal the model's.  The latency
+from the frame's last row beat to its last event on the output (dial 0, consumer
+ready) is measured per frame and checked against the budget (~120 processing-clock
+cycles); the numbers are logged (pytest -s, or the cocotb log).
+"""
+from __future__ import annotations
+
+import random
+from pathlib import Path
+
+import cocotb
+import numpy as np
+import pytest
+from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+
+from common.runner import RTL, rtl_sources, run_cocotb
+from common.tb_util import ClockedTB, env_int, env_str
+from fmt import flatten, params, sensor
+from fmt.settings import TouchSettings
+from fmt.touch import process_frames
+from fmt.tracking import TrackParams
+
+MODULES = ["fmt_touch", "fmt_flatten", "fmt_localmax", "fmt_interp", "fmt_interp_dly",
+           "fmt_interp_cordic", "fmt_div", "fmt_interp_lg", "fmt_interp_exp",
+           "fmt_interp_bias_rom", "fmt_tracker", "fmt_tracker_vel", "fmt_event_port"]
+BUDGET = 120
+FRAME_PERIOD_S = 1e-3          # scaled timeline for the tracking settings
+
+
+class TB(ClockedTB):
+    def __init__(self, dut):
+        super().__init__(dut)
+        self.cfg = params.get(env_str("CFG", "small"))
+        self.cycle = 0
+        self.events = []
+        self.row_cycles = {}
+        d = dut
+        d.hm_valid_i.value = 0
+        d.hm_eof_i.value = 0
+        d.hm_row_i.value = 0
+        d.hm_frame_i.value = 0
+        d.hm_data_i.value = 0
+        d.cal_we_i.value = 0
+        d.cal_sel_i.value = 0
+        d.cal_row_i.value = 0
+        d.cal_col_i.value = 0
+        d.cal_data_i.value = 0
+        d.sat_clr_i.value = 0
+        d.ev_ready_i.value = 1
+        d.delay_i.value = 0
+        d.report_period_i.value = 0
+        cocotb.start_soon(self._monitor())
+
+    def settings(self, st: TouchSettings):
+        cfg, d = self.cfg, self.dut
+        tp = TrackParams.from_settings(cfg, st, FRAME_PERIOD_S)
+        d.threshold_i.value = st.threshold
+        d.moore_i.value = int(st.neighbourhood == "moore")
+        d.limit_i.value = st.max_touches if st.max_touches is not None else cfg.max_touches
+        d.bias_en_i.value = int(st.bias_correction)
+        d.max_jump_i.value = tp.max_jump_q
+        d.hold_jump_i.value = tp.hold_jump_q
+        d.hold_off_i.value = tp.hold_off_frames
+        d.vel_shift_i.value = tp.vel_shift
+        d.max_speed_i.value = tp.max_speed_v
+
+    async def _monitor(self):
+        d = self.dut
+        while True:
+            await RisingEdge(self.clk)
+            await ReadOnly()
+            self.cycle += 1
+            v, r = d.ev_valid_o.value, d.rst.value
+            if not (v.is_resolvable and r.is_resolvable) or int(r):
+                continue
+            if int(v) and int(d.ev_ready_i.value):
+                self.events.append((self.cycle, tuple(int(getattr(d, f).value) for f in (
+                    "ev_frame_o", "ev_id_o", "ev_type_o", "ev_x_o", "ev_y_o", "ev_strength_o",
+                    "ev_axis_major_o", "ev_axis_minor_o", "ev_angle_o", "ev_flags_o")),
+                    int(d.ev_last_o.value)))
+
+    async def calibrate(self, off, gain):
+        d, cfg = self.dut, self.cfg
+        await self.writable()
+        for sel, arr in ((0, off), (1, gain)):
+            for r in range(cfg.rows):
+                for c in range(cfg.cols):
+                    d.cal_we_i.value = 1
+                    d.cal_sel_i.value = sel
+                    d.cal_row_i.value = r
+                    d.cal_col_i.value = c
+                    d.cal_data_i.value = int(arr[r, c])
+                    await RisingEdge(self.clk)
+                    await self.writable()
+        d.cal_we_i.value = 0
+
+    async def send(self, frames, rng, period):
+        """Heat maps one row per cycle in random order, hm_eof on the next cycle, one
+        frame every `period` cycles.  Records the edge that takes each last row."""
+        d, cfg = self.dut, self.cfg
+        w = cfg.hm_width
+        await self.writable()
+        for k, hm in enumerate(frames):
+            order = list(range(cfg.rows))
+            rng.shuffle(order)
+            t0 = self.cycle
+            for r in order:
+                word = 0
+                for c in range(cfg.cols):
+                    word |= int(hm[r, c]) << (c * w)
+                d.hm_valid_i.value = 1
+                d.hm_row_i.value = r
+                d.hm_frame_i.value = k
+                d.hm_data_i.value = word
+                await RisingEdge(self.clk)
+                await self.writable()
+            self.row_cycles[k] = self.cycle          # the edge that took the last row
+            d.hm_valid_i.value = 0
+            d.hm_eof_i.value = 1
+            d.hm_frame_i.value = k
+            await RisingEdge(self.clk)
+            await self.writable()
+            d.hm_eof_i.value = 0
+            while self.cycle < t0 + period:
+                await RisingEdge(self.clk)
+                await self.writable()
+
+
+def random_maps(cfg, rng, n, top):
+    out = np.zeros((n, cfg.rows, cfg.cols), dtype=np.int64)
+    for k in range(n):
+        z = rng.integers(0, 3000, size=(cfg.rows, cfg.cols))
+        for _ in range(rng.integers(0, 6)):
+            r, c = rng.integers(0, cfg.rows), rng.integers(0, cfg.cols)
+            z[r, c] += int(rng.integers(2000, 40000))
+        if rng.random() < 0.2:
+            z = rng.integers(0, top + 1, size=(cfg.rows, cfg.cols))   # many maxima, saturation
+        out[k] = np.clip(z, 0, top)
+    return out
+
+
+def scene_maps(cfg, n, top, rng):
+    """Two fingers moving 0.4 mm per frame, one tapping, a 3rd crossing."""
+    out = np.zeros((n, cfg.rows, cfg.cols), dtype=np.int64)
+    W, H = cfg.width_mm, cfg.height_mm
+    for k in range(n):
+        cts = [(3 + 0.4 * k % (W - 6), 0.3 * H + 0.1 * k, 8.0, 1.0)]
+        if (k // 5) % 2 == 0:
+            cts.append((0.7 * W, 0.6 * H, 7.0, 0.8))
+        cts.append((W - 3 - 0.5 * k % (W - 6), 0.5 * H, 8.0, 1.2))
+        m = sensor.contact_map(cfg, cts) * 25000 + rng.normal(0, 30, (cfg.rows, cfg.cols)) + 200
+        out[k] = np.clip(np.rint(m), 0, top)
+    return out
+
+
+def group(events):
+    fr, cur = [], []
+    for c, e, last in events:
+        cur.append((c, e))
+        if last:
+            fr.append(cur)
+            cur = []
+    assert not cur, "stream ended inside a frame"
+    return fr
+
+
+async def run_case(tb, maps, st, cal, rng, period):
+    cfg = tb.cfg
+    tb.settings(st)
+    await tb.reset()
+    # the calibration RAM is not cleared by reset: always load one
+    await tb.calibrate(*(cal if cal is not None else flatten.identity(cfg)))
+    tb.events.clear()
+    tb.row_cycles.clear()
+    await tb.send(maps, rng, period)
+    for _ in range(200):
+        await RisingEdge(tb.clk)
+    exp = process_frames(maps, cfg, st, fixed=True, flatten_cal=cal, frame_period_s=FRAME_PERIOD_S)
+    got = {fr[0][1][0]: fr for fr in group(tb.events)}
+    lat = []
+    for k, evs in enumerate(exp):
+        e = [(x.frame, x.id, x.type_code, x.x_q, x.y_q, x.strength, x.axis_major_q,
+              x.axis_minor_q, x.angle, x.flags) for x in evs]
+        g = [x[1] for x in got.get(k, [])]
+        assert g == e, f"frame {k}:\nRTL   {g}\nmodel {e}"
+        if evs:
+            # last row taken at edge R -> last event handshake seen after edge L
+            # in cycles: last row beat in cycle c -> last event valid in cycle c + lat
+            lat.append((len(evs), got[k][-1][0] - tb.row_cycles[k] + 1))
+    assert len(got) == sum(1 for x in exp if x)
+    return lat
+
+
+@cocotb.test()
+async def random_heatmaps(dut):
+    tb = TB(dut)
+    cfg = tb.cfg
+    top = (1 << cfg.hm_width) - 1
+    rng = np.random.default_rng(env_int("SEED", 1))
+    prng = random.Random(env_int("SEED", 1))
+    maps = random_maps(cfg, rng, 25, top)
+    off = rng.integers(0, 400, size=(cfg.rows, cfg.cols))
+    gain = rng.integers(12000, 24000, size=(cfg.rows, cfg.cols))
+    st = TouchSettings(threshold=2500, hold_off_us=3000)
+    period = cfg.rows + 160
+    lat = await run_case(tb, maps, st, (off, gain), prng, period)
+    st2 = TouchSettings(threshold=1500, neighbourhood="vn", bias_correction=False,
+                        max_touches=3, hold_off_us=1000)
+    lat += await run_case(tb, maps[:12], st2, None, prng, period)
+    worst = max(l for _, l in lat)
+    dut._log.info(f"latency last row -> last event (events, cycles): worst {worst}, "
+                  f"all {sorted(set(lat))}")
+    assert worst <= BUDGET + 20
+
+
+@cocotb.test()
+async def scene_heatmaps(dut):
+    tb = TB(dut)
+    cfg = tb.cfg
+    top = (1 << cfg.hm_width) - 1
+    rng = np.random.default_rng(5)
+    maps = scene_maps(cfg, 40, top, rng)
+    st = TouchSettings(threshold=3000, hold_off_us=3000, max_speed_mm_s=1000)
+    lat = await run_case(tb, maps, st, None, random.Random(5), cfg.rows + 160)
+    by_n = {}
+    for n, l in lat:
+        by_n[n] = max(by_n.get(n, 0), l)
+    dut._log.info(f"latency last row -> last event, worst per event count: {by_n}")
+    assert max(by_n.values()) <= BUDGET
+
+
+# ---- pytest entry ------------------------------------------------------------------
+def build_args(sim: str) -> list[str]:
+    args = [f'-DFMT_ROM_DIR="{RTL}/"']
+    if sim == "verilator":
+        args += ["--output-split", "0", "--output-split-cfuncs", "0", "-CFLAGS", "-O0"]
+    return args
+
+
+@pytest.mark.parametrize("cfg_name", ["small", "medium"])
+def test_fmt_touch(sim, cfg_name):
+    cfg = params.get(cfg_name)
+    run_cocotb(
+        sim=sim,
+        toplevel="fmt_touch",
+        sources=rtl_sources(*MODULES),
+        test_module="test_fmt_touch",
+        test_dir=Path(__file__).parent,
+        parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
+                    "MAX_TOUCHES": cfg.max_touches, "EV_DEPTH": 256},
+        extra_env={"CFG": cfg_name, "SEED": 1},
+        build_args=build_args(sim), tag=cfg_name,
+    )
