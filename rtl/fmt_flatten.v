@@ -18,6 +18,9 @@
 // clear the RAM (block RAM has no reset); after configuration load offset 0 / gain
 // 16384 (identity) or a calibration: with INIT_IDENTITY = 1 (default) the memories are
 // initialised to the identity for simulation and FPGA configuration.
+// Read-back: cal_re_i latches (row, col, sel); the read uses the memories' read port in
+// the first cycle without a heat-map beat, cal_rvalid_o/cal_rdata_o follow 2 cycles
+// later (a new request before the answer replaces the pending one).
 // Saturation: sat_flag_o is sticky (cleared by rst or sat_clr_i), sat_count_o counts
 // saturated cells (saturating counter), one cycle behind the output beat.
 `default_nettype none
@@ -31,7 +34,8 @@ module fmt_flatten #(
     parameter CNT_W         = 16,                // saturation counter width
     parameter INIT_IDENTITY = 1,                 // 1: memories start at offset 0, gain 1.0
     parameter ROW_IDX_W     = (ROWS > 1) ? $clog2(ROWS) : 1,  // row index width
-    parameter COL_IDX_W     = (COLS > 1) ? $clog2(COLS) : 1   // column index width
+    parameter COL_IDX_W     = (COLS > 1) ? $clog2(COLS) : 1,  // column index width
+    parameter CAL_W         = (HM_W > 16) ? HM_W : 16         // calibration data width
 ) (
     input  wire                    clk,
     input  wire                    rst,          // synchronous, active high
@@ -53,7 +57,10 @@ module fmt_flatten #(
     input  wire                    cal_sel_i,    // 0 = offset (HM_W bits), 1 = gain (Q2.14)
     input  wire [ROW_IDX_W-1:0]    cal_row_i,    // cell row
     input  wire [COL_IDX_W-1:0]    cal_col_i,    // cell column
-    input  wire [15:0]             cal_data_i,   // value (offset uses the low HM_W bits)
+    input  wire [CAL_W-1:0]        cal_data_i,   // value (offset: low HM_W bits, gain: low 16 bits)
+    input  wire                    cal_re_i,     // read back cal_row_i/cal_col_i/cal_sel_i
+    output reg                     cal_rvalid_o, // read-back data valid (one cycle)
+    output reg  [CAL_W-1:0]        cal_rdata_o,  // read-back value (zero-extended)
     // saturation monitor
     input  wire                    sat_clr_i,    // clear flag and counter
     output reg                     sat_flag_o,   // sticky: some cell saturated
@@ -78,6 +85,15 @@ module fmt_flatten #(
     wire [COLS*HM_W-1:0]  q4;
     wire [COLS-1:0]       sat4;
 
+    // read-back request, served in a cycle without a heat-map beat
+    reg                  rd_pend_q, rd_go_q, rd_sel_q;
+    reg [ROW_IDX_W-1:0]  rd_row_q;
+    reg [COL_IDX_W-1:0]  rd_col_q;
+    wire                 rd_serve = rd_pend_q && !hm_valid_i;
+    wire [ROW_IDX_W-1:0] rd_addr  = hm_valid_i ? hm_row_i : rd_row_q;
+    wire [COLS*HM_W-1:0]   off_all;
+    wire [COLS*GAIN_W-1:0] gain_all;
+
     genvar c;
     generate
         for (c = 0; c < COLS; c = c + 1) begin : g_col
@@ -95,10 +111,12 @@ module fmt_flatten #(
             wire we_col = cal_we_i && (cal_col_i == c);
             always @(posedge clk) begin
                 if (we_col && !cal_sel_i) off_mem[cal_row_i] <= cal_data_i[HM_W-1:0];
-                if (we_col &&  cal_sel_i) gain_mem[cal_row_i] <= cal_data_i;
-                off_rd_q  <= off_mem[hm_row_i];
-                gain_rd_q <= gain_mem[hm_row_i];
+                if (we_col &&  cal_sel_i) gain_mem[cal_row_i] <= cal_data_i[GAIN_W-1:0];
+                off_rd_q  <= off_mem[rd_addr];
+                gain_rd_q <= gain_mem[rd_addr];
             end
+            assign off_all[c*HM_W +: HM_W]      = off_rd_q;
+            assign gain_all[c*GAIN_W +: GAIN_W] = gain_rd_q;
 
             // s2: subtract, clamp at zero
             wire [HM_W:0] diff = {1'b0, z1_q[c*HM_W +: HM_W]} - {1'b0, off_rd_q};
@@ -127,6 +145,36 @@ module fmt_flatten #(
             pop = pop + {{(POP_W-1){1'b0}}, hm_sat_o[k]};
     end
     wire [CNT_W:0] cnt_sum = {1'b0, sat_count_o} + {{(CNT_W+1-POP_W){1'b0}}, pop};
+
+    // read-back: column select of the read registers
+    reg [CAL_W-1:0] rd_word;
+    always @(*) begin
+        rd_word = {CAL_W{1'b0}};
+        if (rd_sel_q) rd_word[GAIN_W-1:0] = gain_all[rd_col_q*GAIN_W +: GAIN_W];
+        else          rd_word[HM_W-1:0]   = off_all[rd_col_q*HM_W +: HM_W];
+    end
+    always @(posedge clk) begin
+        if (rst) begin
+            rd_pend_q    <= 1'b0;
+            rd_go_q      <= 1'b0;
+            rd_row_q     <= {ROW_IDX_W{1'b0}};
+            rd_col_q     <= {COL_IDX_W{1'b0}};
+            rd_sel_q     <= 1'b0;
+            cal_rvalid_o <= 1'b0;
+        end else begin
+            if (cal_re_i) begin
+                rd_pend_q <= 1'b1;
+                rd_row_q  <= cal_row_i;
+                rd_col_q  <= cal_col_i;
+                rd_sel_q  <= cal_sel_i;
+            end else if (rd_serve) begin
+                rd_pend_q <= 1'b0;
+            end
+            rd_go_q      <= rd_serve && !cal_re_i;
+            cal_rvalid_o <= rd_go_q;
+        end
+        cal_rdata_o <= rd_word;
+    end
 
     always @(posedge clk) begin
         z1_q <= hm_data_i;

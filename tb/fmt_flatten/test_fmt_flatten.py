@@ -32,7 +32,8 @@ class TB(ClockedTB):
         self.rows, self.cols = self.cfg.rows, self.cfg.cols
         self.offset, self.gain = identity(self.cfg)
         for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i",
-                  "cal_we_i", "cal_sel_i", "cal_row_i", "cal_col_i", "cal_data_i", "sat_clr_i"):
+                  "cal_we_i", "cal_sel_i", "cal_row_i", "cal_col_i", "cal_data_i", "cal_re_i",
+                  "sat_clr_i"):
             getattr(dut, s).value = 0
 
     def pack(self, row) -> int:
@@ -191,6 +192,48 @@ async def reset_mid_frame(dut):
     sched = tb.frames_schedule(rng, [hm], first_frame=7)
     out = await tb.run(sched)
     tb.check(sched, out)
+
+
+@cocotb.test()
+async def calibration_readback(dut):
+    """Read back offsets and gains, also while heat-map beats occupy the read port
+    (the request waits for a free cycle)."""
+    tb = TB(dut)
+    await tb.reset()
+    rng = random.Random(env_int("SEED", 1) + 3)
+    nrng = np.random.default_rng(env_int("SEED", 1) + 3)
+    off = nrng.integers(0, 1 << tb.w, size=(tb.rows, tb.cols))
+    gain = nrng.integers(0, GAIN_MAX + 1, size=(tb.rows, tb.cols))
+    await tb.load(off, gain)
+    for trial in range(24):
+        r, c, sel = rng.randrange(tb.rows), rng.randrange(tb.cols), rng.randrange(2)
+        busy = rng.randrange(0, 4) if trial % 2 else 0      # beats occupying the read port
+        await tb.writable()
+        dut.cal_re_i.value = 1
+        dut.cal_row_i.value = r
+        dut.cal_col_i.value = c
+        dut.cal_sel_i.value = sel
+        dut.hm_valid_i.value = int(busy > 0)
+        dut.hm_row_i.value = rng.randrange(tb.rows)
+        await RisingEdge(tb.clk)
+        await tb.writable()
+        dut.cal_re_i.value = 0
+        waited = 0
+        for i in range(busy + 4):
+            dut.hm_valid_i.value = int(i + 1 < busy)
+            await RisingEdge(tb.clk)
+            await ReadOnly()
+            waited += 1
+            if int(dut.cal_rvalid_o.value):
+                break
+            await tb.writable()
+        assert int(dut.cal_rvalid_o.value) == 1, "no read-back answer"
+        want = int(gain[r, c] if sel else off[r, c])
+        assert int(dut.cal_rdata_o.value) == want, f"cell ({r},{c}) sel {sel}"
+        assert waited == max(busy, 1) + 1, f"answer after {waited} cycles, {busy} busy"
+        await tb.writable()
+        dut.hm_valid_i.value = 0
+    await tb.cycles(LATENCY + 2)
 
 
 # ---- pytest entry ------------------------------------------------------------------
