@@ -154,7 +154,3 @@ def events(heatmaps: np.ndarray, scene: Scene, settings=None, fixed: bool = Fals
     from .settings import TouchSettings
     settings = TouchSettings() if settings is None else settings
     return _touch.process_frames(heatmaps, scene.cfg, settings, fixed=fixed)
-
-
-__all__ = ["ChainResult", "heatmaps_float", "render_heatmaps", "frame_coupling", "events",
-           "noiseless", "_sensor"]

@@ -193,17 +193,19 @@ def _disk_maps(cfg: SensorConfig, ct: np.ndarray) -> np.ndarray:
     return out / p ** 2
 
 
+try:                                   # scipy is optional (not in requirements.txt)
+    from scipy.special import erf as _scipy_erf  # type: ignore
+except Exception:                      # pragma: no cover - depends on the environment
+    _scipy_erf = None
 _ERF = np.frompyfunc(math.erf, 1, 1)
 
 
 def erf(x) -> np.ndarray:
-    """Vectorized error function (double precision)."""
+    """Vectorized error function (double precision: math.erf, or scipy when present)."""
     x = np.asarray(x, dtype=np.float64)
-    try:
-        from scipy.special import erf as _serf  # type: ignore
-        return _serf(x)
-    except Exception:  # pragma: no cover - scipy is optional
-        return np.asarray(_ERF(x), dtype=np.float64)
+    if _scipy_erf is not None:
+        return _scipy_erf(x)
+    return np.asarray(_ERF(x), dtype=np.float64)
 
 
 def _interval_prob(lo, hi, mu, sigma):
