@@ -14,10 +14,12 @@
 //            candidate bit = slot active and D <= gate (max_jump_i for a contact seen
 //            last frame, hold_jump_i for one in hold-off).  Touches beyond MAX_TOUCHES
 //            are dropped (sticky drop_flag_o).
-//   MATCH    (after tp_eof) one greedy step per cycle: a min tree over the
-//            MAX_TOUCHES^2 candidate matrix (unassigned touches and slots) picks the
-//            smallest D, ties to the smallest index t * 2^SB + s; the pair is
-//            assigned, a move event issued and the slot's velocity/prediction updated:
+//   MATCH    (after tp_eof) one greedy step per 2 cycles: a min tree over the
+//            MAX_TOUCHES^2 candidate matrix (unassigned touches and slots), pipelined
+//            in two stages (per-touch minima over the slots, registered; then the
+//            minimum over the touches), picks the smallest D, ties to the smallest
+//            index t * 2^SB + s; the pair is assigned, a move event issued and the
+//            slot's velocity/prediction updated:
 //              e = (x << VF) - p;  v = clamp(v + (e >>> vel_shift_i), +-max_speed_i);
 //              p = (x << VF) + v.
 //            No candidate left -> LIFT.
@@ -27,10 +29,10 @@
 //            at or after the round-robin pointer; generation + 1; id = {gen, slot};
 //            no free slot -> the touch is dropped (sticky noslot_flag_o).
 //   UPDATE   one cycle: every active slot neither matched nor new: miss + 1, p += v.
-// Events leave through a one-event holding register (to mark ev_last_o), so the last
-// event of a frame is on the output 2 cycles after it is formed; with m matches, l
-// lifts, n news, the frame's last event is on the output m + l + n + 5 cycles after
-// the tp_eof cycle (tp_eof -> MATCH 1, empty MATCH/LIFT/NEW steps 3, hold 1).
+// Events leave through a one-event holding register (to mark ev_last_o).  With m
+// matches, l lifts, n news and d new touches without a free slot, the frame's last
+// event is on the output 2m + l + n + d + 6 cycles after the tp_eof cycle (tp_eof ->
+// MATCH 1, the empty MATCH step 2, empty LIFT/NEW steps 2, UPDATE and hold 1).
 // A frame with no events emits nothing.  Touches of the next frame must not arrive
 // before the tracker is idle again (overrun_flag_o; they are dropped).
 // tp_frame_i is sampled with every touch and with tp_eof (the event frame number).
@@ -122,6 +124,7 @@ module fmt_tracker #(
     reg [MT*HOLD_W-1:0] miss_q;
     reg [MT*16-1:0]    lx_q, ly_q;
     reg [SB-1:0]       next_slot_q;               // round-robin allocation pointer
+    reg                mph_q;                     // MATCH phase: 0 tree stage A, 1 stage B
     // event holding register
     reg                pend_q;
     reg [ID_W-1:0]     pid_q;
@@ -170,12 +173,20 @@ module fmt_tracker #(
         end
     end
 
-    // ---- min tree over the candidate matrix ----------------------------------------
-    reg [NL*KW-1:0] tk;        // keys, reduced in place
-    reg [NL*LW-1:0] ti;        // leaf indices
-    reg             m_found;
-    reg [SB-1:0]    m_s;
-    reg [SB-1:0]    m_t;
+    // ---- min tree over the candidate matrix, two pipeline stages ----------------------
+    // Leaf t*MTP+s = {invalid, D}.  Stage A (MATCH phase 0): the first SB levels reduce
+    // over s for each touch t -> per-touch minima, registered.  Stage B (MATCH phase
+    // 1): the last SB levels reduce over t.  Ties always go to the lower index, so the
+    // result is the smallest (D, t, s) -- the same as one flat tree.
+    reg [NL*KW-1:0]  tk;        // stage A keys, reduced in place
+    reg [NL*LW-1:0]  ti;        // stage A leaf indices
+    reg [MTP*KW-1:0] rk_q;      // registered per-touch minima
+    reg [MTP*LW-1:0] ri_q;
+    reg [MTP*KW-1:0] bk;        // stage B keys, reduced in place
+    reg [MTP*LW-1:0] bi;
+    reg              m_found;
+    reg [SB-1:0]     m_s;
+    reg [SB-1:0]     m_t;
     integer l_i, n_i, t_i;
     always @* begin
         for (t_i = 0; t_i < MTP; t_i = t_i + 1) begin
@@ -190,7 +201,7 @@ module fmt_tracker #(
             end
         end
         // level by level: node i <- min(node 2i, node 2i+1), ties to the left (lower index)
-        for (n_i = NL / 2; n_i >= 1; n_i = n_i / 2) begin
+        for (n_i = NL / 2; n_i >= MTP; n_i = n_i / 2) begin
             for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
                 if (tk[(2*l_i+1)*KW +: KW] < tk[(2*l_i)*KW +: KW]) begin
                     tk[l_i*KW +: KW] = tk[(2*l_i+1)*KW +: KW];
@@ -201,9 +212,24 @@ module fmt_tracker #(
                 end
             end
         end
-        m_found = ~tk[KW-1];
-        m_t = ti[LW-1:SB];
-        m_s = ti[SB-1:0];
+    end
+    always @* begin
+        bk = rk_q;
+        bi = ri_q;
+        for (n_i = MTP / 2; n_i >= 1; n_i = n_i / 2) begin
+            for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
+                if (bk[(2*l_i+1)*KW +: KW] < bk[(2*l_i)*KW +: KW]) begin
+                    bk[l_i*KW +: KW] = bk[(2*l_i+1)*KW +: KW];
+                    bi[l_i*LW +: LW] = bi[(2*l_i+1)*LW +: LW];
+                end else begin
+                    bk[l_i*KW +: KW] = bk[(2*l_i)*KW +: KW];
+                    bi[l_i*LW +: LW] = bi[(2*l_i)*LW +: LW];
+                end
+            end
+        end
+        m_found = ~bk[KW-1];
+        m_t = bi[LW-1:SB];
+        m_s = bi[SB-1:0];
     end
 
     // ---- the matched pair's update (one shared datapath) ------------------------
@@ -273,7 +299,7 @@ module fmt_tracker #(
         gen_type = T_MOVE;
         gen_data = {TD_W{1'b0}};
         case (state_q)
-            S_MATCH: if (m_found) begin
+            S_MATCH: if (mph_q && m_found) begin
                 gen_ev = 1'b1;
                 gen_id = {gen_q[m_s*GEN_W +: GEN_W], m_s};
                 gen_type = T_MOVE;
@@ -317,6 +343,9 @@ module fmt_tracker #(
             lx_q           <= {(MT*16){1'b0}};
             ly_q           <= {(MT*16){1'b0}};
             next_slot_q    <= {SB{1'b0}};
+            mph_q          <= 1'b0;
+            rk_q           <= {(MTP*KW){1'b1}};
+            ri_q           <= {(MTP*LW){1'b0}};
             pend_q         <= 1'b0;
             pid_q          <= {ID_W{1'b0}};
             ptype_q        <= 2'd0;
@@ -364,7 +393,11 @@ module fmt_tracker #(
             // ---- matching / lifts / news / update -------------------------------------
             case (state_q)
                 S_MATCH: begin
-                    if (m_found) begin
+                    mph_q <= ~mph_q;
+                    if (!mph_q) begin
+                        rk_q <= tk[MTP*KW-1:0];
+                        ri_q <= ti[MTP*LW-1:0];
+                    end else if (m_found) begin
                         tused_q[m_t] <= 1'b1;
                         sused_q[m_s] <= 1'b1;
                         vx_q[m_s*V_W +: V_W] <= m_vx_new;

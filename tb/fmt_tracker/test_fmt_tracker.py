@@ -6,7 +6,7 @@ vanish and flicker, random order, more than MAX_TOUCHES touches, random settings
 scripted scenarios on a scaled timeline (drumroll, merge/split, fast crossing,
 flicker, hold-off expiry, 17 touches with 16 slots), plus a reset in the middle of a
 frame.  Also measures and checks the tail latency: the frame's last event is on the
-output exactly n_events + n_noslot + 5 cycles after the tp_eof cycle
+output exactly n_events + n_moves + n_noslot + 6 cycles after the tp_eof cycle
 (n_noslot = new touches dropped for want of a slot, one cycle each).
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.tracking import EV_TYPES, Touch, Tracker, TrackParams
 
-TAIL_FIXED = 5
+TAIL_FIXED = 6
 
 
 class TB(ClockedTB):
@@ -141,7 +141,9 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
             # cycle c + lat (a plain register would be lat = 1)
             lat = got[-1][0] - eof + 1
-            assert lat == len(got) + noslot + TAIL_FIXED, f"tail latency {lat} for {len(got)} events"
+            moves = sum(1 for x in exp if x.type == "move")
+            assert lat == len(got) + moves + noslot + TAIL_FIXED, \
+                f"tail latency {lat} for {len(got)} events ({moves} moves)"
             tail.append((len(got), lat))
     return model, tail
 
