@@ -97,3 +97,16 @@ def test_tx_sign_alignment():
     tx, _ = pn_signs(299, chip_len=3, bits=cfg.pn_bits)
     sgn = np.concatenate([[1], 1 - 2 * tx.astype(np.int64)])
     assert np.array_equal(y, plain * sgn[:, None])
+
+
+def test_channel_sim_fixed_hand_values():
+    # 2 rows, 1 column; G = 0.5 and 0.25 (16 fractional bits); noise 0.5 LSB (4 frac bits)
+    dac = np.array([[3, 2], [3, 2], [2047, 2047], [-5, 1]])
+    g0 = np.array([[1 << 15], [1 << 14]])
+    g1 = np.array([[(1 << 16) - 1], [(1 << 16) - 1]])
+    noise = np.array([[8], [-8]])
+    adc, clip = dds.channel_sim_fixed(dac, g0, [(2, g1)], noise, adc_bits=12)
+    # s0: 1.5 + 0.5 + 0.5 = 2.5 -> 3 (half up); s1: 2.0 - 0.5 = 1.5 -> 2
+    # s2: ~4094 -> clipped to 2047; s3: (-5 + 1)*(1 - 2^-16) - 0.5 = -4.49994 -> -4
+    assert adc[:, 0].tolist() == [3, 2, 2047, -4]
+    assert clip.tolist() == [False, False, True, False]
