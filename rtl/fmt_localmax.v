@@ -15,17 +15,18 @@
 // existing neighbour rows are present, so evaluation runs while the frame arrives:
 //   E0: pick the lowest ready row, read rows r-1, r, r+1          (1 row per cycle)
 //   E1: compare every cell of row r with its neighbours -> maxima mask (COLS bits)
-//   E2: serialise the maxima, one per cycle (lowest column first), gather the 3x3
-//   E3: insert the candidate into a sorted list of MAX_TOUCHES entries (z descending,
+//   E2: serialise the maxima, one per cycle (lowest column first)
+//   E3: insert (z, row, col) into a sorted list of MAX_TOUCHES entries (z descending,
 //       ties by raster index ascending); the weakest falls off the end.
 // After the frame's hm_eof, once every row is evaluated, the list is emitted, one
-// candidate per cycle, then cand_eof.  Settings (threshold_i, moore_i, limit_i) are
-// used live: change them between frames.
+// candidate per cycle: the same three read ports fetch the candidate's rows and a
+// column select forms its 3x3 neighbourhood; then cand_eof.  Settings (threshold_i,
+// moore_i, limit_i) are used live: change them between frames.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
-// hm_eof right after the last row): last row beat -> last candidate = 6 + n cycles
-// for n candidates (1 -> 7, 5 -> 11), plus one cycle per maximum that lies in the rows
-// completed by the last beat (16 maxima all in the last row: 41); hm_eof -> last
+// hm_eof right after the last row): last row beat -> last candidate = 7 + n cycles
+// for n candidates (1 -> 8, 5 -> 12), plus one cycle per maximum that lies in the rows
+// completed by the last beat (16 maxima all in the last row: 42); hm_eof -> last
 // candidate is one cycle less; cand_eof follows the last candidate.  Throughput: one
 // row per cycle plus one cycle per maximum; a frame must be finished (cand_eof) before
 // the frame after the next one starts to arrive, else overrun_o is set (sticky).
@@ -126,7 +127,6 @@ module fmt_localmax #(
         for (i = ROWS - 1; i >= 0; i = i - 1)
             if (ready[i]) pick = i[ROW_IDX_W-1:0];
     end
-
     // ---- state ------------------------------------------------------------------------
     localparam S_RUN = 1'b0, S_EMIT = 1'b1;
     reg state_q;
@@ -139,29 +139,45 @@ module fmt_localmax #(
     wire e1_adv  = e1_v_q && e2_free;
     wire issue   = (state_q == S_RUN) && (|ready) && (!e1_v_q || e1_adv);
 
-    // ---- E0 -> E1: three synchronous reads --------------------------------------------
+    // ---- the sorted list (z, raster index) --------------------------------------------
+    reg [K-1:0]       l_v_q;
+    reg [HM_W-1:0]    l_z_q   [0:K-1];
+    reg [IDX_W-1:0]   l_idx_q [0:K-1];
+    reg [FOUND_W-1:0] found_q;
+    reg [LIM_W-1:0]   left_q;                 // candidates still to emit
+    wire              em_issue = (state_q == S_EMIT) && (left_q != {LIM_W{1'b0}});
+    wire [ROW_IDX_W-1:0] l_row0 = l_idx_q[0][COL_IDX_W +: ROW_IDX_W];
+
+    // ---- E0 -> E1: three synchronous reads (evaluation, or a candidate's 3x3 at emission)
     reg [RW-1:0]        ra_q, rb_q, rc_q;       // rows r-1, r, r+1
     reg [ROW_IDX_W-1:0] r1_q;
+    wire [ROW_IDX_W-1:0] rd_row = (state_q == S_EMIT) ? l_row0 : pick;
     wire [ADDR_W-1:0] base  = pb_q ? ROWS_A : {ADDR_W{1'b0}};
-    wire [ADDR_W-1:0] a_mid = base + {{(ADDR_W-ROW_IDX_W){1'b0}}, pick};
-    wire [ADDR_W-1:0] a_up  = (pick == {ROW_IDX_W{1'b0}}) ? a_mid : a_mid - 1'b1;
-    wire [ADDR_W-1:0] a_dn  = (pick == LAST_ROW) ? a_mid : a_mid + 1'b1;
+    wire [ADDR_W-1:0] a_mid = base + {{(ADDR_W-ROW_IDX_W){1'b0}}, rd_row};
+    wire [ADDR_W-1:0] a_up  = (rd_row == {ROW_IDX_W{1'b0}}) ? a_mid : a_mid - 1'b1;
+    wire [ADDR_W-1:0] a_dn  = (rd_row == LAST_ROW) ? a_mid : a_mid + 1'b1;
     always @(posedge clk) begin
-        if (issue) begin
+        if (issue || em_issue) begin
             ra_q <= mem[a_up];
             rb_q <= mem[a_mid];
             rc_q <= mem[a_dn];
-            r1_q <= pick;
+            r1_q <= rd_row;
         end
     end
     wire top1 = (r1_q == {ROW_IDX_W{1'b0}});
     wire bot1 = (r1_q == LAST_ROW);
 
     // ---- E1: maxima mask of row r1 ----------------------------------------------------
-    // gt_l[c] = B[c] > B[c-1]: cell c beats its left neighbour; the left one beats (>=)
-    // its right neighbour exactly when !gt_l[c].
+    // gt_l[c] = B[c] > B[c-1] (c beats its left neighbour); the left neighbour beats
+    // (>=) c exactly when !gt_l[c]: one comparator per horizontal pair.
+    wire [COLS:0] gt_l;
+    assign gt_l[0]    = 1'b1;
+    assign gt_l[COLS] = 1'b0;
     genvar c;
     generate
+        for (c = 1; c < COLS; c = c + 1) begin : g_h
+            assign gt_l[c] = (rb_q[c*HM_W +: HM_W] > rb_q[(c-1)*HM_W +: HM_W]);
+        end
         for (c = 0; c < COLS; c = c + 1) begin : g_cmp
             wire [HM_W-1:0] p  = rb_q[c*HM_W +: HM_W];
             wire [HM_W-1:0] u  = ra_q[c*HM_W +: HM_W];
@@ -169,92 +185,86 @@ module fmt_localmax #(
             wire ok_thr = (p >= threshold_i);
             wire ok_u   = top1 || (p > u);
             wire ok_d   = bot1 || (p >= d);
-            wire ok_l, ok_r, ok_ul, ok_ur, ok_dl, ok_dr;
+            wire ok_l   = gt_l[c];
+            wire ok_r   = !gt_l[c + 1];
+            wire ok_ul, ok_ur, ok_dl, ok_dr;
             if (c > 0) begin : g_l
-                wire [HM_W-1:0] l  = rb_q[(c-1)*HM_W +: HM_W];
                 wire [HM_W-1:0] ul = ra_q[(c-1)*HM_W +: HM_W];
                 wire [HM_W-1:0] dl = rc_q[(c-1)*HM_W +: HM_W];
-                assign ok_l  = (p > l);
                 assign ok_ul = top1 || !moore_i || (p > ul);
                 assign ok_dl = bot1 || !moore_i || (p >= dl);
             end else begin : g_nl
-                assign ok_l = 1'b1;  assign ok_ul = 1'b1;  assign ok_dl = 1'b1;
+                assign ok_ul = 1'b1;  assign ok_dl = 1'b1;
             end
             if (c < COLS - 1) begin : g_r
-                wire [HM_W-1:0] rr = rb_q[(c+1)*HM_W +: HM_W];
                 wire [HM_W-1:0] ur = ra_q[(c+1)*HM_W +: HM_W];
                 wire [HM_W-1:0] dr = rc_q[(c+1)*HM_W +: HM_W];
-                assign ok_r  = (p >= rr);
                 assign ok_ur = top1 || !moore_i || (p > ur);
                 assign ok_dr = bot1 || !moore_i || (p >= dr);
             end else begin : g_nr
-                assign ok_r = 1'b1;  assign ok_ur = 1'b1;  assign ok_dr = 1'b1;
+                assign ok_ur = 1'b1;  assign ok_dr = 1'b1;
             end
             assign mask_next[c] = ok_thr & ok_u & ok_d & ok_l & ok_r & ok_ul & ok_ur & ok_dl & ok_dr;
         end
     endgenerate
 
-    // ---- E2: serialise maxima, gather the 3x3 -----------------------------------------
-    reg [RW-1:0]        wa_q, wb2_q, wc_q;      // window rows r-1, r, r+1
+    // ---- E2: serialise the maxima of the row (lowest column first) -------------------
+    reg [RW-1:0]        wrow_q;                 // the evaluated row (values for sorting)
     reg [ROW_IDX_W-1:0] r2_q;
-    reg                 top2_q, bot2_q;
     reg [COL_IDX_W-1:0] sel;                    // lowest set bit of mask_q
     always @(*) begin
         sel = {COL_IDX_W{1'b0}};
         for (i = COLS - 1; i >= 0; i = i - 1)
             if (mask_q[i]) sel = i[COL_IDX_W-1:0];
     end
-    // column mux: the three cells (c-1, c, c+1) of each window row around column sel
+    wire [HM_W-1:0] sel_z = wrow_q[sel*HM_W +: HM_W];
+
+    // E3 candidate register
+    reg [HM_W-1:0]  n_z_q;
+    reg [IDX_W-1:0] n_idx_q;
+
+    // ---- E3: insertion ----------------------------------------------------------------
+    reg [K-1:0] better;                       // entry i stays ahead of the new candidate
+    always @(*) begin
+        for (i = 0; i < K; i = i + 1)
+            better[i] = l_v_q[i] && ((l_z_q[i] > n_z_q) ||
+                                     ((l_z_q[i] == n_z_q) && (l_idx_q[i] < n_idx_q)));
+    end
+
+    // ---- emission: 3x3 of the candidate read back in E1, column select ---------------
+    reg                 em_v_q, em_eof_q;
+    reg [ROW_IDX_W-1:0] em_row_q;
+    reg [COL_IDX_W-1:0] em_col_q;
+    reg [FRAME_W-1:0]   em_frame_q;
     reg [Z9_W-1:0] z9;
     reg [8:0]      miss9;
     integer j;
     always @(*) begin
         z9 = {Z9_W{1'b0}};
         for (j = 0; j < COLS; j = j + 1) begin
-            if (sel == j[COL_IDX_W-1:0]) begin
+            if (em_col_q == j[COL_IDX_W-1:0]) begin
                 if (j > 0) begin
-                    z9[0*HM_W +: HM_W] = wa_q [((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
-                    z9[3*HM_W +: HM_W] = wb2_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
-                    z9[6*HM_W +: HM_W] = wc_q [((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                    z9[0*HM_W +: HM_W] = ra_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                    z9[3*HM_W +: HM_W] = rb_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
+                    z9[6*HM_W +: HM_W] = rc_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
                 end
-                z9[1*HM_W +: HM_W] = wa_q [j*HM_W +: HM_W];
-                z9[4*HM_W +: HM_W] = wb2_q[j*HM_W +: HM_W];
-                z9[7*HM_W +: HM_W] = wc_q [j*HM_W +: HM_W];
+                z9[1*HM_W +: HM_W] = ra_q[j*HM_W +: HM_W];
+                z9[4*HM_W +: HM_W] = rb_q[j*HM_W +: HM_W];
+                z9[7*HM_W +: HM_W] = rc_q[j*HM_W +: HM_W];
                 if (j < COLS - 1) begin
-                    z9[2*HM_W +: HM_W] = wa_q [((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
-                    z9[5*HM_W +: HM_W] = wb2_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
-                    z9[8*HM_W +: HM_W] = wc_q [((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                    z9[2*HM_W +: HM_W] = ra_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                    z9[5*HM_W +: HM_W] = rb_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
+                    z9[8*HM_W +: HM_W] = rc_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
                 end
             end
         end
         miss9 = 9'd0;
-        if (sel == {COL_IDX_W{1'b0}}) miss9 = miss9 | 9'b001_001_001;
-        if (sel == LAST_COL)          miss9 = miss9 | 9'b100_100_100;
-        if (top2_q)                   miss9 = miss9 | 9'b000_000_111;
-        if (bot2_q)                   miss9 = miss9 | 9'b111_000_000;
-        if (top2_q) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
-        if (bot2_q) z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
-    end
-
-    // E3 candidate register
-    reg [Z9_W-1:0]      n_z9_q;
-    reg [8:0]           n_miss_q;
-    reg [IDX_W-1:0]     n_idx_q;
-
-    // ---- the sorted list -------------------------------------------------------------
-    reg [K-1:0]     l_v_q;
-    reg [Z9_W-1:0]  l_z9_q   [0:K-1];
-    reg [8:0]       l_miss_q [0:K-1];
-    reg [IDX_W-1:0] l_idx_q  [0:K-1];
-    reg [FOUND_W-1:0] found_q;
-    reg [LIM_W-1:0]   left_q;                 // candidates still to emit
-
-    wire [HM_W-1:0] n_z = n_z9_q[4*HM_W +: HM_W];
-    reg  [K-1:0]    better;                   // entry i stays ahead of the new candidate
-    always @(*) begin
-        for (i = 0; i < K; i = i + 1)
-            better[i] = l_v_q[i] && ((l_z9_q[i][4*HM_W +: HM_W] > n_z) ||
-                                     ((l_z9_q[i][4*HM_W +: HM_W] == n_z) && (l_idx_q[i] < n_idx_q)));
+        if (em_col_q == {COL_IDX_W{1'b0}})     miss9 = miss9 | 9'b001_001_001;
+        if (em_col_q == LAST_COL)              miss9 = miss9 | 9'b100_100_100;
+        if (em_row_q == {ROW_IDX_W{1'b0}})     miss9 = miss9 | 9'b000_000_111;
+        if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
+        if (em_row_q == {ROW_IDX_W{1'b0}}) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
+        if (em_row_q == LAST_ROW)          z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
     end
 
     wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
@@ -271,12 +281,16 @@ module fmt_localmax #(
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
         if (e1_adv) begin
-            wa_q <= ra_q;  wb2_q <= rb_q;  wc_q <= rc_q;
-            r2_q <= r1_q;  top2_q <= top1;  bot2_q <= bot1;
+            wrow_q <= rb_q;
+            r2_q   <= r1_q;
         end
-        n_z9_q   <= z9;
-        n_miss_q <= miss9;
-        n_idx_q  <= {r2_q, sel};
+        n_z_q   <= sel_z;
+        n_idx_q <= {r2_q, sel};
+        cand_z_o       <= z9;
+        cand_missing_o <= miss9;
+        cand_row_o     <= em_row_q;
+        cand_col_o     <= em_col_q;
+        cand_frame_o   <= em_frame_q;
 
         if (rst) begin
             arr_q[0] <= {ROWS{1'b0}};
@@ -293,6 +307,10 @@ module fmt_localmax #(
             l_v_q    <= {K{1'b0}};
             found_q  <= {FOUND_W{1'b0}};
             left_q   <= {LIM_W{1'b0}};
+            em_v_q   <= 1'b0;
+            em_eof_q <= 1'b0;
+            em_row_q <= {ROW_IDX_W{1'b0}};
+            em_col_q <= {COL_IDX_W{1'b0}};
             cand_valid_o      <= 1'b0;
             cand_eof_o        <= 1'b0;
             cand_count_o      <= {LIM_W{1'b0}};
@@ -336,26 +354,23 @@ module fmt_localmax #(
                 for (i = 0; i < K; i = i + 1) begin
                     if (!better[i]) begin
                         if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
-                            l_v_q[i]    <= 1'b1;
-                            l_z9_q[i]   <= n_z9_q;
-                            l_miss_q[i] <= n_miss_q;
-                            l_idx_q[i]  <= n_idx_q;
+                            l_v_q[i]   <= 1'b1;
+                            l_z_q[i]   <= n_z_q;
+                            l_idx_q[i] <= n_idx_q;
                         end else begin
-                            l_v_q[i]    <= l_v_q[(i == 0) ? 0 : i - 1];
-                            l_z9_q[i]   <= l_z9_q[(i == 0) ? 0 : i - 1];
-                            l_miss_q[i] <= l_miss_q[(i == 0) ? 0 : i - 1];
-                            l_idx_q[i]  <= l_idx_q[(i == 0) ? 0 : i - 1];
+                            l_v_q[i]   <= l_v_q[(i == 0) ? 0 : i - 1];
+                            l_z_q[i]   <= l_z_q[(i == 0) ? 0 : i - 1];
+                            l_idx_q[i] <= l_idx_q[(i == 0) ? 0 : i - 1];
                         end
                     end
                 end
             end
 
             // ---- finish and emit ----
-            cand_valid_o <= 1'b0;
-            cand_eof_o   <= 1'b0;
             if (finish) begin
-                state_q <= S_EMIT;
-                left_q  <= complete ? n_emit : {LIM_W{1'b0}};
+                state_q    <= S_EMIT;
+                em_frame_q <= frm_q[pb_q];
+                left_q     <= complete ? n_emit : {LIM_W{1'b0}};
                 cand_count_o      <= complete ? n_emit : {LIM_W{1'b0}};
                 cand_found_o      <= complete ? found_q : {FOUND_W{1'b0}};
                 cand_overflow_o   <= complete && over;
@@ -365,32 +380,31 @@ module fmt_localmax #(
                     drop_count_o    <= drop_sum[CNT_W] ? {CNT_W{1'b1}} : drop_sum[CNT_W-1:0];
                 end
             end
-            if (state_q == S_EMIT) begin
-                cand_frame_o <= frm_q[pb_q];
-                if (left_q != {LIM_W{1'b0}}) begin
-                    left_q         <= left_q - 1'b1;
-                    cand_valid_o   <= 1'b1;
-                    cand_row_o     <= l_idx_q[0][COL_IDX_W +: ROW_IDX_W];
-                    cand_col_o     <= l_idx_q[0][0 +: COL_IDX_W];
-                    cand_z_o       <= l_z9_q[0];
-                    cand_missing_o <= l_miss_q[0];
-                    for (i = 0; i < K - 1; i = i + 1) begin
-                        l_v_q[i]    <= l_v_q[i + 1];
-                        l_z9_q[i]   <= l_z9_q[i + 1];
-                        l_miss_q[i] <= l_miss_q[i + 1];
-                        l_idx_q[i]  <= l_idx_q[i + 1];
-                    end
-                    l_v_q[K-1] <= 1'b0;
-                end else begin
-                    cand_eof_o  <= 1'b1;
-                    state_q     <= S_RUN;
-                    l_v_q       <= {K{1'b0}};
-                    found_q     <= {FOUND_W{1'b0}};
-                    done_q      <= {ROWS{1'b0}};
-                    arr_q[pb_q] <= {ROWS{1'b0}};
-                    eofs_q[pb_q] <= 1'b0;
-                    pb_q        <= ~pb_q;
+            // emission pipeline: em_issue reads the rows (E1 registers), then the column
+            // select registers the candidate; cand_eof follows the last one
+            em_v_q       <= em_issue;
+            em_eof_q     <= releasing;
+            cand_valid_o <= em_v_q;
+            cand_eof_o   <= em_eof_q;
+            if (em_issue) begin
+                em_row_q <= l_row0;
+                em_col_q <= l_idx_q[0][0 +: COL_IDX_W];
+                left_q   <= left_q - 1'b1;
+                for (i = 0; i < K - 1; i = i + 1) begin
+                    l_v_q[i]   <= l_v_q[i + 1];
+                    l_z_q[i]   <= l_z_q[i + 1];
+                    l_idx_q[i] <= l_idx_q[i + 1];
                 end
+                l_v_q[K-1] <= 1'b0;
+            end
+            if (releasing) begin
+                state_q      <= S_RUN;
+                l_v_q        <= {K{1'b0}};
+                found_q      <= {FOUND_W{1'b0}};
+                done_q       <= {ROWS{1'b0}};
+                arr_q[pb_q]  <= {ROWS{1'b0}};
+                eofs_q[pb_q] <= 1'b0;
+                pb_q         <= ~pb_q;
             end
         end
     end
