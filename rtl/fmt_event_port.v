@@ -13,8 +13,10 @@
 // (RAM write, RAM read, output register; the dial adds exactly delay_i cycles, 0 adds
 // nothing) when the consumer is ready and nothing queues in front of it: the head
 // event leaves the RAM only when now - ev_time >= delay_i + 2 (mod 2^TIME_W).
-// Events keep their input spacing.  Largest loss-free delay at full rate: the FIFO
-// must hold every event younger than the delay: (DEPTH / MAX_EV - 1) frames.
+// Events keep their input spacing.  Largest loss-free delay: the FIFO must hold every
+// event younger than the delay, (DEPTH / MAX_EV - 1) admitted frames: at every frame
+// (162.76 kHz, DEPTH 2048, MAX_EV 32) 63 frames = 387 us; at a 250 Hz report rate
+// 63 x 4 ms = 252 ms (the paper's 150 ms Pong delay fits).
 //
 // Admission, decided at a frame's first event for the whole frame:
 //   report_period_i > 0 and fewer than report_period_i cycles since the last admitted
@@ -33,7 +35,7 @@ module fmt_event_port #(
     parameter FRAME_W  = 16,                      // frame number width
     parameter ID_W     = 8,                       // contact ID width
     parameter TIME_W   = 32,                      // time stamp, delay and period width
-    parameter DEPTH    = 1024,                    // FIFO entries (power of two)
+    parameter DEPTH    = 2048,                    // FIFO entries (power of two)
     parameter MAX_EV   = 2 * `FMT_MAX_TOUCHES,    // room reserved per frame (events)
     parameter CNT_W    = 16,                      // drop / skip counter width
     parameter AW       = $clog2(DEPTH)            // FIFO address width

@@ -22,7 +22,7 @@ module fmt_touch #(
     parameter FRAME_W     = 16,                 // frame number width
     parameter ID_W        = 8,                  // contact ID width
     parameter TIME_W      = 32,                 // event time stamp width
-    parameter EV_DEPTH    = 1024,               // event FIFO entries (power of two)
+    parameter EV_DEPTH    = 2048,               // event FIFO entries (power of two)
     parameter VF          = 12,                 // tracker: extra fraction bits of p, v
     parameter V_W         = 22,                 // tracker: velocity width
     parameter HOLD_W      = 12,                 // tracker: hold-off width

@@ -14,11 +14,11 @@ Dial-a-latency: the head event leaves the RAM only when ``now - ev_time >= delay
 (modulo 2^TIME_W), so with ``delay`` = D the event is on the output in cycle exactly
 ``c + 3 + D``: the dial adds exactly D cycles, zero at D = 0.  Events keep their input
 spacing, so this holds for every event while the FIFO does not overflow.  Maximum
-delay without loss at full rate: the FIFO must hold every event younger than D, so
-D_max = (depth / max_ev - 1) frames (a frame may bring up to ``max_ev`` events); at
-the default depth 1024, max_ev 32 that is 31 frames (190 us at 162.76 kHz).  Longer
-delays (the paper's 150 ms) work with a report period: at most one frame per
-``report_period`` cycles enters the FIFO.
+delay without loss: the FIFO must hold every event younger than D, so D_max =
+(depth / max_ev - 1) admitted frames (a frame may bring up to ``max_ev`` events); at
+the default depth 2048, max_ev 32 that is 63 frames: 387 us at every frame
+(162.76 kHz); with a report period (at most one frame per ``report_period`` cycles
+enters the FIFO) of 4 ms (250 Hz) it is 252 ms, enough for the paper's 150 ms.
 
 Admission (decided at a frame's first event, applied to the whole frame):
   * report-rate decimation: if ``report_period`` > 0 and fewer than ``report_period``
@@ -42,7 +42,7 @@ FIXED_LATENCY = 3
 
 @dataclass(frozen=True)
 class PortParams:
-    depth: int = 1024          # FIFO entries (power of two)
+    depth: int = 2048          # FIFO entries (power of two)
     max_ev: int = 32           # room reserved per frame (2 x MAX_TOUCHES)
     time_w: int = 32           # time stamp / delay / report period width
     cnt_w: int = 16            # drop / skip counter width

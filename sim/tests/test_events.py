@@ -122,3 +122,19 @@ def test_reset_mid_frame():
     # time stamps restart at the reset
     first_after = next(o for o in outs if o.cycle > 203)
     assert first_after.time == 220 - 204
+
+
+def test_long_delay_with_report_period():
+    """The Pong case, scaled: with a report period R the loss-free delay is
+    (depth / max_ev - 1) x R cycles (full frames arriving faster than R)."""
+    p = PortParams(depth=64, max_ev=8)
+    R, F = 50, 10
+    frames = [[TouchEvent(f, i, "move", i, f) for i in range(8)] for f in range(200)]
+    beats = frames_to_beats(frames, period=F)
+    d = (p.depth // p.max_ev - 1) * R - p.max_ev
+    outs, port = run_port(beats, 200 * F + d + 100, delay=d, report_period=R, p=p)
+    assert port.drop_count == 0 and port.skip_count == 200 - 40
+    got = frames_out(outs)
+    assert [g[0].frame for g in got] == list(range(0, 200, 5))
+    outs, port = run_port(beats, 200 * F + d + 100, delay=d + 2 * R, report_period=R, p=p)
+    assert port.drop_count > 0
