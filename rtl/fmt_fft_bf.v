@@ -25,7 +25,7 @@ module fmt_fft_bf #(
     parameter LOG2_D  = 0,           // delay D = 2^LOG2_D (D = N/2 for the first stage)
     parameter DW      = 13,          // input width (signed); output is DW + 1
     parameter MINUS_J = 0,           // 1: BF2II stage (-j on the second half of each 4D block)
-    parameter RAM_MIN = 64           // delay lines this long or longer use the RAM form
+    parameter RAM_MIN = 8            // delay lines this long or longer use the RAM form
 ) (
     input  wire              clk,
     input  wire              rst,          // synchronous, active high
@@ -60,12 +60,20 @@ module fmt_fft_bf #(
     wire signed [OW-1:0] b_re = {in_re_i[DW-1], in_re_i};
     wire signed [OW-1:0] b_im = {in_im_i[DW-1], in_im_i};
 
-    // b' = swap ? -j b : b;   a + b' and a - b' written without a separate negation
-    wire signed [OW-1:0] br_sel = swap ? b_im : b_re;
-    wire signed [OW-1:0] sum_re = a_re + br_sel;
-    wire signed [OW-1:0] dif_re = a_re - br_sel;
-    wire signed [OW-1:0] sum_im = swap ? (a_im - b_re) : (a_im + b_im);
-    wire signed [OW-1:0] dif_im = swap ? (a_im + b_re) : (a_im - b_im);
+    // b' = swap ? -j b : b = (b_im, -b_re).  Each sum/difference is one adder with its
+    // operand selection, masking and carry-in folded into the LUT in front of the carry
+    // chain (-x = ~x + 1):
+    //   y  = ctrl ? a + b' : a      = a + (b' & ctrl)
+    //   fb = ctrl ? a - b' : b      (the delay line input)
+    wire [OW-1:0] mask   = {OW{ctrl}};
+    wire [OW-1:0] bre_p  = swap ? b_im : b_re;            // Re b'
+    wire [OW-1:0] bim_px = swap ? ~b_re : b_im;           // Im b' (minus the +1 when swap)
+    wire [OW-1:0] bre_n  = ~bre_p;                        // -Re b' - 1
+    wire [OW-1:0] bim_n  = swap ? b_re : ~b_im;           // -Im b' (minus the +1 when !swap)
+    wire [OW-1:0] y_re   = a_re + (bre_p & mask);
+    wire [OW-1:0] y_im   = a_im + (bim_px & mask) + {{(OW-1){1'b0}}, swap};
+    wire [OW-1:0] dif_re = a_re + bre_n + {{(OW-1){1'b0}}, 1'b1};
+    wire [OW-1:0] dif_im = a_im + bim_n + {{(OW-1){1'b0}}, ~swap};
 
     wire [2*OW-1:0] dl_in = ctrl ? {dif_re, dif_im} : {b_re, b_im};
 
@@ -91,8 +99,8 @@ module fmt_fft_bf #(
 
     always @(posedge clk) begin
         if (ce) begin
-            out_re_o <= ctrl ? sum_re : a_re;
-            out_im_o <= ctrl ? sum_im : a_im;
+            out_re_o <= y_re;
+            out_im_o <= y_im;
         end
     end
 

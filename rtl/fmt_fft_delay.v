@@ -9,7 +9,8 @@
 //   when tiny).
 // DEPTH >= RAM_MIN: a ring of DEPTH words (DEPTH a power of two) with one write port and
 //   one registered read port whose read address runs one ahead of the write address,
-//   so ring + read register = DEPTH steps; it maps to block RAM (simple dual port).
+//   so ring + read register = DEPTH steps; it maps to LUT RAM or block RAM (simple
+//   dual port), cheaper than SRLs from 8 words on (2 bits per LUT in a RAM32M).
 // Latency: exactly DEPTH ce-steps (no extra register).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -17,7 +18,7 @@
 module fmt_fft_delay #(
     parameter W       = 16,   // word width (bits)
     parameter DEPTH   = 8,    // delay in samples, >= 1; a power of two when >= RAM_MIN
-    parameter RAM_MIN = 64    // depth from which the ring-buffer (block RAM) form is used, >= 2
+    parameter RAM_MIN = 8     // depth from which the ring-buffer (RAM) form is used, >= 2
 ) (
     input  wire         clk,
     input  wire         rst,    // synchronous, active high: clears the ring pointer only

@@ -6,11 +6,15 @@
 // (TW_W bits each, scale 2^(TW_W-2), so +1 and -1 are exact), read from the hex file
 // TW_DIR + "fmt_fft_twMMMM.hex" that sim/fmt/fft_fixed.py generates.
 //
-// Arithmetic: four exact DW x TW_W products (one DSP48E each, DW <= 25), then
-//   re = (a c - b s + 2^(SH-1)) >>> SH,  im = (a s + b c + 2^(SH-1)) >>> SH
-// (round half up), saturated to OW bits; ovf_o is sticky and set when a valid element
-// saturated (the FFT's growth plan makes that impossible; the flag is there anyway).
-// Latency: 4 ce-steps (ROM/data register, products, sums, rounded output).
+// Arithmetic: four DW x TW_W products (one DSP48E each, DW <= 25), each truncated
+// (floor, arithmetic shift) by T = SH - GUARD bits, then
+//   re = (p_ac>>>T - p_bs>>>T + 2^(GUARD-1)) >>> GUARD   (round half up)
+//   im = (p_as>>>T + p_bc>>>T + 2^(GUARD-1)) >>> GUARD
+// i.e. the exact round-half-up of (a c - b s) / 2^SH up to +-2^-GUARD output LSB from the
+// truncation (the two floors' biases cancel).  The result keeps its low OW bits; if the
+// value did not fit, ovf_o (sticky) is set: the FFT's growth plan makes that impossible,
+// so no saturation logic is spent on it, but it is never silent.
+// Latency: 4 ce-steps (ROM/data register, products, difference/sum, rounded output).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -21,6 +25,7 @@ module fmt_fft_twiddle #(
     parameter OW     = 19,           // output width (signed)
     parameter TW_W   = 18,           // twiddle width (signed), scale 2^(TW_W-2)
     parameter SH     = 13,           // right shift after the products (>= 1)
+    parameter GUARD  = 3,            // product bits kept below the output LSB (>= 1)
     parameter TW_DIR = "rtl/"        // directory of the twiddle hex files (with trailing /)
 ) (
     input  wire              clk,
@@ -34,13 +39,16 @@ module fmt_fft_twiddle #(
     output reg  [LOG2_N-1:0] out_idx_o,    // its position
     output reg  signed [OW-1:0] out_re_o,  // rotated real part, OW bits
     output reg  signed [OW-1:0] out_im_o,  // rotated imaginary part
-    output reg               ovf_o         // sticky: a valid element saturated since reset
+    output reg               ovf_o         // sticky: a valid element did not fit OW bits
 );
 
     localparam M  = 1 << LOG2_M;
-    localparam PW = DW + TW_W;         // product width
-    localparam SW = PW + 1;            // sum width
-    localparam RW = SW - SH;           // width after the shift
+    localparam PW = DW + TW_W;                        // product width
+    localparam T  = (SH > GUARD) ? SH - GUARD : 0;    // product bits dropped (floor)
+    localparam G  = SH - T;                           // bits rounded off at the end
+    localparam QW = PW - T;                           // truncated product width
+    localparam SW = QW + 1;                           // difference/sum width
+    localparam RW = SW - G;                           // width after rounding
 
     // file name "fmt_fft_twMMMM.hex" (M as four decimal digits, ASCII '0' = 48)
     localparam [31:0] DIG3 = 48 + (M / 1000) % 10;
@@ -55,60 +63,63 @@ module fmt_fft_twiddle #(
     // step 1: twiddle and data registers
     reg [2*TW_W-1:0]    tw_q;
     reg signed [DW-1:0] a_q, b_q;
-    // step 2: products
-    reg signed [PW-1:0] p_ac_q, p_bs_q, p_as_q, p_bc_q;
-    // step 3: rounded sums (the low SH bits only carry the rounding into the kept bits)
-    /* verilator lint_off UNUSEDSIGNAL */
+    // step 2: truncated products
+    reg signed [QW-1:0] p_ac_q, p_bs_q, p_as_q, p_bc_q;
+    // step 3: difference and sum
     reg signed [SW-1:0] s_re_q, s_im_q;
-    /* verilator lint_on UNUSEDSIGNAL */
     reg [LOG2_N-1:0]    idx1_q, idx2_q, idx3_q;
     reg                 v1_q, v2_q, v3_q;
 
     wire signed [TW_W-1:0] tw_c = tw_q[2*TW_W-1:TW_W];
     wire signed [TW_W-1:0] tw_s = tw_q[TW_W-1:0];
-    wire signed [SW-1:0]   half = {{(SW-1){1'b0}}, 1'b1} <<< (SH - 1);
+
+    // the low T bits of each product are dropped (floor)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire signed [PW-1:0] m_ac = a_q * tw_c;
+    wire signed [PW-1:0] m_bs = b_q * tw_s;
+    wire signed [PW-1:0] m_as = a_q * tw_s;
+    wire signed [PW-1:0] m_bc = b_q * tw_c;
+    /* verilator lint_on UNUSEDSIGNAL */
 
     always @(posedge clk) begin
         if (ce) begin
             tw_q   <= rom[in_idx_i[LOG2_M-1:0]];
             a_q    <= in_re_i;
             b_q    <= in_im_i;
-            p_ac_q <= a_q * tw_c;
-            p_bs_q <= b_q * tw_s;
-            p_as_q <= a_q * tw_s;
-            p_bc_q <= b_q * tw_c;
-            s_re_q <= p_ac_q - p_bs_q + half;
-            s_im_q <= p_as_q + p_bc_q + half;
+            p_ac_q <= m_ac[PW-1:T];
+            p_bs_q <= m_bs[PW-1:T];
+            p_as_q <= m_as[PW-1:T];
+            p_bc_q <= m_bc[PW-1:T];
+            s_re_q <= {p_ac_q[QW-1], p_ac_q} - {p_bs_q[QW-1], p_bs_q};
+            s_im_q <= {p_as_q[QW-1], p_as_q} + {p_bc_q[QW-1], p_bc_q};
         end
     end
 
-    // step 4: shift and saturate
-    wire signed [RW-1:0] r_re = s_re_q[SW-1:SH];
-    wire signed [RW-1:0] r_im = s_im_q[SW-1:SH];
-    wire signed [OW-1:0] q_re, q_im;
-    wire                 sat_re, sat_im;
+    // step 4: round half up ((s + 2^(G-1)) >>> G), keep OW bits, flag if it did not fit
+    wire signed [SW-1:0] half = {{(SW-1){1'b0}}, 1'b1} <<< (G - 1);
+    // the low G bits only carry the rounding
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire signed [SW-1:0] rs_re = s_re_q + half;
+    wire signed [SW-1:0] rs_im = s_im_q + half;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire signed [RW-1:0] r_re = rs_re[SW-1:G];
+    wire signed [RW-1:0] r_im = rs_im[SW-1:G];
+    wire                 big;
 
     generate
-        if (RW > OW) begin : g_sat
+        if (RW > OW) begin : g_chk
             // fits when the bits above OW-1 all equal the sign bit
-            wire hi_re_ok = (r_re[RW-1:OW-1] == {(RW-OW+1){r_re[RW-1]}});
-            wire hi_im_ok = (r_im[RW-1:OW-1] == {(RW-OW+1){r_im[RW-1]}});
-            assign sat_re = ~hi_re_ok;
-            assign sat_im = ~hi_im_ok;
-            assign q_re = hi_re_ok ? r_re[OW-1:0] : {r_re[RW-1], {(OW-1){~r_re[RW-1]}}};
-            assign q_im = hi_im_ok ? r_im[OW-1:0] : {r_im[RW-1], {(OW-1){~r_im[RW-1]}}};
-        end else begin : g_nosat
-            assign sat_re = 1'b0;
-            assign sat_im = 1'b0;
-            assign q_re = {{(OW-RW){r_re[RW-1]}}, r_re};
-            assign q_im = {{(OW-RW){r_im[RW-1]}}, r_im};
+            assign big = (r_re[RW-1:OW-1] != {(RW-OW+1){r_re[RW-1]}})
+                       | (r_im[RW-1:OW-1] != {(RW-OW+1){r_im[RW-1]}});
+        end else begin : g_nochk
+            assign big = 1'b0;
         end
     endgenerate
 
     always @(posedge clk) begin
         if (ce) begin
-            out_re_o <= q_re;
-            out_im_o <= q_im;
+            out_re_o <= r_re[OW-1:0];
+            out_im_o <= r_im[OW-1:0];
         end
     end
 
@@ -121,7 +132,7 @@ module fmt_fft_twiddle #(
         end else if (ce) begin
             v1_q <= in_valid_i;  v2_q <= v1_q;  v3_q <= v2_q;  out_valid_o <= v3_q;
             idx1_q <= in_idx_i;  idx2_q <= idx1_q;  idx3_q <= idx2_q;  out_idx_o <= idx3_q;
-            if (v3_q && (sat_re || sat_im))
+            if (v3_q && big)
                 ovf_o <= 1'b1;
         end
     end

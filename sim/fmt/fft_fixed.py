@@ -21,10 +21,13 @@ Fixed point (every butterfly grows one bit, so butterflies are exact):
     first twiddle multiplier).
   * twiddles: TW_W-bit signed, scale 2^(TW_W - 2) (so +1 and -1 are exact), each
     component round(v * 2^(TW_W-2)) with ties away from zero (never a tie in practice).
-  * twiddle multiplier: four exact products, re = a c - b s, im = a s + b c, then
-    round half up: (v + 2^(k-1)) >> k.  The FIRST twiddle multiplier keeps FRAC_W more
-    fractional bits (k = TW_W - 2 - FRAC_W) and one guard bit; later ones keep the
-    width (k = TW_W - 2).  The result is saturated to its width (sticky flag).
+  * twiddle multiplier: four products, each truncated (floor) by t = k - GUARD bits,
+    re = a c - b s, im = a s + b c from the truncated products, then round half up:
+    (v + 2^(GUARD-1)) >> GUARD; overall the round-half-up of the exact value / 2^k up to
+    +-2^-GUARD LSB.  The FIRST twiddle multiplier keeps FRAC_W more fractional bits
+    (k = TW_W - 2 - FRAC_W) and one guard bit; later ones keep the width (k = TW_W - 2).
+    The result keeps its low bits (no saturation logic: it cannot overflow) and the
+    sticky flag records any element that did not fit.
   * The output is the last stage's full-width value, X * 2^FRAC_W when the last
     twiddle stage had FRAC_W fraction bits, optionally rounded (half up) to OUT_W bits
     and saturated.  SHIFT = full_width - OUT_W - FRAC_W, out = X * 2^-SHIFT.
@@ -46,6 +49,7 @@ import numpy as np
 
 TW_W = 18          # default twiddle width (DSP48E 18-bit port)
 FRAC_W = 3         # default extra fractional bits kept from the first twiddle on
+GUARD = 3          # product bits kept below the twiddle output's LSB (fmt_fft_twiddle GUARD)
 RTL = Path(__file__).resolve().parents[2] / "rtl"
 
 # Register stages of the RTL (must match rtl/fmt_fft_r22sdf.v and its sub-modules).
@@ -186,20 +190,31 @@ def _sat(v: np.ndarray, w: int) -> tuple[np.ndarray, bool]:
     return np.clip(v, lo, hi), ovf
 
 
-def _twiddle_mul(re, im, c, s, k: int, w: int):
-    """Round-half-up ((a + jb)(c + js)) >> k, saturated to w bits."""
-    half = 1 << (k - 1) if k > 0 else 0
-    pr = re * c - im * s
-    pi = re * s + im * c
-    pr = (pr + half) >> k
-    pi = (pi + half) >> k
-    pr, o1 = _sat(pr, w)
-    pi, o2 = _sat(pi, w)
+def _wrap(v: np.ndarray, w: int) -> tuple[np.ndarray, bool]:
+    """Two's complement wrap to w bits, and whether anything did not fit."""
+    lo, hi = -(1 << (w - 1)), (1 << (w - 1)) - 1
+    ovf = bool(np.any(v < lo) or np.any(v > hi))
+    return ((v - lo) & ((1 << w) - 1)) + lo, ovf
+
+
+def _twiddle_mul(re, im, c, s, k: int, w: int, guard: int = GUARD):
+    """fmt_fft_twiddle: (a + jb)(c + js) / 2^k, round half up after truncating each
+    product by t = k - guard bits (floor); the low w bits are kept (ovf if it did not
+    fit: the RTL does not saturate there, the flag says so)."""
+    t = max(k - guard, 0)
+    g = k - t
+    pr = ((re * c) >> t) - ((im * s) >> t)
+    pi = ((re * s) >> t) + ((im * c) >> t)
+    if g > 0:
+        pr = (pr + (1 << (g - 1))) >> g
+        pi = (pi + (1 << (g - 1))) >> g
+    pr, o1 = _wrap(pr, w)
+    pi, o2 = _wrap(pi, w)
     return pr, pi, o1 or o2
 
 
 def fft_fixed_slots(x_re, x_im, log2_n: int, in_w: int, tw_w: int = TW_W,
-                    frac_w: int = FRAC_W, out_w: int | None = None):
+                    frac_w: int = FRAC_W, out_w: int | None = None, guard: int = GUARD):
     """As :func:`fft_fixed` but in output-slot (bit-reversed) order."""
     n = 1 << log2_n
     xr = np.asarray(x_re, dtype=np.int64)
@@ -239,7 +254,7 @@ def fft_fixed_slots(x_re, x_im, log2_n: int, in_w: int, tw_w: int = TW_W,
                 wo = w + (1 + frac_w if first_tw else 0)
                 rr = xr.reshape(-1, n // m, m)
                 ii = xi.reshape(-1, n // m, m)
-                pr, pi, o = _twiddle_mul(rr, ii, c[None, None, :], sn[None, None, :], k, wo)
+                pr, pi, o = _twiddle_mul(rr, ii, c[None, None, :], sn[None, None, :], k, wo, guard)
                 xr, xi = pr.reshape(-1, n), pi.reshape(-1, n)
                 ovf = ovf or o
                 w = wo
@@ -257,14 +272,14 @@ def fft_fixed_slots(x_re, x_im, log2_n: int, in_w: int, tw_w: int = TW_W,
 
 
 def fft_fixed(x_re, x_im, log2_n: int, in_w: int, tw_w: int = TW_W, frac_w: int = FRAC_W,
-              out_w: int | None = None):
+              out_w: int | None = None, guard: int = GUARD):
     """Bit-exact fixed-point FFT of fmt_fft_r22sdf, natural bin order.
 
     x_re, x_im: integer arrays (..., N) of IN_W-bit values (windows along the leading
     axes).  Returns (X_re, X_im, ovf): int64 arrays (..., N) with X[k] * 2^-SHIFT (see
     :func:`out_shift`, SHIFT = -FRAC_W at the default full OUT_W) and the overflow flag.
     """
-    yr, yi, ovf = fft_fixed_slots(x_re, x_im, log2_n, in_w, tw_w, frac_w, out_w)
+    yr, yi, ovf = fft_fixed_slots(x_re, x_im, log2_n, in_w, tw_w, frac_w, out_w, guard)
     inv = np.empty(1 << log2_n, dtype=np.int64)
     inv[output_slot_order(log2_n)] = np.arange(1 << log2_n)
     return yr[..., inv], yi[..., inv], ovf
