@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0xF213.
+// Register map id 0x0B3E.
 `default_nettype none
 
 module fmt_regfile (
@@ -32,16 +32,18 @@ module fmt_regfile (
     output wire [8:0] tone_amp_wdata_o,             // TONE_AMP: write data
     output wire tone_amp_re_o,                      // TONE_AMP: read strobe
     input  wire [8:0] tone_amp_rdata_i,             // TONE_AMP: read data (valid while selected)
-    output reg  [15:0] touch_threshold_o,           // TOUCH_THRESHOLD (rw): Coarse-touch threshold on the flattened heat map (counts)
-    output reg  [1:0] touch_mode_o,                 // TOUCH_MODE (rw): Bit 0: 1 = Moore (3x3) fit, 0 = Von Neumann; bit 1: bias correction on
-    output reg  [7:0] contact_limit_o,              // CONTACT_LIMIT (rw): Maximum number of contacts reported per frame
-    output reg  [15:0] track_max_jump_o,            // TRACK_MAX_JUMP (rw): Tracking: largest distance from the prediction that keeps an ID, cells Q8
-    output reg  [15:0] track_hold_off_o,            // TRACK_HOLD_OFF (rw): Tracking: frames a missing contact keeps its ID (default 200
-    output reg  [15:0] track_vel_window_o,          // TRACK_VEL_WINDOW (rw): Tracking: velocity time base in frames (default 2000
-    output reg  [15:0] track_max_speed_o,           // TRACK_MAX_SPEED (rw): Tracking: predicted-velocity clamp, cells Q8
+    output reg  [15:0] touch_threshold_o,           // TOUCH_THRESHOLD (rw): Coarse-touch threshold on the flattened heat map (counts); fmt_touch threshold_i
+    output reg  [1:0] touch_mode_o,                 // TOUCH_MODE (rw): Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i)
+    output reg  [4:0] contact_limit_o,              // CONTACT_LIMIT (rw): Contact limit per frame, <= MAX_TOUCHES (limit_i)
+    output reg  [15:0] track_max_jump_o,            // TRACK_MAX_JUMP (rw): Tracker L1 gate of a contact seen last frame, cells Q8
+    output reg  [15:0] track_hold_jump_o,           // TRACK_HOLD_JUMP (rw): Tracker L1 gate of a contact in hold-off, cells Q8
+    output reg  [11:0] track_hold_off_o,            // TRACK_HOLD_OFF (rw): Frames a missing contact keeps its ID (default 200
+    output reg  [3:0] track_vel_shift_o,            // TRACK_VEL_SHIFT (rw): Velocity filter gain 2^-S (default from a 2000
+    output reg  [20:0] track_max_speed_o,           // TRACK_MAX_SPEED (rw): Velocity clamp per axis, 2^-(8+VF) cells per frame (default 3000
     output reg  [15:0] blob_threshold_o,            // BLOB_THRESHOLD (rw): Cells above this belong to a connected region (blob detection)
     output reg  [11:0] blob_min_cells_o,            // BLOB_MIN_CELLS (rw): A region of at least this many cells is reported as a blob
-    output reg  [10:0] cal_sel_o,                   // CAL_SEL (rw): Cell selector r * COLS + c of the calibration windows
+    output reg  [4:0] cal_row_o,                    // CAL_ROW (rw): Row of the calibration windows (cal_row_i)
+    output reg  [5:0] cal_col_o,                    // CAL_COL (rw): Column of the calibration windows (cal_col_i)
     output wire cal_offset_we_o,                    // CAL_OFFSET (window): write strobe
     output wire [15:0] cal_offset_wdata_o,          // CAL_OFFSET: write data
     output wire cal_offset_re_o,                    // CAL_OFFSET: read strobe
@@ -50,19 +52,33 @@ module fmt_regfile (
     output wire [15:0] cal_gain_wdata_o,            // CAL_GAIN: write data
     output wire cal_gain_re_o,                      // CAL_GAIN: read strobe
     input  wire [15:0] cal_gain_rdata_i,            // CAL_GAIN: read data (valid while selected)
-    output reg  [23:0] latency_dial_o,              // LATENCY_DIAL (rw): Dial-a-latency: extra delay of the event port in processing cycles
-    output reg  [15:0] report_div_o,                // REPORT_DIV (rw): Event stream to the UART: one frame of events every REPORT_DIV frames (default: at most 250 Hz)
+    output reg  [31:0] latency_dial_o,              // LATENCY_DIAL (rw): Dial-a-latency: extra event delay in processing cycles (delay_i)
+    output reg  [31:0] report_period_o,             // REPORT_PERIOD (rw): Minimum processing cycles between reported frames (report_period_i; 0 = every frame; default 250 Hz)
     input  wire [31:0] frame_count_i,               // FRAME_COUNT (ro): Frames processed since reset
     input  wire [7:0] status_set_i,                 // STATUS: bits to set
-    output reg  [7:0] status_o,                     // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 heat-map saturation, bit 1 accumulator/FFT overflow, bit 2 event FIFO overflow, bit 3 latency counter saturation, bit 4 control-port error
-    input  wire [15:0] ctrl_errors_i,               // CTRL_ERRORS (ro): Control-port error count (every ERROR reply and junk burst)
-    input  wire [7:0] ctrl_last_err_i,              // CTRL_LAST_ERR (ro): Control-port code of the last error (see PROTOCOL
-    input  wire [31:0] drop_count_i,                // DROP_COUNT (ro): Events dropped (event port not ready)
-    input  wire [15:0] lat_last_i,                  // LAT_LAST (ro): Latency of the last frame, processing cycles (frame end -> last event)
-    input  wire [15:0] lat_min_i,                   // LAT_MIN (ro): Minimum latency since clear
-    input  wire [15:0] lat_max_i,                   // LAT_MAX (ro): Maximum latency since clear
-    input  wire [31:0] lat_count_i,                 // LAT_COUNT (ro): Frames measured since clear
-    output wire lat_clear_we_o,                     // LAT_CLEAR (strobe): Write 1: clear the latency statistics and histogram
+    output reg  [7:0] status_o,                     // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun
+    input  wire [15:0] ctrl_errors_i,               // CTRL_ERRORS (ro): Control-port error count, saturating (every ERROR reply and junk burst)
+    input  wire [7:0] ctrl_last_err_i,              // CTRL_LAST_ERR (ro): Control-port code of the last error (docs/PROTOCOL
+    input  wire [15:0] ev_drop_count_i,             // EV_DROP_COUNT (ro): Event port: frames dropped for lack of room
+    input  wire [15:0] ev_skip_count_i,             // EV_SKIP_COUNT (ro): Event port: frames skipped by REPORT_PERIOD
+    input  wire [15:0] flat_sat_count_i,            // FLAT_SAT_COUNT (ro): Flattening: saturated cells
+    input  wire [15:0] lm_drop_count_i,             // LM_DROP_COUNT (ro): Localmax: candidates dropped by the contact limit
+    output wire sat_clear_we_o,                     // SAT_CLEAR (strobe): Write 1: clear the flattening saturation monitor (sat_clr_i)
+    output wire sat_clear_wdata_o,                  // SAT_CLEAR: write data
+    input  wire [15:0] lat_first_last_i,            // LAT_FIRST_LAST (ro): Latency, window end -> first event of the frame, last value (cycles)
+    input  wire [15:0] lat_first_min_i,             // LAT_FIRST_MIN (ro): Latency to the first event, minimum since clear
+    input  wire [15:0] lat_first_max_i,             // LAT_FIRST_MAX (ro): Latency to the first event, maximum since clear
+    input  wire [31:0] lat_first_count_i,           // LAT_FIRST_COUNT (ro): Frames measured (first event)
+    input  wire [15:0] lat_last_last_i,             // LAT_LAST_LAST (ro): Latency, window end -> last event of the frame, last value (cycles)
+    input  wire [15:0] lat_last_min_i,              // LAT_LAST_MIN (ro): Latency to the last event, minimum since clear
+    input  wire [15:0] lat_last_max_i,              // LAT_LAST_MAX (ro): Latency to the last event, maximum since clear
+    input  wire [31:0] lat_last_count_i,            // LAT_LAST_COUNT (ro): Frames measured (last event)
+    input  wire [15:0] lat_trig_last_i,             // LAT_TRIG_LAST (ro): Touch-to-data latency, trigger input -> next new contact, last (cycles)
+    input  wire [15:0] lat_trig_min_i,              // LAT_TRIG_MIN (ro): Touch-to-data latency, minimum since clear
+    input  wire [15:0] lat_trig_max_i,              // LAT_TRIG_MAX (ro): Touch-to-data latency, maximum since clear
+    input  wire [31:0] lat_trig_count_i,            // LAT_TRIG_COUNT (ro): Triggers measured
+    input  wire lat_trig_armed_i,                   // LAT_TRIG_ARMED (ro): A trigger is waiting for its new-contact event
+    output wire lat_clear_we_o,                     // LAT_CLEAR (strobe): Write 1: clear the latency statistics and histograms (clear_i)
     output wire lat_clear_wdata_o,                  // LAT_CLEAR: write data
     output reg  [31:0] reg_rdata_o                  // read data, the cycle after reg_re_i
 );
@@ -82,26 +98,41 @@ module fmt_regfile (
     localparam [15:0] A_TOUCH_MODE = 16'h0021;
     localparam [15:0] A_CONTACT_LIMIT = 16'h0022;
     localparam [15:0] A_TRACK_MAX_JUMP = 16'h0023;
-    localparam [15:0] A_TRACK_HOLD_OFF = 16'h0024;
-    localparam [15:0] A_TRACK_VEL_WINDOW = 16'h0025;
-    localparam [15:0] A_TRACK_MAX_SPEED = 16'h0026;
-    localparam [15:0] A_BLOB_THRESHOLD = 16'h0027;
-    localparam [15:0] A_BLOB_MIN_CELLS = 16'h0028;
-    localparam [15:0] A_CAL_SEL = 16'h0030;
-    localparam [15:0] A_CAL_OFFSET = 16'h0031;
-    localparam [15:0] A_CAL_GAIN = 16'h0032;
+    localparam [15:0] A_TRACK_HOLD_JUMP = 16'h0024;
+    localparam [15:0] A_TRACK_HOLD_OFF = 16'h0025;
+    localparam [15:0] A_TRACK_VEL_SHIFT = 16'h0026;
+    localparam [15:0] A_TRACK_MAX_SPEED = 16'h0027;
+    localparam [15:0] A_BLOB_THRESHOLD = 16'h0028;
+    localparam [15:0] A_BLOB_MIN_CELLS = 16'h0029;
+    localparam [15:0] A_CAL_ROW = 16'h0030;
+    localparam [15:0] A_CAL_COL = 16'h0031;
+    localparam [15:0] A_CAL_OFFSET = 16'h0032;
+    localparam [15:0] A_CAL_GAIN = 16'h0033;
     localparam [15:0] A_LATENCY_DIAL = 16'h0040;
-    localparam [15:0] A_REPORT_DIV = 16'h0041;
+    localparam [15:0] A_REPORT_PERIOD = 16'h0041;
     localparam [15:0] A_FRAME_COUNT = 16'h0080;
     localparam [15:0] A_STATUS = 16'h0081;
     localparam [15:0] A_CTRL_ERRORS = 16'h0082;
     localparam [15:0] A_CTRL_LAST_ERR = 16'h0083;
-    localparam [15:0] A_DROP_COUNT = 16'h0084;
-    localparam [15:0] A_LAT_LAST = 16'h0090;
-    localparam [15:0] A_LAT_MIN = 16'h0091;
-    localparam [15:0] A_LAT_MAX = 16'h0092;
-    localparam [15:0] A_LAT_COUNT = 16'h0093;
-    localparam [15:0] A_LAT_CLEAR = 16'h0094;
+    localparam [15:0] A_EV_DROP_COUNT = 16'h0084;
+    localparam [15:0] A_EV_SKIP_COUNT = 16'h0085;
+    localparam [15:0] A_FLAT_SAT_COUNT = 16'h0086;
+    localparam [15:0] A_LM_DROP_COUNT = 16'h0087;
+    localparam [15:0] A_SAT_CLEAR = 16'h0088;
+    localparam [15:0] A_LAT_FIRST_LAST = 16'h0090;
+    localparam [15:0] A_LAT_FIRST_MIN = 16'h0091;
+    localparam [15:0] A_LAT_FIRST_MAX = 16'h0092;
+    localparam [15:0] A_LAT_FIRST_COUNT = 16'h0093;
+    localparam [15:0] A_LAT_LAST_LAST = 16'h0094;
+    localparam [15:0] A_LAT_LAST_MIN = 16'h0095;
+    localparam [15:0] A_LAT_LAST_MAX = 16'h0096;
+    localparam [15:0] A_LAT_LAST_COUNT = 16'h0097;
+    localparam [15:0] A_LAT_TRIG_LAST = 16'h0098;
+    localparam [15:0] A_LAT_TRIG_MIN = 16'h0099;
+    localparam [15:0] A_LAT_TRIG_MAX = 16'h009A;
+    localparam [15:0] A_LAT_TRIG_COUNT = 16'h009B;
+    localparam [15:0] A_LAT_TRIG_ARMED = 16'h009C;
+    localparam [15:0] A_LAT_CLEAR = 16'h009F;
 
     // write decode
     wire wr_scratch = reg_we_i && (reg_addr_i == A_SCRATCH);
@@ -117,17 +148,20 @@ module fmt_regfile (
     wire wr_touch_mode = reg_we_i && (reg_addr_i == A_TOUCH_MODE);
     wire wr_contact_limit = reg_we_i && (reg_addr_i == A_CONTACT_LIMIT);
     wire wr_track_max_jump = reg_we_i && (reg_addr_i == A_TRACK_MAX_JUMP);
+    wire wr_track_hold_jump = reg_we_i && (reg_addr_i == A_TRACK_HOLD_JUMP);
     wire wr_track_hold_off = reg_we_i && (reg_addr_i == A_TRACK_HOLD_OFF);
-    wire wr_track_vel_window = reg_we_i && (reg_addr_i == A_TRACK_VEL_WINDOW);
+    wire wr_track_vel_shift = reg_we_i && (reg_addr_i == A_TRACK_VEL_SHIFT);
     wire wr_track_max_speed = reg_we_i && (reg_addr_i == A_TRACK_MAX_SPEED);
     wire wr_blob_threshold = reg_we_i && (reg_addr_i == A_BLOB_THRESHOLD);
     wire wr_blob_min_cells = reg_we_i && (reg_addr_i == A_BLOB_MIN_CELLS);
-    wire wr_cal_sel = reg_we_i && (reg_addr_i == A_CAL_SEL);
+    wire wr_cal_row = reg_we_i && (reg_addr_i == A_CAL_ROW);
+    wire wr_cal_col = reg_we_i && (reg_addr_i == A_CAL_COL);
     wire wr_cal_offset = reg_we_i && (reg_addr_i == A_CAL_OFFSET);
     wire wr_cal_gain = reg_we_i && (reg_addr_i == A_CAL_GAIN);
     wire wr_latency_dial = reg_we_i && (reg_addr_i == A_LATENCY_DIAL);
-    wire wr_report_div = reg_we_i && (reg_addr_i == A_REPORT_DIV);
+    wire wr_report_period = reg_we_i && (reg_addr_i == A_REPORT_PERIOD);
     wire wr_status = reg_we_i && (reg_addr_i == A_STATUS);
+    wire wr_sat_clear = reg_we_i && (reg_addr_i == A_SAT_CLEAR);
     wire wr_lat_clear = reg_we_i && (reg_addr_i == A_LAT_CLEAR);
     assign tone_tw_we_o    = wr_tone_tw;
     assign tone_tw_wdata_o = reg_wdata_i[31:0];
@@ -141,6 +175,8 @@ module fmt_regfile (
     assign cal_gain_we_o    = wr_cal_gain;
     assign cal_gain_wdata_o = reg_wdata_i[15:0];
     assign cal_gain_re_o    = reg_re_i && (reg_addr_i == A_CAL_GAIN);
+    assign sat_clear_we_o    = wr_sat_clear;
+    assign sat_clear_wdata_o = reg_wdata_i[0:0];
     assign lat_clear_we_o    = wr_lat_clear;
     assign lat_clear_wdata_o = reg_wdata_i[0:0];
 
@@ -155,16 +191,18 @@ module fmt_regfile (
             tone_sel_o <= 5'h00;
             touch_threshold_o <= 16'h07D0;
             touch_mode_o <= 2'h3;
-            contact_limit_o <= 8'h10;
+            contact_limit_o <= 5'h10;
             track_max_jump_o <= 16'h0300;
-            track_hold_off_o <= 16'h0021;
-            track_vel_window_o <= 16'h0146;
-            track_max_speed_o <= 16'h0001;
+            track_hold_jump_o <= 16'h00C0;
+            track_hold_off_o <= 12'h021;
+            track_vel_shift_o <= 4'h8;
+            track_max_speed_o <= 21'h000F19;
             blob_threshold_o <= 16'h03E8;
             blob_min_cells_o <= 12'h00C;
-            cal_sel_o <= 11'h000;
-            latency_dial_o <= 24'h000000;
-            report_div_o <= 16'h028C;
+            cal_row_o <= 5'h00;
+            cal_col_o <= 6'h00;
+            latency_dial_o <= 32'h00000000;
+            report_period_o <= 32'h0007A120;
             status_o <= 8'h00;
         end else begin
             if (wr_scratch) scratch_o <= reg_wdata_i[31:0];
@@ -176,16 +214,18 @@ module fmt_regfile (
             if (wr_tone_sel) tone_sel_o <= reg_wdata_i[4:0];
             if (wr_touch_threshold) touch_threshold_o <= reg_wdata_i[15:0];
             if (wr_touch_mode) touch_mode_o <= reg_wdata_i[1:0];
-            if (wr_contact_limit) contact_limit_o <= reg_wdata_i[7:0];
+            if (wr_contact_limit) contact_limit_o <= reg_wdata_i[4:0];
             if (wr_track_max_jump) track_max_jump_o <= reg_wdata_i[15:0];
-            if (wr_track_hold_off) track_hold_off_o <= reg_wdata_i[15:0];
-            if (wr_track_vel_window) track_vel_window_o <= reg_wdata_i[15:0];
-            if (wr_track_max_speed) track_max_speed_o <= reg_wdata_i[15:0];
+            if (wr_track_hold_jump) track_hold_jump_o <= reg_wdata_i[15:0];
+            if (wr_track_hold_off) track_hold_off_o <= reg_wdata_i[11:0];
+            if (wr_track_vel_shift) track_vel_shift_o <= reg_wdata_i[3:0];
+            if (wr_track_max_speed) track_max_speed_o <= reg_wdata_i[20:0];
             if (wr_blob_threshold) blob_threshold_o <= reg_wdata_i[15:0];
             if (wr_blob_min_cells) blob_min_cells_o <= reg_wdata_i[11:0];
-            if (wr_cal_sel) cal_sel_o <= reg_wdata_i[10:0];
-            if (wr_latency_dial) latency_dial_o <= reg_wdata_i[23:0];
-            if (wr_report_div) report_div_o <= reg_wdata_i[15:0];
+            if (wr_cal_row) cal_row_o <= reg_wdata_i[4:0];
+            if (wr_cal_col) cal_col_o <= reg_wdata_i[5:0];
+            if (wr_latency_dial) latency_dial_o <= reg_wdata_i[31:0];
+            if (wr_report_period) report_period_o <= reg_wdata_i[31:0];
             status_o <= (status_o & ~(wr_status ? reg_wdata_i[7:0] : 8'h00)) | status_set_i;
         end
     end
@@ -209,27 +249,42 @@ module fmt_regfile (
                 A_TONE_AMP: reg_rdata_o <= {23'h0, tone_amp_rdata_i};
                 A_TOUCH_THRESHOLD: reg_rdata_o <= {16'h0, touch_threshold_o};
                 A_TOUCH_MODE: reg_rdata_o <= {30'h0, touch_mode_o};
-                A_CONTACT_LIMIT: reg_rdata_o <= {24'h0, contact_limit_o};
+                A_CONTACT_LIMIT: reg_rdata_o <= {27'h0, contact_limit_o};
                 A_TRACK_MAX_JUMP: reg_rdata_o <= {16'h0, track_max_jump_o};
-                A_TRACK_HOLD_OFF: reg_rdata_o <= {16'h0, track_hold_off_o};
-                A_TRACK_VEL_WINDOW: reg_rdata_o <= {16'h0, track_vel_window_o};
-                A_TRACK_MAX_SPEED: reg_rdata_o <= {16'h0, track_max_speed_o};
+                A_TRACK_HOLD_JUMP: reg_rdata_o <= {16'h0, track_hold_jump_o};
+                A_TRACK_HOLD_OFF: reg_rdata_o <= {20'h0, track_hold_off_o};
+                A_TRACK_VEL_SHIFT: reg_rdata_o <= {28'h0, track_vel_shift_o};
+                A_TRACK_MAX_SPEED: reg_rdata_o <= {11'h0, track_max_speed_o};
                 A_BLOB_THRESHOLD: reg_rdata_o <= {16'h0, blob_threshold_o};
                 A_BLOB_MIN_CELLS: reg_rdata_o <= {20'h0, blob_min_cells_o};
-                A_CAL_SEL: reg_rdata_o <= {21'h0, cal_sel_o};
+                A_CAL_ROW: reg_rdata_o <= {27'h0, cal_row_o};
+                A_CAL_COL: reg_rdata_o <= {26'h0, cal_col_o};
                 A_CAL_OFFSET: reg_rdata_o <= {16'h0, cal_offset_rdata_i};
                 A_CAL_GAIN: reg_rdata_o <= {16'h0, cal_gain_rdata_i};
-                A_LATENCY_DIAL: reg_rdata_o <= {8'h0, latency_dial_o};
-                A_REPORT_DIV: reg_rdata_o <= {16'h0, report_div_o};
+                A_LATENCY_DIAL: reg_rdata_o <= latency_dial_o;
+                A_REPORT_PERIOD: reg_rdata_o <= report_period_o;
                 A_FRAME_COUNT: reg_rdata_o <= frame_count_i;
                 A_STATUS: reg_rdata_o <= {24'h0, status_o};
                 A_CTRL_ERRORS: reg_rdata_o <= {16'h0, ctrl_errors_i};
                 A_CTRL_LAST_ERR: reg_rdata_o <= {24'h0, ctrl_last_err_i};
-                A_DROP_COUNT: reg_rdata_o <= drop_count_i;
-                A_LAT_LAST: reg_rdata_o <= {16'h0, lat_last_i};
-                A_LAT_MIN: reg_rdata_o <= {16'h0, lat_min_i};
-                A_LAT_MAX: reg_rdata_o <= {16'h0, lat_max_i};
-                A_LAT_COUNT: reg_rdata_o <= lat_count_i;
+                A_EV_DROP_COUNT: reg_rdata_o <= {16'h0, ev_drop_count_i};
+                A_EV_SKIP_COUNT: reg_rdata_o <= {16'h0, ev_skip_count_i};
+                A_FLAT_SAT_COUNT: reg_rdata_o <= {16'h0, flat_sat_count_i};
+                A_LM_DROP_COUNT: reg_rdata_o <= {16'h0, lm_drop_count_i};
+                A_SAT_CLEAR: reg_rdata_o <= 32'h0;
+                A_LAT_FIRST_LAST: reg_rdata_o <= {16'h0, lat_first_last_i};
+                A_LAT_FIRST_MIN: reg_rdata_o <= {16'h0, lat_first_min_i};
+                A_LAT_FIRST_MAX: reg_rdata_o <= {16'h0, lat_first_max_i};
+                A_LAT_FIRST_COUNT: reg_rdata_o <= lat_first_count_i;
+                A_LAT_LAST_LAST: reg_rdata_o <= {16'h0, lat_last_last_i};
+                A_LAT_LAST_MIN: reg_rdata_o <= {16'h0, lat_last_min_i};
+                A_LAT_LAST_MAX: reg_rdata_o <= {16'h0, lat_last_max_i};
+                A_LAT_LAST_COUNT: reg_rdata_o <= lat_last_count_i;
+                A_LAT_TRIG_LAST: reg_rdata_o <= {16'h0, lat_trig_last_i};
+                A_LAT_TRIG_MIN: reg_rdata_o <= {16'h0, lat_trig_min_i};
+                A_LAT_TRIG_MAX: reg_rdata_o <= {16'h0, lat_trig_max_i};
+                A_LAT_TRIG_COUNT: reg_rdata_o <= lat_trig_count_i;
+                A_LAT_TRIG_ARMED: reg_rdata_o <= {31'h0, lat_trig_armed_i};
                 A_LAT_CLEAR: reg_rdata_o <= 32'h0;
                 default: reg_rdata_o <= 32'h0;
             endcase

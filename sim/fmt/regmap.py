@@ -38,6 +38,7 @@ from pathlib import Path
 
 from . import params, protocol
 from .settings import TouchSettings
+from .tracking import TrackParams
 
 ROOT = Path(__file__).resolve().parents[2]
 REGFILE_PATH = ROOT / "rtl" / "fmt_regfile.v"
@@ -47,10 +48,17 @@ CFG = params.DEFAULT
 SETTINGS = TouchSettings()
 WINDOWS_M = 1                               # windows per frame (brief: M = 1 by default)
 FRAME_PERIOD_S = WINDOWS_M * CFG.n_fft / CFG.fs_hz
+# Processing clock of the default build: 3 x fs = 125 MHz (docs/ARCHITECTURE.md,
+# "Clocking"; params.py has no CLK_PER_SAMPLE yet).
+CLK_PER_SAMPLE = 3
+PROC_CLK_HZ = CLK_PER_SAMPLE * CFG.fs_hz
 HOST_REPORT_HZ = 250                        # brief: Windows hosts accept at most 250 Hz
-_TRACK = SETTINGS.converted(CFG, FRAME_PERIOD_S)
-_CAL_SEL_W = max(1, math.ceil(math.log2(CFG.rows * CFG.cols)))
-_ROW_SEL_W = max(1, math.ceil(math.log2(CFG.rows)))
+_TRACK = TrackParams.from_settings(CFG, SETTINGS, FRAME_PERIOD_S)
+_ROW_W = max(1, math.ceil(math.log2(CFG.rows)))          # fmt_touch ROW_IDX_W
+_COL_W = max(1, math.ceil(math.log2(CFG.cols)))          # fmt_touch COL_IDX_W
+_LIM_W = math.ceil(math.log2(CFG.max_touches + 1))       # fmt_touch LIM_W
+_HOLD_W = 12                                             # fmt_touch HOLD_W
+_V_W = _TRACK.v_w                                        # fmt_touch V_W (max_speed is V_W-1 bits)
 
 ACCESS = ("const", "rw", "ro", "w1c", "window", "strobe")
 
@@ -89,55 +97,73 @@ REGISTERS: list[Reg] = [
     R("PN_CHIP_LEN", 0x012, 10, "rw", 1, "Samples per PN chip (fmt_pn_gen chip_len_i; 0 is taken as 1)."),
     R("PN_RX_DELAY", 0x013, 6, "rw", 0, "Receive PN delay in samples (fmt_pn_gen rx_delay_i)."),
     R("WINDOWS_M", 0x014, 8, "rw", WINDOWS_M, "FFT windows accumulated per frame (M >= 1)."),
-    R("TONE_SEL", 0x018, _ROW_SEL_W, "rw", 0, "Row selector of the tone-plan windows TONE_TW and TONE_AMP."),
+    R("TONE_SEL", 0x018, _ROW_W, "rw", 0, "Row selector of the tone-plan windows TONE_TW and TONE_AMP."),
     R("TONE_TW", 0x019, CFG.phase_bits, "window", 0,
       "Tuning word of row TONE_SEL (DDS phase increment; default bin k -> k << (PHASE_BITS - LOG2_N))."),
     R("TONE_AMP", 0x01A, CFG.amp_bits + 1, "window", 0,
       f"Row TONE_SEL: bits {CFG.amp_bits - 1}..0 amplitude (full scale {(1 << CFG.amp_bits) - 1}), "
       f"bit {CFG.amp_bits} enable."),
-    # ---- touch processing -------------------------------------------------------------------
+    # ---- touch processing (fmt_touch run-time inputs) ---------------------------------------
     R("TOUCH_THRESHOLD", 0x020, CFG.hm_width, "rw", SETTINGS.threshold,
-      "Coarse-touch threshold on the flattened heat map (counts)."),
+      "Coarse-touch threshold on the flattened heat map (counts); fmt_touch threshold_i."),
     R("TOUCH_MODE", 0x021, 2, "rw",
       (1 if SETTINGS.neighbourhood == "moore" else 0) | (2 if SETTINGS.bias_correction else 0),
-      "Bit 0: 1 = Moore (3x3) fit, 0 = Von Neumann; bit 1: bias correction on."),
-    R("CONTACT_LIMIT", 0x022, 8, "rw",
+      "Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i)."),
+    R("CONTACT_LIMIT", 0x022, _LIM_W, "rw",
       SETTINGS.max_touches if SETTINGS.max_touches is not None else CFG.max_touches,
-      "Maximum number of contacts reported per frame."),
-    R("TRACK_MAX_JUMP", 0x023, 16, "rw", _TRACK["max_jump_q"],
-      f"Tracking: largest distance from the prediction that keeps an ID, cells Q8.8 "
-      f"(default {SETTINGS.max_jump_mm} mm)."),
-    R("TRACK_HOLD_OFF", 0x024, 16, "rw", _TRACK["hold_off_frames"],
-      f"Tracking: frames a missing contact keeps its ID (default {SETTINGS.hold_off_us} us)."),
-    R("TRACK_VEL_WINDOW", 0x025, 16, "rw", _TRACK["velocity_window_frames"],
-      f"Tracking: velocity time base in frames (default {SETTINGS.velocity_window_us} us)."),
-    R("TRACK_MAX_SPEED", 0x026, 16, "rw", _TRACK["max_speed_q_per_frame"],
-      f"Tracking: predicted-velocity clamp, cells Q8.8 per frame (default {SETTINGS.max_speed_mm_s} mm/s)."),
-    R("BLOB_THRESHOLD", 0x027, CFG.hm_width, "rw", SETTINGS.blob_threshold,
+      "Contact limit per frame, <= MAX_TOUCHES (limit_i)."),
+    R("TRACK_MAX_JUMP", 0x023, 16, "rw", _TRACK.max_jump_q,
+      f"Tracker L1 gate of a contact seen last frame, cells Q8.8 (default {SETTINGS.max_jump_mm} mm; max_jump_i)."),
+    R("TRACK_HOLD_JUMP", 0x024, 16, "rw", _TRACK.hold_jump_q,
+      "Tracker L1 gate of a contact in hold-off, cells Q8.8 (hold_jump_i)."),
+    R("TRACK_HOLD_OFF", 0x025, _HOLD_W, "rw", _TRACK.hold_off_frames,
+      f"Frames a missing contact keeps its ID (default {SETTINGS.hold_off_us} us; hold_off_i)."),
+    R("TRACK_VEL_SHIFT", 0x026, 4, "rw", _TRACK.vel_shift,
+      f"Velocity filter gain 2^-S (default from a {SETTINGS.velocity_window_us} us window; vel_shift_i)."),
+    R("TRACK_MAX_SPEED", 0x027, _V_W - 1, "rw", _TRACK.max_speed_v,
+      f"Velocity clamp per axis, 2^-(8+VF) cells per frame (default {SETTINGS.max_speed_mm_s} mm/s; max_speed_i)."),
+    R("BLOB_THRESHOLD", 0x028, CFG.hm_width, "rw", SETTINGS.blob_threshold,
       "Cells above this belong to a connected region (blob detection)."),
-    R("BLOB_MIN_CELLS", 0x028, 12, "rw", SETTINGS.blob_min_cells,
+    R("BLOB_MIN_CELLS", 0x029, 12, "rw", SETTINGS.blob_min_cells,
       "A region of at least this many cells is reported as a blob."),
-    R("CAL_SEL", 0x030, _CAL_SEL_W, "rw", 0, "Cell selector r * COLS + c of the calibration windows."),
-    R("CAL_OFFSET", 0x031, CFG.hm_width, "window", 0, "Field-flattening offset of cell CAL_SEL (counts)."),
-    R("CAL_GAIN", 0x032, 16, "window", 0, "Field-flattening gain of cell CAL_SEL, unsigned Q2.14 (1.0 = 16384, fmt.flatten)."),
-    # ---- outputs ----------------------------------------------------------------------------
-    R("LATENCY_DIAL", 0x040, 24, "rw", 0, "Dial-a-latency: extra delay of the event port in processing cycles."),
-    R("REPORT_DIV", 0x041, 16, "rw", math.ceil(1.0 / FRAME_PERIOD_S / HOST_REPORT_HZ),
-      f"Event stream to the UART: one frame of events every REPORT_DIV frames "
-      f"(default: at most {HOST_REPORT_HZ} Hz)."),
+    R("CAL_ROW", 0x030, _ROW_W, "rw", 0, "Row of the calibration windows (cal_row_i)."),
+    R("CAL_COL", 0x031, _COL_W, "rw", 0, "Column of the calibration windows (cal_col_i)."),
+    R("CAL_OFFSET", 0x032, CFG.hm_width, "window", 0,
+      "Field-flattening offset of cell (CAL_ROW, CAL_COL), counts (cal_sel_i = 0)."),
+    R("CAL_GAIN", 0x033, 16, "window", 0,
+      "Field-flattening gain of cell (CAL_ROW, CAL_COL), unsigned Q2.14, 1.0 = 16384 (cal_sel_i = 1)."),
+    # ---- event port -------------------------------------------------------------------------
+    R("LATENCY_DIAL", 0x040, 32, "rw", 0, "Dial-a-latency: extra event delay in processing cycles (delay_i)."),
+    R("REPORT_PERIOD", 0x041, 32, "rw", math.ceil(PROC_CLK_HZ / HOST_REPORT_HZ),
+      f"Minimum processing cycles between reported frames (report_period_i; 0 = every frame; "
+      f"default {HOST_REPORT_HZ} Hz)."),
     # ---- status -----------------------------------------------------------------------------
     R("FRAME_COUNT", 0x080, 32, "ro", 0, "Frames processed since reset."),
     R("STATUS", 0x081, 8, "w1c", 0,
-      "Sticky flags, write 1 to clear: bit 0 heat-map saturation, bit 1 accumulator/FFT overflow, "
-      "bit 2 event FIFO overflow, bit 3 latency counter saturation, bit 4 control-port error."),
-    R("CTRL_ERRORS", 0x082, 16, "ro", 0, "Control-port error count (every ERROR reply and junk burst)."),
-    R("CTRL_LAST_ERR", 0x083, 8, "ro", 0, "Control-port code of the last error (see PROTOCOL.md)."),
-    R("DROP_COUNT", 0x084, 32, "ro", 0, "Events dropped (event port not ready)."),
-    R("LAT_LAST", 0x090, 16, "ro", 0, "Latency of the last frame, processing cycles (frame end -> last event)."),
-    R("LAT_MIN", 0x091, 16, "ro", 0, "Minimum latency since clear."),
-    R("LAT_MAX", 0x092, 16, "ro", 0, "Maximum latency since clear."),
-    R("LAT_COUNT", 0x093, 32, "ro", 0, "Frames measured since clear."),
-    R("LAT_CLEAR", 0x094, 1, "strobe", 0, "Write 1: clear the latency statistics and histogram."),
+      "Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT "
+      "overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 "
+      "control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun."),
+    R("CTRL_ERRORS", 0x082, 16, "ro", 0, "Control-port error count, saturating (every ERROR reply and junk burst)."),
+    R("CTRL_LAST_ERR", 0x083, 8, "ro", 0, "Control-port code of the last error (docs/PROTOCOL.md)."),
+    R("EV_DROP_COUNT", 0x084, 16, "ro", 0, "Event port: frames dropped for lack of room."),
+    R("EV_SKIP_COUNT", 0x085, 16, "ro", 0, "Event port: frames skipped by REPORT_PERIOD."),
+    R("FLAT_SAT_COUNT", 0x086, 16, "ro", 0, "Flattening: saturated cells."),
+    R("LM_DROP_COUNT", 0x087, 16, "ro", 0, "Localmax: candidates dropped by the contact limit."),
+    R("SAT_CLEAR", 0x088, 1, "strobe", 0, "Write 1: clear the flattening saturation monitor (sat_clr_i)."),
+    R("LAT_FIRST_LAST", 0x090, 16, "ro", 0, "Latency, window end -> first event of the frame, last value (cycles)."),
+    R("LAT_FIRST_MIN", 0x091, 16, "ro", 0, "Latency to the first event, minimum since clear."),
+    R("LAT_FIRST_MAX", 0x092, 16, "ro", 0, "Latency to the first event, maximum since clear."),
+    R("LAT_FIRST_COUNT", 0x093, 32, "ro", 0, "Frames measured (first event)."),
+    R("LAT_LAST_LAST", 0x094, 16, "ro", 0, "Latency, window end -> last event of the frame, last value (cycles)."),
+    R("LAT_LAST_MIN", 0x095, 16, "ro", 0, "Latency to the last event, minimum since clear."),
+    R("LAT_LAST_MAX", 0x096, 16, "ro", 0, "Latency to the last event, maximum since clear."),
+    R("LAT_LAST_COUNT", 0x097, 32, "ro", 0, "Frames measured (last event)."),
+    R("LAT_TRIG_LAST", 0x098, 16, "ro", 0, "Touch-to-data latency, trigger input -> next new contact, last (cycles)."),
+    R("LAT_TRIG_MIN", 0x099, 16, "ro", 0, "Touch-to-data latency, minimum since clear."),
+    R("LAT_TRIG_MAX", 0x09A, 16, "ro", 0, "Touch-to-data latency, maximum since clear."),
+    R("LAT_TRIG_COUNT", 0x09B, 32, "ro", 0, "Triggers measured."),
+    R("LAT_TRIG_ARMED", 0x09C, 1, "ro", 0, "A trigger is waiting for its new-contact event."),
+    R("LAT_CLEAR", 0x09F, 1, "strobe", 0, "Write 1: clear the latency statistics and histograms (clear_i)."),
 ]
 
 WINDOWS: list[Window] = [
@@ -145,7 +171,8 @@ WINDOWS: list[Window] = [
            "Raw heat-map snapshot (before field flattening; what `fmtctl calibrate` needs): "
            "cell (r, c) at HEATMAP + r * COLS + c, unsigned, low HM_W bits."),
     Window("LAT_HIST", 0x8000, 32,
-           "Latency histograms (bin counts, 32 bits each), see fmt.latency."),
+           "Latency histograms, 32-bit bin counts: words 0..15 first event, 16..31 last event "
+           "(fmt_latency hist_sel_i = bit 4, hist_addr_i = bits 3..0)."),
 ]
 
 BY_NAME = {r.name: r for r in REGISTERS}

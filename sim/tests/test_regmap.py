@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from fmt import params, regmap
 from fmt.settings import TouchSettings
+from fmt.tracking import TrackParams
 
 
 def test_generated_files_fresh():
@@ -32,8 +33,11 @@ def test_resets_from_shared_defaults():
     conv = s.converted(cfg, regmap.FRAME_PERIOD_S)
     assert r["TRACK_MAX_JUMP"].reset == conv["max_jump_q"]
     assert r["TRACK_HOLD_OFF"].reset == conv["hold_off_frames"]
-    # report divider keeps the UART event rate at or below 250 Hz
-    assert 1.0 / regmap.FRAME_PERIOD_S / r["REPORT_DIV"].reset <= 250.0
+    tp = TrackParams.from_settings(cfg, s, regmap.FRAME_PERIOD_S)
+    assert (r["TRACK_HOLD_JUMP"].reset, r["TRACK_VEL_SHIFT"].reset, r["TRACK_MAX_SPEED"].reset) == \
+        (tp.hold_jump_q, tp.vel_shift, tp.max_speed_v)
+    # the report period keeps the event rate to the host at or below 250 Hz
+    assert regmap.PROC_CLK_HZ / r["REPORT_PERIOD"].reset <= 250.0
 
 
 def test_regfile_model():

@@ -40,9 +40,12 @@ module fmt_ctrl_tb_top #(
     output wire         stream_en_o,
     output wire         lat_clear_o
 );
-    localparam [31:0] DROP_PATTERN = 32'hD5D5_0001;
-    localparam [15:0] LAT_LAST_PATTERN = 16'd111, LAT_MIN_PATTERN = 16'd100, LAT_MAX_PATTERN = 16'd140;
-    localparam [31:0] LAT_COUNT_PATTERN = 32'd4242;
+    // fixed values of the core's status inputs (the test knows them)
+    localparam [15:0] EV_DROP = 16'd3, EV_SKIP = 16'd5, FLAT_SAT = 16'd7, LM_DROP = 16'd9;
+    localparam [15:0] LF_LAST = 16'd101, LF_MIN = 16'd100, LF_MAX = 16'd140;
+    localparam [15:0] LL_LAST = 16'd201, LL_MIN = 16'd200, LL_MAX = 16'd240;
+    localparam [15:0] LT_LAST = 16'd301, LT_MIN = 16'd300, LT_MAX = 16'd340;
+    localparam [31:0] LF_COUNT = 32'd4242, LL_COUNT = 32'd4243, LT_COUNT = 32'd7;
 
     wire        reg_we, reg_re, blk_req, err_pulse;
     wire [15:0] reg_addr, blk_addr, err_count;
@@ -92,16 +95,23 @@ module fmt_ctrl_tb_top #(
         .tone_amp_we_o(tone_amp_we), .tone_amp_wdata_o(tone_amp_wdata), .tone_amp_re_o(tone_amp_re),
         .tone_amp_rdata_i(tone_amp_mem[tone_sel]),
         .touch_threshold_o(), .touch_mode_o(), .contact_limit_o(), .track_max_jump_o(),
-        .track_hold_off_o(), .track_vel_window_o(), .track_max_speed_o(), .blob_threshold_o(),
-        .blob_min_cells_o(), .cal_sel_o(),
+        .track_hold_jump_o(), .track_hold_off_o(), .track_vel_shift_o(), .track_max_speed_o(),
+        .blob_threshold_o(), .blob_min_cells_o(), .cal_row_o(), .cal_col_o(),
         .cal_offset_we_o(), .cal_offset_wdata_o(), .cal_offset_re_o(), .cal_offset_rdata_i(16'h0),
         .cal_gain_we_o(), .cal_gain_wdata_o(), .cal_gain_re_o(), .cal_gain_rdata_i(16'h0),
-        .latency_dial_o(), .report_div_o(),
+        .latency_dial_o(), .report_period_o(),
         .frame_count_i(frame_count_i),
         .status_set_i(status_set_i | {3'b000, err_pulse, 4'b0000}), .status_o(),
-        .ctrl_errors_i(err_count), .ctrl_last_err_i(err_last), .drop_count_i(DROP_PATTERN),
-        .lat_last_i(LAT_LAST_PATTERN), .lat_min_i(LAT_MIN_PATTERN), .lat_max_i(LAT_MAX_PATTERN),
-        .lat_count_i(LAT_COUNT_PATTERN), .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o());
+        .ctrl_errors_i(err_count), .ctrl_last_err_i(err_last),
+        .ev_drop_count_i(EV_DROP), .ev_skip_count_i(EV_SKIP), .flat_sat_count_i(FLAT_SAT),
+        .lm_drop_count_i(LM_DROP), .sat_clear_we_o(), .sat_clear_wdata_o(),
+        .lat_first_last_i(LF_LAST), .lat_first_min_i(LF_MIN), .lat_first_max_i(LF_MAX),
+        .lat_first_count_i(LF_COUNT),
+        .lat_last_last_i(LL_LAST), .lat_last_min_i(LL_MIN), .lat_last_max_i(LL_MAX),
+        .lat_last_count_i(LL_COUNT),
+        .lat_trig_last_i(LT_LAST), .lat_trig_min_i(LT_MIN), .lat_trig_max_i(LT_MAX),
+        .lat_trig_count_i(LT_COUNT), .lat_trig_armed_i(1'b1),
+        .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o());
     /* verilator lint_on PINCONNECTEMPTY */
 
     wire unused_ok = &{1'b0, tone_tw_re, tone_amp_re};

@@ -29,8 +29,12 @@ from fmt import params, protocol as P, regmap
 from fmt_uart.uart_bfm import UartBfm
 
 HERE = Path(__file__).parent
-DROP_PATTERN = 0xD5D50001
-LAT_PATTERNS = {"LAT_LAST": 111, "LAT_MIN": 100, "LAT_MAX": 140, "LAT_COUNT": 4242}
+# the fixed status inputs of fmt_ctrl_tb_top.v
+FIXED_INPUTS = {"EV_DROP_COUNT": 3, "EV_SKIP_COUNT": 5, "FLAT_SAT_COUNT": 7, "LM_DROP_COUNT": 9,
+                "LAT_FIRST_LAST": 101, "LAT_FIRST_MIN": 100, "LAT_FIRST_MAX": 140, "LAT_FIRST_COUNT": 4242,
+                "LAT_LAST_LAST": 201, "LAT_LAST_MIN": 200, "LAT_LAST_MAX": 240, "LAT_LAST_COUNT": 4243,
+                "LAT_TRIG_LAST": 301, "LAT_TRIG_MIN": 300, "LAT_TRIG_MAX": 340, "LAT_TRIG_COUNT": 7,
+                "LAT_TRIG_ARMED": 1}
 
 
 class TB(ClockedTB):
@@ -73,9 +77,9 @@ class TB(ClockedTB):
         self._sync_status()
         sel = self.regs.val["TONE_SEL"]
         inputs = {"FRAME_COUNT": self.frame_count, "CTRL_ERRORS": self.model.err_count,
-                  "CTRL_LAST_ERR": self.model.err_last, "DROP_COUNT": DROP_PATTERN,
+                  "CTRL_LAST_ERR": self.model.err_last,
                   "TONE_TW": self.tone_tw.get(sel, 0), "TONE_AMP": self.tone_amp.get(sel, 0),
-                  **LAT_PATTERNS}
+                  **FIXED_INPUTS}
         return self.regs.read(addr, inputs)
 
     def write_reg(self, addr: int, data: int) -> None:
@@ -138,8 +142,8 @@ class TB(ClockedTB):
 
     async def snapshot(self):
         """Read every readable register range (model-checked)."""
-        for a, n in ((0x000, 3), (0x010, 9), (0x020, 9), (0x030, 3), (0x040, 2), (0x080, 5),
-                     (0x090, 5)):
+        for a, n in ((0x000, 3), (0x010, 9), (0x020, 10), (0x030, 4), (0x040, 2), (0x080, 9),
+                     (0x090, 16)):
             await self.read(a, n)
 
     async def start(self):
@@ -161,7 +165,8 @@ async def info_and_registers(dut):
     await tb.snapshot()                                 # reset values of the map
     await tb.write(R("SCRATCH"), [0xCAFEF00D])
     await tb.write(R("RUN"), [rng.getrandbits(32) for _ in range(5)])   # RUN..WINDOWS_M, masked
-    await tb.write(R("TOUCH_THRESHOLD"), [rng.getrandbits(32) for _ in range(9)])
+    await tb.write(R("TOUCH_THRESHOLD"), [rng.getrandbits(32) for _ in range(10)])
+    await tb.write(R("CAL_ROW"), [rng.getrandbits(32) for _ in range(2)])
     await tb.write(R("LATENCY_DIAL"), [rng.getrandbits(32) for _ in range(2)])
     await tb.snapshot()
     # w1c: set bits from the core side, clear some from the host

@@ -157,7 +157,8 @@ async def fmtctl_end_to_end(dut):
 
     rc, out, err = await tb.fmtctl("latency")
     assert rc == 0, err
-    assert re.search(r"max\s+140 cycles", out) and "frames measured 4242" in out, out
+    assert re.search(r"first event\s+last 101 min 100 max 140 count 4242", out), out
+    assert re.search(r"trigger -> new contact\s+last 301 min 300 max 340 count 7", out), out
 
     # errors reported by fmtctl itself: one line, non-zero
     for args in (("set", "FRAME_COUNT", "5"), ("get", "NO_SUCH_REG"), ("set", "PN_RX_DELAY", "64")):
