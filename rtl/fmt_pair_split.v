@@ -49,15 +49,24 @@ module fmt_pair_split #(
     localparam SPAN = ROWS * BIN_STEP;
 
     // ---- decode: is in_bin a comb bin (k) or a mirror (N-k), and of which row ----
+    localparam [31:0]          LO_I   = BIN_LO;
+    localparam [31:0]          N_I    = N;
+    localparam [31:0]          SPAN_I = SPAN;
+    localparam [31:0]          STEP_I = BIN_STEP;
+    localparam signed [DW-1:0] LO_S   = LO_I[DW-1:0];
+    localparam signed [DW-1:0] N_S    = N_I[DW-1:0];
+    localparam signed [DW-1:0] SPAN_S = SPAN_I[DW-1:0];
+    localparam signed [DW-1:0] STEP_S = STEP_I[DW-1:0];
+    localparam signed [DW-1:0] ZERO_S = 0;
     wire signed [DW-1:0] bin_s  = {2'b00, in_bin};
-    wire signed [DW-1:0] d_k    = bin_s - BIN_LO;                 // k - BIN_LO
-    wire signed [DW-1:0] d_m    = N - bin_s - BIN_LO;             // (N - bin) - BIN_LO
-    wire                 hit_k  = (d_k >= 0) && (d_k < SPAN) && ((d_k % BIN_STEP) == 0);
-    wire                 hit_m  = (d_m >= 0) && (d_m < SPAN) && ((d_m % BIN_STEP) == 0);
+    wire signed [DW-1:0] d_k    = bin_s - LO_S;                   // k - BIN_LO
+    wire signed [DW-1:0] d_m    = N_S - bin_s - LO_S;             // (N - bin) - BIN_LO
+    wire                 hit_k  = (d_k >= ZERO_S) && (d_k < SPAN_S) && ((d_k % STEP_S) == ZERO_S);
+    wire                 hit_m  = (d_m >= ZERO_S) && (d_m < SPAN_S) && ((d_m % STEP_S) == ZERO_S);
     // the quotients are < ROWS when they are used: only their low ROW_W bits matter
     /* verilator lint_off UNUSEDSIGNAL */
-    wire signed [DW-1:0] r_k    = d_k / BIN_STEP;
-    wire signed [DW-1:0] r_m    = d_m / BIN_STEP;
+    wire signed [DW-1:0] r_k    = d_k / STEP_S;
+    wire signed [DW-1:0] r_m    = d_m / STEP_S;
     /* verilator lint_on UNUSEDSIGNAL */
     wire [ROW_W-1:0]     row    = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
     wire                 hit    = in_valid && (hit_k || hit_m);

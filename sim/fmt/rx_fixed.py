@@ -6,7 +6,7 @@ Chain per column pair (columns 2p, 2p+1; COLS must be even):
   despread  x = adc * (+1/-1 from rx_sign)                   (ADC_BITS + 1 bits)
   FFT       Z = fft_fixed(x_a + j x_b) per window of N samples, Z = X * 2^-SHIFT, OUT_W bits
   split     2A[k] = Z[k] + conj(Z[N-k]),  2B[k] = (Z[k] - conj(Z[N-k])) / j   (exact, OUT_W+1)
-  magnitude CORDIC vectoring, ITER = 12, GUARD = 4, gain compensated, round half up
+  magnitude CORDIC vectoring, ITER = 12, GUARD = 3, gain compensated, round half up
   accum     sum over M = 2^m windows, cell = (sum + 2^(s-1)) >> s, s = m + HM_SHIFT,
             saturated to HM_W bits (sticky flag)
 With HM_SHIFT = 1 a cell is |A[k]| * 2^-SHIFT (FFT output LSBs), averaged over M.
@@ -25,8 +25,8 @@ import numpy as np
 from . import params as _params
 
 MAG_ITER = 12        # CORDIC iterations (fmt_magnitude ITER)
-MAG_GUARD = 4        # CORDIC guard bits (fmt_magnitude GUARD)
-MAG_GAIN_BITS = 16   # fractional bits of the gain-compensation constant
+MAG_GUARD = 3        # CORDIC guard bits (fmt_magnitude GUARD)
+MAG_GAIN_BITS = 20   # fractional bits of the gain-compensation constant
 M_LOG2_MAX = 3       # fmt_accum M_LOG2_MAX: M in 1, 2, 4, 8
 HM_SHIFT = 1         # fmt_accum HM_SHIFT: undo the factor 2 of the pair split
 
@@ -139,24 +139,24 @@ def despread_fixed(adc, rx_sign) -> np.ndarray:
     return adc * s[:, None]
 
 
-def _default_fft():
-    from . import fft_fixed as _f   # the FFT engineer's twin of fmt_fft_r22sdf
-    return _f
+def fft_shift(cfg) -> int:
+    """S of fmt_col_pair_rx: the FFT output is X * 2^-S, S = max(0, ADC_BITS + LOG2_N - 2
+    - HM_W), so that a full-scale tone's |X| = 2^(ADC_BITS + LOG2_N - 2) maps to 2^HM_W."""
+    return max(0, cfg.adc_bits + cfg.log2_n - 2 - cfg.hm_width)
+
+
+def fft_out_w(cfg) -> int:
+    """FFT_OUT_W of fmt_col_pair_rx (integer bins, S bits rounded off)."""
+    return cfg.adc_bits + cfg.log2_n + 2 - fft_shift(cfg)
 
 
 def fft_windows_fixed(x_re, x_im, cfg, fft_kw=None):
-    """Per-window natural-order fixed-point FFT of (windows, N) int arrays -> (re, im, ovf)."""
-    f = _default_fft()
-    fft_kw = dict(fft_kw or {})
-    out_re = np.empty(x_re.shape, dtype=np.int64)
-    out_im = np.empty(x_re.shape, dtype=np.int64)
-    ovf = False
-    for w in range(x_re.shape[0]):
-        r, i, o = f.fft_fixed(x_re[w], x_im[w], cfg.log2_n, cfg.adc_bits + 1, **fft_kw)
-        out_re[w] = r
-        out_im[w] = i
-        ovf = ovf or bool(o)
-    return out_re, out_im, ovf
+    """Natural-order fixed-point FFT (fmt_fft_r22sdf twin) of (windows, N) int arrays at
+    the receiver's output width -> (re, im, ovf)."""
+    from . import fft_fixed as f     # twin of fmt_fft_r22sdf
+    kw = {"out_w": fft_out_w(cfg)}
+    kw.update(fft_kw or {})
+    return f.fft_fixed(x_re, x_im, cfg.log2_n, cfg.adc_bits + 1, **kw)
 
 
 def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHIFT,
@@ -193,16 +193,18 @@ def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHI
     return hm, row_order(cfg), RxFlags(fft_ovf=ovf, sat=sat)
 
 
-def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, fft_shift: float = 0.0):
+def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, shift: float | None = None):
     """Floating-point receiver of the same despread samples: numpy FFT per real column,
     exact magnitude at the comb bins, mean over M windows, in the fixed path's units
-    (|X[k]| * 2^-fft_shift, fft_shift = the FFT's output scaling SHIFT)."""
+    (|X[k]| * 2^-S, S = fft_shift(cfg) unless given)."""
+    if shift is None:
+        shift = fft_shift(cfg)
     x = despread_fixed(adc, rx_sign).astype(float)
     n = cfg.n_fft
     wins = x.shape[0] // n
     x = x[:wins * n].reshape(wins, n, -1)
     X = np.fft.fft(x, axis=1)[:, comb_bins(cfg), :]          # (wins, rows, cols)
-    mag = np.abs(X) * 2.0 ** (-fft_shift)
+    mag = np.abs(X) * 2.0 ** (-shift)
     m = 1 << m_log2
     frames = wins // m
     return mag[:frames * m].reshape(frames, m, cfg.rows, -1).mean(axis=1)

@@ -1,0 +1,195 @@
+// fmt_col_pair_rx -- receiver of two real columns a, b sharing one complex FFT:
+// despread (x2) -> fmt_fft_r22sdf (z = a + j b) -> fmt_pair_split -> fmt_magnitude (x2,
+// one per column: a completed pair needs |A| and |B| in the same ce cycle) ->
+// fmt_accum (M = 2^m windows per frame) -> one row of two heat-map cells per beat.
+//
+// Scaling: the FFT output is rounded to FFT_OUT_W bits, X * 2^-S with
+// S = max(0, ADC_BITS + LOG2_N - 2 - HM_W); with HM_SHIFT = 1 a cell is
+//   hm = |X_col[k]| * 2^-S  (mean over the M windows, round half up, saturating)
+// so a full-scale tone (amplitude 2^(ADC_BITS-1), |X| = 2^(ADC_BITS+LOG2_N-2)) just
+// reaches 2^HM_W (amplitude 2047 of 12 bits gives 65504 at every size with S > 0).
+// Defaults: N = 256 -> S = 2, FFT_OUT_W = 20, magnitude 21 bits.
+//
+// Frames: window k is ADC samples k*N .. k*N + N-1 counted from the first ce after
+// reset (the FFT is held in reset for that ce while the despreaders fill); a frame
+// is M = 2^m_log2_i consecutive windows (m_log2_i sampled at the first window of each
+// frame, values above M_LOG2_MAX are clamped).  Rows leave in the order their pair
+// completes in the FFT's bit-reversed output (sim/fmt/rx_fixed.py row_order), only in
+// the last window of a frame.
+// Latency (ce cycles, M = 1): from the ce edge that takes a window's last ADC sample
+// to the ce edge that loads row r into the outputs: LATENCY0 (fmt_fft_r22sdf, counted
+// from its input register, which the despread register feeds; 22 at N = 256 with the
+// output rounding) + slot(r) (completion slot, rx_fixed.completion_slots) + 1 (pair
+// split) + ITER + 3 (magnitude) + 2 (accum) = 22 + 251 + 18 = 291 for the last row at
+// N = 256 (measured by tb/fmt_rx_array).
+// Flags (sticky until reset): fft_ovf_o (FFT internal saturation), sat_o (a cell
+// clipped at 2^HM_W - 1).  The magnitude cannot overflow (fmt_magnitude).
+// Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (columns of one pair).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_col_pair_rx #(
+    parameter LOG2_N     = `FMT_LOG2_N,    // FFT size N = 2^LOG2_N
+    parameter ROWS       = `FMT_ROWS,      // comb bins (rows)
+    parameter BIN_LO     = `FMT_BIN_LO,    // bin of row 0
+    parameter BIN_STEP   = `FMT_BIN_STEP,  // bins between rows
+    parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
+    parameter HM_W       = `FMT_HM_W,      // heat-map cell width (unsigned)
+    parameter M_LOG2_MAX = 3,              // largest log2 M (M = 1, 2, 4, 8 by default)
+    parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
+    parameter FFT_SHIFT  = (ADC_BITS + LOG2_N - 2 > HM_W) ? ADC_BITS + LOG2_N - 2 - HM_W : 0, // S
+    parameter FFT_OUT_W  = ADC_BITS + LOG2_N + 2 - FFT_SHIFT,  // FFT output width (X * 2^-S)
+    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
+    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
+) (
+    input  wire                       clk,
+    input  wire                       rst,        // synchronous, active high
+    input  wire                       ce,         // sample strobe
+    input  wire signed [ADC_BITS-1:0] adc_a_i,    // column a ADC sample (even column)
+    input  wire signed [ADC_BITS-1:0] adc_b_i,    // column b ADC sample (odd column)
+    input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
+    input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
+    output wire                       out_valid,  // one row of the pair this ce cycle
+    output wire [ROW_W-1:0]           out_row,    // row index
+    output wire [2*HM_W-1:0]          out_hm,     // {cell b, cell a}, unsigned
+    output wire                       out_last_row, // this row is the frame's last row
+    output wire                       fft_ovf_o,  // sticky FFT saturation
+    output wire                       sat_o       // sticky heat-map cell saturation
+);
+
+    localparam W    = FFT_OUT_W;
+    localparam MW   = W + 1;                        // pair split / magnitude width
+    localparam TAGW = ROW_W + 2 + SH_W;             // {row, first, last, shift}
+    localparam [M_LOG2_MAX:0] ONE = 1;
+    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
+
+    // ---- despread ----
+    wire signed [ADC_BITS:0] xa, xb;
+    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsa (
+        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_a_i), .sign_i(rx_sign_i), .y_o(xa));
+    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsb (
+        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_b_i), .sign_i(rx_sign_i), .y_o(xb));
+
+    // ---- FFT ----
+    // The despreaders add one ce cycle; the FFT is held in reset through the first ce
+    // after reset so that its window 0 is ADC samples 0 .. N-1 (counted from that ce).
+    reg fft_rst_q;
+    always @(posedge clk) begin
+        if (rst)      fft_rst_q <= 1'b1;
+        else if (ce)  fft_rst_q <= 1'b0;
+    end
+
+    wire                f_valid;
+    wire [LOG2_N-1:0]   f_slot, f_bin;
+    wire signed [W-1:0] f_re, f_im;
+    fmt_fft_r22sdf #(
+        .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W), .TW_DIR(TW_DIR)
+    ) u_fft (
+        .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re(xa), .in_im(xb),
+        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
+        .out_re(f_re), .out_im(f_im), .ovf_o(fft_ovf_o));
+
+    // ---- window / frame bookkeeping (at the FFT output) ----
+    reg                  started_q;
+    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
+    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
+    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
+    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
+    wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}});
+    wire                 wrap    = !started_q || (wcnt_q == last_q);
+    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
+    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
+    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
+    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
+    wire                 w_last  = (w_cur == last_cur);
+
+    always @(posedge clk) begin
+        if (rst) begin
+            started_q <= 1'b0;
+            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
+            m_q       <= {SH_W{1'b0}};
+        end else if (ce && new_win) begin
+            started_q <= 1'b1;
+            wcnt_q    <= w_cur;
+            m_q       <= m_cur;
+        end
+    end
+
+    // ---- pair split ----
+    wire                ps_valid;
+    wire [ROW_W-1:0]    ps_row;
+    wire signed [MW-1:0] ps_ar, ps_ai, ps_br, ps_bi;
+    wire [SH_W+1:0]     ps_tag;
+    fmt_pair_split #(
+        .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
+        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
+    ) u_split (
+        .clk(clk), .rst(rst), .ce(ce),
+        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
+        .in_tag({m_cur, w_first, w_last}),
+        .out_valid(ps_valid), .out_row(ps_row),
+        .a_re(ps_ar), .a_im(ps_ai), .b_re(ps_br), .b_im(ps_bi), .out_tag(ps_tag));
+
+    // ---- magnitudes ----
+    wire             mg_valid;
+    wire [MW-1:0]    mag_a, mag_b;
+    wire [TAGW-1:0]  mg_tag;
+    // unit b runs in lockstep with unit a: its valid and tag equal a's and are not used
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire             mg_valid_b;
+    wire             mg_tag_b;
+    /* verilator lint_on UNUSEDSIGNAL */
+    fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag_a (
+        .clk(clk), .rst(rst), .ce(ce), .in_valid(ps_valid), .in_re(ps_ar), .in_im(ps_ai),
+        .in_tag({ps_row, ps_tag}), .out_valid(mg_valid), .out_mag(mag_a), .out_tag(mg_tag));
+    fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag_b (
+        .clk(clk), .rst(rst), .ce(ce), .in_valid(ps_valid), .in_re(ps_br), .in_im(ps_bi),
+        .in_tag(1'b0), .out_valid(mg_valid_b), .out_mag(mag_b), .out_tag(mg_tag_b));
+
+    // ---- accumulation over the frame ----
+    wire [ROW_W-1:0] mg_row   = mg_tag[TAGW-1 -: ROW_W];
+    wire [SH_W-1:0]  mg_shift = mg_tag[SH_W+1:2];
+    wire             mg_first = mg_tag[1];
+    wire             mg_last  = mg_tag[0];
+    fmt_accum #(
+        .ROWS(ROWS), .LANES(2), .D_W(MW), .M_LOG2_MAX(M_LOG2_MAX), .HM_W(HM_W),
+        .HM_SHIFT(1), .ROW_W(ROW_W), .SH_W(SH_W)
+    ) u_acc (
+        .clk(clk), .rst(rst), .ce(ce),
+        .in_valid(mg_valid), .in_row(mg_row), .in_data({mag_b, mag_a}),
+        .in_first(mg_first), .in_last(mg_last), .in_shift(mg_shift),
+        .out_valid(out_valid), .out_row(out_row), .out_data(out_hm), .sat_o(sat_o));
+
+    // the frame's last row is the row whose pair completes last (a constant)
+    function integer bitrev_f;
+        input integer v;
+        integer j;
+        begin
+            bitrev_f = 0;
+            for (j = 0; j < LOG2_N; j = j + 1)
+                if (((v >> j) & 1) != 0) bitrev_f = bitrev_f | (1 << (LOG2_N - 1 - j));
+        end
+    endfunction
+    function integer last_row_f;
+        input integer dummy;
+        integer r, k, s, best;
+        begin
+            best = -1;
+            last_row_f = 0;
+            for (r = 0; r < ROWS; r = r + 1) begin
+                k = BIN_LO + r * BIN_STEP;
+                s = (bitrev_f(k) > bitrev_f((1 << LOG2_N) - k)) ? bitrev_f(k) : bitrev_f((1 << LOG2_N) - k);
+                if (s > best) begin
+                    best = s;
+                    last_row_f = r + 0 * dummy;
+                end
+            end
+        end
+    endfunction
+    localparam LAST_ROW = last_row_f(0);
+    assign out_last_row = (out_row == LAST_ROW[ROW_W-1:0]);
+
+endmodule
+
+`default_nettype wire

@@ -1,0 +1,78 @@
+#!/usr/bin/env python3
+"""Replay ADC captures through the RTL receive back end (fmt_rx_array under Verilator,
+fed from Python through cocotb) and write the heat maps.
+
+    source scripts/env.sh
+    python scripts/replay_rx.py --in captures.npy --out heatmaps.npy [--config default|small|medium]
+                                [--m 1] [--sign rx_sign.npy] [--check]
+
+captures.npy: (samples, COLS) integers in the ADC range, sample 0 = the first sample
+after reset.  --sign: (samples,) 0/1 receive PN signs (default: PN off).  --m: windows
+per frame (1, 2, 4, 8).  Writes heatmaps.npy (frames, ROWS, COLS) uint32 and
+heatmaps.npy.json (frames, sticky flags).  --check compares with the bit-exact model
+sim/fmt/rx_fixed.py and exits 1 on a difference.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT / "sim"), str(ROOT / "tb")]
+os.environ["PYTHONPATH"] = os.pathsep.join(
+    [str(ROOT / "sim"), str(ROOT / "tb")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
+
+import numpy as np  # noqa: E402
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--in", dest="inp", required=True, help="ADC capture .npy (samples x columns)")
+    ap.add_argument("--out", required=True, help="heat maps .npy (frames x rows x cols)")
+    ap.add_argument("--config", default="default", choices=["default", "small", "medium"])
+    ap.add_argument("--m", type=int, default=1, choices=[1, 2, 4, 8], help="windows per frame")
+    ap.add_argument("--sign", default="", help="receive PN signs .npy (samples,), default PN off")
+    ap.add_argument("--check", action="store_true", help="compare with rx_fixed (bit-exact)")
+    a = ap.parse_args(argv)
+
+    from common.runner import run_cocotb, rtl_sources
+    from fmt import params, rx_fixed
+    sys.path.insert(0, str(ROOT / "tb" / "fmt_rx_array"))
+    from test_fmt_rx_array import RTL_FILES, VERILATOR_ARGS
+
+    cfg = params.get(a.config)
+    m_log2 = a.m.bit_length() - 1
+    inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
+    env = {"CFG": a.config, "M_LOG2": m_log2, "REPLAY_IN": inp, "REPLAY_OUT": out,
+           "REPLAY_SIGN": Path(a.sign).resolve() if a.sign else ""}
+    run_cocotb(
+        sim="verilator",
+        toplevel="fmt_rx_array",
+        sources=rtl_sources(*RTL_FILES),
+        test_module="replay_cocotb",
+        test_dir=ROOT / "tb" / "fmt_rx_array",
+        parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
+                    "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
+                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"'},
+        extra_env=env,
+        build_args=VERILATOR_ARGS,
+    )
+    hm = np.load(out)
+    info = json.loads(Path(str(out) + ".json").read_text())
+    print(f"{out}: {hm.shape[0]} frames of {cfg.rows} x {cfg.cols}, flags {info}")
+    if a.check:
+        adc = np.load(inp)
+        sign = np.load(a.sign) if a.sign else np.zeros(len(adc), dtype=np.uint8)
+        exp, _, _ = rx_fixed.rx_heatmaps_fixed(adc, sign, cfg, m_log2)
+        if not np.array_equal(hm, exp):
+            print(f"MISMATCH: {int(np.sum(hm != exp))} cells differ from rx_fixed")
+            return 1
+        print("bit-exact with rx_fixed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
