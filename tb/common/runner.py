@@ -81,6 +81,8 @@ def run_cocotb(sim: str, toplevel: str, sources: list, test_module: str,
         extra_env=env,
         waves=waves,
         testcase=testcase,
+        # keep the xUnit results with the build, not in the source tree
+        results_xml=str(build_dir / "results.xml"),
     )
     if waves:
         print(f"waves in {build_dir}")
