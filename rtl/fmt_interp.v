@@ -9,7 +9,8 @@
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
 // (z[0][+1] - z[0][-1]) / (2 (2 z00 - z[0][+1] - z[0][-1])) when both neighbours exist
-// and its denominator is > 0; else 0 (cell centre).  |offset| = round half up of a
+// and its denominator is > 0; one neighbour missing: the one-sided estimate from the
+// ratio neighbour / z00 (same divider, edge table); else 0 (cell centre).  |offset| = round half up of a
 // 9-bit truncating quotient (fmt_div) in 1/256 cell, clamped to 128 (0.5 cell) when
 // >= 257/512; optional bias table (fmt_interp_bias_rom).  tp_x = col * 256 + offset
 // clamped to [0, (COLS-1) * 256], tp_y likewise: cells, 8 fractional bits.
@@ -169,7 +170,8 @@ module fmt_interp #(
     reg [Z+1:0]          s2_edg, s2_crn;
     reg [Z-1:0]          s2_z4;
     reg signed [VW-1:0]  s2_nvx, s2_dvx, s2_nvy, s2_dvy;
-    reg                  s2_mx, s2_my, s2_edge, s2_sat, s2_moore, s2_bias;
+    reg                  s2_mxl, s2_mxh, s2_myl, s2_myh, s2_edge, s2_sat, s2_moore, s2_bias;
+    reg [Z-1:0]          s2_znx, s2_zny;    // the present neighbour of a one-sided axis
     reg [SHW-1:0]        s2_sh;
     always @(posedge clk) begin
         s2_cs0 <= cs0; s2_cs1 <= cs1; s2_cs2 <= cs2;
@@ -180,8 +182,10 @@ module fmt_interp #(
         s2_dvx <= (((z4s <<< 1) - z5s) - z3s) <<< 1;
         s2_nvy <= z7s - z1s;
         s2_dvy <= (((z4s <<< 1) - z7s) - z1s) <<< 1;
-        s2_mx  <= s1_miss[3] | s1_miss[5];
-        s2_my  <= s1_miss[1] | s1_miss[7];
+        s2_mxl <= s1_miss[3]; s2_mxh <= s1_miss[5];
+        s2_myl <= s1_miss[1]; s2_myh <= s1_miss[7];
+        s2_znx <= s1_miss[3] ? s1_z[5] : s1_z[3];
+        s2_zny <= s1_miss[1] ? s1_z[7] : s1_z[1];
         s2_edge <= |s1_miss;
         s2_sat <= sat_d;
         s2_sh  <= sh_d;
@@ -205,7 +209,8 @@ module fmt_interp #(
     reg signed [CW-1:0]  s3_a, s3_b, s3_c, s3_d, s3_e;
     reg signed [FW-1:0]  s3_f;
     reg signed [VW-1:0]  s3_nvx, s3_dvx, s3_nvy, s3_dvy;
-    reg                  s3_mx, s3_my, s3_edge, s3_sat, s3_moore, s3_bias;
+    reg                  s3_mxl, s3_mxh, s3_myl, s3_myh, s3_edge, s3_sat, s3_moore, s3_bias;
+    reg [Z-1:0]          s3_znx, s3_zny, s3_z4;
     reg [SHW-1:0]        s3_sh;
     always @(posedge clk) begin
         s3_a <= cs0s + cs2s - (cs1s <<< 1);
@@ -215,7 +220,9 @@ module fmt_interp #(
         s3_e <= rs2s - rs0s;
         s3_f <= z4f * 20 + (edgf <<< 3) - (crnf <<< 2);
         s3_nvx <= s2_nvx; s3_dvx <= s2_dvx; s3_nvy <= s2_nvy; s3_dvy <= s2_dvy;
-        s3_mx <= s2_mx; s3_my <= s2_my; s3_edge <= s2_edge; s3_sat <= s2_sat;
+        s3_mxl <= s2_mxl; s3_mxh <= s2_mxh; s3_myl <= s2_myl; s3_myh <= s2_myh;
+        s3_znx <= s2_znx; s3_zny <= s2_zny; s3_z4 <= s2_z4;
+        s3_edge <= s2_edge; s3_sat <= s2_sat;
         s3_moore <= s2_moore; s3_bias <= s2_bias; s3_sh <= s2_sh;
     end
 
@@ -226,7 +233,8 @@ module fmt_interp #(
     reg signed [NW-1:0]  s4_an, s4_bn, s4_cn, s4_dn, s4_en;
     reg signed [FNW-1:0] s4_fn;
     reg signed [VW-1:0]  s4_nvx, s4_dvx, s4_nvy, s4_dvy;
-    reg                  s4_mx, s4_my, s4_edge, s4_sat, s4_moore, s4_bias, s4_aneg;
+    reg                  s4_mxl, s4_mxh, s4_myl, s4_myh, s4_edge, s4_sat, s4_moore, s4_bias, s4_aneg;
+    reg [Z-1:0]          s4_znx, s4_zny, s4_z4;
     /* verilator lint_off WIDTHTRUNC */ // the shifted coefficients fit NW / FNW bits (see widths)
     always @(posedge clk) begin
         s4_be <= s3_b * s3_e;
@@ -242,7 +250,9 @@ module fmt_interp #(
         s4_en <= s3_e >>> s3_sh;
         s4_fn <= s3_f >>> s3_sh;
         s4_nvx <= s3_nvx; s4_dvx <= s3_dvx; s4_nvy <= s3_nvy; s4_dvy <= s3_dvy;
-        s4_mx <= s3_mx; s4_my <= s3_my; s4_edge <= s3_edge; s4_sat <= s3_sat;
+        s4_mxl <= s3_mxl; s4_mxh <= s3_mxh; s4_myl <= s3_myl; s4_myh <= s3_myh;
+        s4_znx <= s3_znx; s4_zny <= s3_zny; s4_z4 <= s3_z4;
+        s4_edge <= s3_edge; s4_sat <= s3_sat;
         s4_moore <= s3_moore; s4_bias <= s3_bias;
         s4_aneg <= s3_a[CW-1];
     end
@@ -276,7 +286,8 @@ module fmt_interp #(
     reg signed [FNW-1:0] s5_fn;
     reg signed [NW+2:0]  s5_p;
     reg signed [VW-1:0]  s5_nvx, s5_dvx, s5_nvy, s5_dvy;
-    reg                  s5_mx, s5_my, s5_edge, s5_sat, s5_moore, s5_bias, s5_aneg;
+    reg                  s5_mxl, s5_mxh, s5_myl, s5_myh, s5_edge, s5_sat, s5_moore, s5_bias, s5_aneg;
+    reg [Z-1:0]          s5_znx, s5_zny, s5_z4;
     always @(posedge clk) begin
         s5_nmx <= (be_w * 6) - (cd_w <<< 3);
         s5_nmy <= (bd_w * 6) - (ae_w <<< 3);
@@ -289,7 +300,9 @@ module fmt_interp #(
         s5_an <= s4_an; s5_bn <= s4_bn; s5_cn <= s4_cn; s5_fn <= s4_fn;
         s5_p  <= -(({{3{s4_an[NW-1]}}, s4_an} + {{3{s4_cn[NW-1]}}, s4_cn}) <<< 1);
         s5_nvx <= s4_nvx; s5_dvx <= s4_dvx; s5_nvy <= s4_nvy; s5_dvy <= s4_dvy;
-        s5_mx <= s4_mx; s5_my <= s4_my; s5_edge <= s4_edge; s5_sat <= s4_sat;
+        s5_mxl <= s4_mxl; s5_mxh <= s4_mxh; s5_myl <= s4_myl; s5_myh <= s4_myh;
+        s5_znx <= s4_znx; s5_zny <= s4_zny; s5_z4 <= s4_z4;
+        s5_edge <= s4_edge; s5_sat <= s4_sat;
         s5_moore <= s4_moore; s5_bias <= s4_bias; s5_aneg <= s4_aneg;
     end
 
@@ -297,27 +310,39 @@ module fmt_interp #(
     // s6: fit selection per axis; ellipse products
     // =================================================================================
     wire moore_ok = s5_moore & ~s5_edge & s5_aneg & (s5_dm > 0);
+    wire s5_mx = s5_mxl | s5_mxh;
+    wire s5_my = s5_myl | s5_myh;
+    wire z4_pos = |s5_z4;
+    // one neighbour missing: one-sided ratio estimate (num = +-z_nb, den = z00)
+    wire ex = ~moore_ok & (s5_mxl ^ s5_mxh) & z4_pos;
+    wire ey = ~moore_ok & (s5_myl ^ s5_myh) & z4_pos;
     wire vx_ok = ~s5_mx & (s5_dvx > 0);
     wire vy_ok = ~s5_my & (s5_dvy > 0);
+    wire signed [PW-1:0] znx_w = {{(PW-Z){1'b0}}, s5_znx};
+    wire signed [PW-1:0] zny_w = {{(PW-Z){1'b0}}, s5_zny};
+    wire signed [PW-1:0] z4_w  = {{(PW-Z){1'b0}}, s5_z4};
     wire signed [PW-1:0] nvx_w = {{(PW-VW){s5_nvx[VW-1]}}, s5_nvx};
     wire signed [PW-1:0] dvx_w = {{(PW-VW){s5_dvx[VW-1]}}, s5_dvx};
     wire signed [PW-1:0] nvy_w = {{(PW-VW){s5_nvy[VW-1]}}, s5_nvy};
     wire signed [PW-1:0] dvy_w = {{(PW-VW){s5_dvy[VW-1]}}, s5_dvy};
     wire signed [PW-1:0] one_w = 1;
-    wire signed [PW-1:0] numx = moore_ok ? s5_nmx : (vx_ok ? nvx_w : {PW{1'b0}});
+    wire signed [PW-1:0] numx = moore_ok ? s5_nmx : ex ? (s5_mxl ? znx_w : -znx_w)
+                              : (vx_ok ? nvx_w : {PW{1'b0}});
+    wire signed [PW-1:0] numy = moore_ok ? s5_nmy : ey ? (s5_myl ? zny_w : -zny_w)
+                              : (vy_ok ? nvy_w : {PW{1'b0}});
     /* verilator lint_off UNUSEDSIGNAL */ // sign bits of den: only used when den > 0
-    wire signed [PW-1:0] denx = moore_ok ? s5_dm  : (vx_ok ? dvx_w : one_w);
-    wire signed [PW-1:0] numy = moore_ok ? s5_nmy : (vy_ok ? nvy_w : {PW{1'b0}});
-    wire signed [PW-1:0] deny = moore_ok ? s5_dm  : (vy_ok ? dvy_w : one_w);
+    wire signed [PW-1:0] denx = moore_ok ? s5_dm  : ex ? z4_w : (vx_ok ? dvx_w : one_w);
+    wire signed [PW-1:0] deny = moore_ok ? s5_dm  : ey ? z4_w : (vy_ok ? dvy_w : one_w);
     /* verilator lint_on UNUSEDSIGNAL */
     wire fb_d = (s5_moore & ~s5_edge & ~moore_ok)
               | (~moore_ok & ~s5_mx & ~(s5_dvx > 0))
-              | (~moore_ok & ~s5_my & ~(s5_dvy > 0));
+              | (~moore_ok & ~s5_my & ~(s5_dvy > 0))
+              | (~moore_ok & ((s5_mxl ^ s5_mxh) | (s5_myl ^ s5_myh)) & ~z4_pos);
 
     wire signed [DMW-1:0] acn_w = {{(DMW-N2W){s5_acn[N2W-1]}}, s5_acn};
     wire signed [DMW-1:0] bbn_w = {{(DMW-N2W){s5_bbn[N2W-1]}}, s5_bbn};
     reg [PW-2:0]         s6_magx, s6_magy, s6_denx, s6_deny;
-    reg                  s6_sgx, s6_sgy, s6_fb, s6_mok, s6_edge, s6_sat, s6_bias;
+    reg                  s6_sgx, s6_sgy, s6_fb, s6_mok, s6_edge, s6_sat, s6_bias, s6_ex, s6_ey;
     reg signed [DMW-1:0] s6_dmn;
     reg signed [N3W-1:0] s6_cdd, s6_bde, s6_aee;
     reg signed [FNW-1:0] s6_fn;
@@ -334,6 +359,8 @@ module fmt_interp #(
         s6_edge <= s5_edge;
         s6_sat  <= s5_sat;
         s6_bias <= s5_bias;
+        s6_ex   <= ex;
+        s6_ey   <= ey;
         s6_dmn  <= (acn_w <<< 4) - (bbn_w * 9);
         s6_cdd  <= s5_cn * s5_ddn;
         s6_bde  <= s5_bn * s5_den;
@@ -355,11 +382,11 @@ module fmt_interp #(
     /* verilator lint_on PINCONNECTEMPTY */
 
     // side information of the position path: s6 -> s16
-    wire s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias;
-    fmt_interp_dly #(.W(7), .N(QW + 1), .RST(0)) u_dly_pos (
+    wire s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias, s16_ex, s16_ey;
+    fmt_interp_dly #(.W(9), .N(QW + 1), .RST(0)) u_dly_pos (
         .clk(clk), .rst(rst),
-        .d_i({s6_sgx, s6_sgy, s6_mok, s6_fb, s6_edge, s6_sat, s6_bias}),
-        .q_o({s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias}));
+        .d_i({s6_sgx, s6_sgy, s6_mok, s6_fb, s6_edge, s6_sat, s6_bias, s6_ex, s6_ey}),
+        .q_o({s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias, s16_ex, s16_ey}));
 
     // =================================================================================
     // ellipse path s7 .. s9: qn, G
@@ -449,18 +476,22 @@ module fmt_interp #(
     // =================================================================================
     // position s17: round / clamp; s18: bias table; s19: coordinates
     // =================================================================================
-    wire clx = ovx | (qx >= 257);
-    wire cly = ovy | (qy >= 257);
+    // clamp (fit offsets only); the edge estimate indexes its table by q >> 1 (255 on
+    // overflow, ratio >= 1)
+    wire clx = ~s16_ex & (ovx | (qx >= 257));
+    wire cly = ~s16_ey & (ovy | (qy >= 257));
     /* verilator lint_off UNUSEDSIGNAL */ // (q + 1) >> 1 for q <= 256: bits 8:1 only
     wire [QW:0] qx1 = {1'b0, qx} + 1'b1;
     wire [QW:0] qy1 = {1'b0, qy} + 1'b1;
     /* verilator lint_on UNUSEDSIGNAL */
     reg [7:0] s17_rx, s17_ry;
-    reg       s17_sgx, s17_sgy, s17_mok, s17_bias;
+    reg       s17_sgx, s17_sgy, s17_mok, s17_bias, s17_ex, s17_ey;
     reg [3:0] s17_flags;
     always @(posedge clk) begin
-        s17_rx  <= clx ? 8'd128 : qx1[8:1];
-        s17_ry  <= cly ? 8'd128 : qy1[8:1];
+        s17_rx  <= s16_ex ? (ovx ? 8'd255 : qx[8:1]) : (clx ? 8'd128 : qx1[8:1]);
+        s17_ry  <= s16_ey ? (ovy ? 8'd255 : qy[8:1]) : (cly ? 8'd128 : qy1[8:1]);
+        s17_ex  <= s16_ex;
+        s17_ey  <= s16_ey;
         s17_sgx <= s16_sgx;
         s17_sgy <= s16_sgy;
         s17_mok <= s16_mok;
@@ -468,20 +499,21 @@ module fmt_interp #(
         s17_flags <= {s16_mok, s16_edge, s16_sat, s16_fb | clx | cly};
     end
     wire [7:0] bx18, by18;
-    fmt_interp_bias_rom u_bias_x (.clk(clk), .addr_i({s17_mok, s17_rx}), .data_o(bx18));
-    fmt_interp_bias_rom u_bias_y (.clk(clk), .addr_i({s17_mok, s17_ry}), .data_o(by18));
+    fmt_interp_bias_rom u_bias_x (.clk(clk), .addr_i({s17_ex, s17_mok, s17_rx}), .data_o(bx18));
+    fmt_interp_bias_rom u_bias_y (.clk(clk), .addr_i({s17_ey, s17_mok, s17_ry}), .data_o(by18));
     reg [7:0] s18_rx, s18_ry;
-    reg       s18_sgx, s18_sgy, s18_bias;
+    reg       s18_sgx, s18_sgy, s18_bias, s18_ex, s18_ey;
     always @(posedge clk) begin
         s18_rx <= s17_rx; s18_ry <= s17_ry;
         s18_sgx <= s17_sgx; s18_sgy <= s17_sgy; s18_bias <= s17_bias;
+        s18_ex <= s17_ex; s18_ey <= s17_ey;
     end
     wire [ROW_W-1:0] row18;
     wire [COL_W-1:0] col18;
     fmt_interp_dly #(.W(ROW_W + COL_W), .N(17), .RST(0)) u_dly_rc (
         .clk(clk), .rst(rst), .d_i({s1_row, s1_col}), .q_o({row18, col18}));
-    wire [7:0] ox = s18_bias ? bx18 : s18_rx;
-    wire [7:0] oy = s18_bias ? by18 : s18_ry;
+    wire [7:0] ox = (s18_bias | s18_ex) ? bx18 : s18_rx;
+    wire [7:0] oy = (s18_bias | s18_ey) ? by18 : s18_ry;
     wire signed [18:0] colq = {{(11-COL_W){1'b0}}, col18, 8'd0};
     wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, row18, 8'd0};
     wire signed [18:0] oxs  = {11'd0, ox};

@@ -1,18 +1,19 @@
-// fmt_interp_bias_rom -- bias-correction table of the paraboloid fits, 512 x 8 bit,
-// registered read (1 clock cycle).  Address {fit, |offset|}: fit = 1 Moore, 0 Von
-// Neumann; |offset| in 1/256 cell (0..128); data = corrected |offset| (0..128).
-// Contents rtl/fmt_interp_bias.hex from `python -m fmt.interp --write-hex` (the inverse
-// of the mean fitted-offset curve of an 8 mm disk contact on the 5 mm pitch; see
-// sim/fmt/interp.py).  Twin: fmt.interp.bias_table.
+// fmt_interp_bias_rom -- offset tables of the fits, 1024 x 8 bit, registered read (1
+// clock cycle).  Address {kind[1:0], index[7:0]}: kind 0 Von Neumann bias correction,
+// 1 Moore bias correction (index = fitted |offset| in 1/256 cell, 0..128), 2 one-sided
+// edge estimate (index = floor(256 * neighbour / centre), 0..255), 3 unused (zeros);
+// data = |offset| in 1/256 cell (0..128).  Contents rtl/fmt_interp_bias.hex from
+// `python -m fmt.interp --write-hex` (inverse curves of an 8 mm disk contact on the
+// 5 mm pitch; see sim/fmt/interp.py).  Twin: fmt.interp.bias_table / edge_table.
 `default_nettype none
 `include "fmt_defaults.vh"
 
 module fmt_interp_bias_rom (
     input  wire       clk,    // processing clock
-    input  wire [8:0] addr_i, // {fit, |offset|[7:0]}
+    input  wire [9:0] addr_i, // {kind[1:0], index[7:0]}
     output reg  [7:0] data_o  // corrected |offset|, one cycle later
 );
-    reg [7:0] rom [0:511];
+    reg [7:0] rom [0:1023];
     initial begin
 `ifdef FMT_ROM_DIR
         $readmemh({`FMT_ROM_DIR, "fmt_interp_bias.hex"}, rom);

@@ -22,9 +22,15 @@ Fits (paper Eq. 3-7), in integers (z = z3, x = dx = column offset, y = dy = row 
 Decision rules (identical in float, fixed and RTL):
 
 * edge = any neighbour missing (flag bit 2).  Moore fit only when no neighbour is
-  missing; an axis with a missing neighbour gets offset 0 (the cell centre), the other
-  axis the Von Neumann fit.  (A contact within ~1.2 mm of the edge lights one cell
-  only: no fit can recover its position.)
+  missing; an axis with both neighbours present gets its Von Neumann fit; an axis with
+  ONE neighbour missing gets the one-sided estimate: q = floor(z_nb * 512 / z00) (the
+  same divider; ratio of the present neighbour to the centre), offset = EDGE[q >> 1]
+  (255 when q overflows, ratio >= 1) towards the present neighbour, from a 256-entry
+  table made from the 8 mm disk profile (a contact whose ratio is below that of a
+  centred contact -- i.e. one sitting towards the sensor's border -- reads 0, the cell
+  centre: a contact within ~1.2 mm of the edge lights one cell only and no fit can
+  recover its position).  The bias setting does not apply to it.  z00 = 0 -> offset 0
+  and flag bit 0.  Both neighbours missing (a 1-wide sensor) -> 0.
 * Moore mode: the Moore fit is used iff a < 0 and dm > 0 (both eigenvalues of M
   negative: a true maximum); otherwise (plateau, saddle, ridge) each axis falls back to
   its Von Neumann fit and flag bit 0 is set.  Flag bit 3 = Moore fit used.
@@ -40,8 +46,9 @@ Decision rules (identical in float, fixed and RTL):
   out, sign restored), fit = 1 for the Moore fit, 0 for Von Neumann.  The table is the
   inverse of the mean fitted-offset curve of an 8 mm disk contact (paper Eq. 2 profile,
   ``fmt.sensor``) on the 5 mm pitch; it is shown on a Gaussian profile too
-  (``scripts/interp_accuracy.py``).  ROM ``rtl/fmt_interp_bias.hex`` (512 x 8 bit,
-  address {fit, |offset|[7:0]}, entries 129..255 repeat entry 128, never addressed).
+  (``scripts/interp_accuracy.py``).  ROM ``rtl/fmt_interp_bias.hex`` (1024 x 8 bit,
+  address {kind[1:0], index[7:0]}: kind 0 Von Neumann bias, 1 Moore bias (entries
+  129..255 repeat entry 128, never addressed), 2 the edge table, 3 unused zeros).
 * Position: x = col * 256 + offset, clamped to [0, (COLS-1) * 256] (likewise y):
   16-bit unsigned, cells, 8 fractional bits, from the centre of cell (0, 0).
 * Strength: the candidate's centre cell z00 (the peak cell value).
@@ -173,18 +180,20 @@ def moore_lstsq_coeffs(z):
 
 
 def _axis_terms(z, miss):
-    """(num, den, missing) of the Von Neumann fits, x then y."""
+    """(num, den, lo missing, hi missing, lo value, hi value) of the Von Neumann fits,
+    x then y."""
     nvx = z[1][2] - z[1][0]
     dvx = 2 * (2 * z[1][1] - z[1][2] - z[1][0])
     nvy = z[2][1] - z[0][1]
     dvy = 2 * (2 * z[1][1] - z[2][1] - z[0][1])
-    mx = bool(miss[1][0] or miss[1][2])
-    my = bool(miss[0][1] or miss[2][1])
-    return (nvx, dvx, mx), (nvy, dvy, my)
+    return ((nvx, dvx, bool(miss[1][0]), bool(miss[1][2]), z[1][0], z[1][2]),
+            (nvy, dvy, bool(miss[0][1]), bool(miss[2][1]), z[0][1], z[2][1]))
 
 
 def _select(z, miss, moore):
-    """Per-axis (num, den, kind) with kind 'moore', 'vn' or 'zero', plus flags."""
+    """Per-axis (num, den, kind) with kind 'moore', 'vn', 'edge' or 'zero', plus flags.
+    'edge': one neighbour missing: num = +-(present neighbour) (sign = its side),
+    den = z00 (the one-sided ratio estimate)."""
     a, b, c, d, e, f = coeffs(z)
     edge = bool(miss.any())
     fb = False
@@ -196,9 +205,15 @@ def _select(z, miss, moore):
     if moore_ok:
         out = [(6 * b * e - 8 * c * d, dm, "moore"), (6 * b * d - 8 * a * e, dm, "moore")]
     else:
-        for num, den, mis in _axis_terms(z, miss):
-            if mis:
+        for num, den, mlo, mhi, zlo, zhi in _axis_terms(z, miss):
+            if mlo and mhi:
                 out.append((0, 1, "zero"))
+            elif mlo or mhi:
+                if z[1][1] > 0:
+                    out.append((zhi if mlo else -zlo, z[1][1], "edge"))
+                else:
+                    fb = True
+                    out.append((0, 1, "zero"))
             elif den > 0:
                 out.append((num, den, "vn"))
             else:
@@ -276,12 +291,48 @@ def bias_table(profile: str = "disk", diameter_mm: float = 8.0):
     return _BIAS_CACHE[key]
 
 
-def render_bias_hex(tab=None) -> str:
+def edge_curve(profile: str = "disk", diameter_mm: float = 8.0, n_t: int = 257, n_s: int = 9):
+    """Mean ratio r = z(neighbour) / z(centre) against the true offset t in [0, 0.5] cell
+    towards that neighbour (mean over the other axis' offset in [-0.5, 0.5])."""
+    from . import params, sensor
+    cfg = params.MEDIUM
+    p = cfg.pitch_mm
+    r0, c0 = cfg.rows // 2, cfg.cols // 2
+    t = np.linspace(0.0, 0.5, n_t)
+    sv = np.linspace(-0.5, 0.5, n_s)
+    T, S = np.meshgrid(t, sv, indexing="ij")
+    ct = np.stack([(c0 + T.ravel()) * p, (r0 + S.ravel()) * p,
+                   np.full(T.size, diameter_mm), np.ones(T.size)], axis=1)
+    maps = sensor.contact_maps(cfg, ct, profile=profile)
+    r = (maps[:, r0, c0 + 1] / maps[:, r0, c0]).reshape(n_t, n_s).mean(axis=1)
+    return t, r
+
+
+def edge_table(profile: str = "disk", diameter_mm: float = 8.0):
+    """(256,) int table of the one-sided edge estimate: entry i = round(256 t) where the
+    mean ratio neighbour / centre of a contact at offset t towards the neighbour is
+    (i + 0.5) / 256; 0 below the ratio of a centred contact, 128 at ratio 1."""
+    key = ("edge", profile, diameter_mm)
+    if key not in _BIAS_CACHE:
+        t, r = edge_curve(profile, diameter_mm)
+        r = np.maximum.accumulate(r)
+        q = (np.arange(256) + 0.5) / 256.0
+        _BIAS_CACHE[key] = np.clip(np.round(np.interp(q, r, t, left=0.0, right=0.5) * 256),
+                                   0, 128).astype(np.int64)
+    return _BIAS_CACHE[key]
+
+
+def render_bias_hex(tab=None, etab=None) -> str:
+    """1024 x 8 bit: rows {fit}: 0 Von Neumann bias, 1 Moore bias (129 entries, padded with
+    entry 128), 2 the edge table (256 entries), 3 zeros (unused)."""
     tab = bias_table() if tab is None else tab
+    etab = edge_table() if etab is None else etab
     words = []
     for k in range(2):
         row = list(tab[k]) + [int(tab[k][-1])] * (256 - BIAS_N)
         words += [f"{int(v):02x}" for v in row]
+    words += [f"{int(v):02x}" for v in etab]
+    words += ["00"] * 256
     return "\n".join(words) + "\n"
 
 
@@ -317,6 +368,15 @@ def offset_fixed(num: int, den: int):
     else:
         r, clamp = (q + 1) >> 1, False
     return (-r if num < 0 else r), clamp
+
+
+def edge_offset_fixed(num: int, den: int, etab=None) -> int:
+    """One-sided edge estimate: q = floor(|num| * 512 / den) (the same divider),
+    index = q >> 1 (255 on overflow, i.e. ratio >= 1), offset = +-EDGE[index]."""
+    etab = edge_table() if etab is None else etab
+    q, ovf = div_fixed(abs(num) << 9, den)
+    r = int(etab[255 if ovf else q >> 1])
+    return -r if num < 0 else r
 
 
 def lg_fixed(x: int) -> int:
@@ -385,6 +445,9 @@ def interp_fixed(cand, cfg, moore: bool = True, bias: bool = True, frame: int = 
     sel, moore_ok, fb, edge, co = _select(z, miss, moore)
     offs = []
     for num, den, kind in sel:
+        if kind == "edge":
+            offs.append(edge_offset_fixed(num, den))
+            continue
         o, clamp = offset_fixed(num, den)
         fb = fb or clamp
         if bias:
@@ -439,6 +502,11 @@ def interp_float(cand, cfg, moore: bool = True, bias: bool = True, frame: int = 
     sel, moore_ok, fb, edge, co = _select(z, miss, moore)
     offs = []
     for num, den, kind in sel:
+        if kind == "edge":
+            r = abs(num) / den * 256 - 0.5
+            o = float(np.interp(r, np.arange(256), edge_table())) / 256
+            offs.append(-o if num < 0 else o)
+            continue
         o = num / den
         if abs(o) >= CLAMP_AT:
             o, fb = math.copysign(0.5, o), True

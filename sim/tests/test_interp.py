@@ -153,14 +153,33 @@ def test_fallbacks():
 def test_edges_and_saturation():
     z = np.array([[0, 0, 0], [500, 2000, 900], [300, 1200, 400]])
     missing = 0b000000111            # row above outside the sensor
+    etab = interp.edge_table()
     tp = interp.interp_fixed(cand(z, row=0, missing=missing), CFG, moore=True, bias=False)
-    assert tp.flags == interp.FLAG_EDGE
-    assert tp.y == 0 and tp.axis_major == 0
+    assert tp.flags == interp.FLAG_EDGE and tp.axis_major == 0
+    # y: one-sided estimate from the ratio 1200 / 2000 (towards the present row below)
+    assert tp.y == etab[(1200 * 512 // 2000) >> 1] and 0 < tp.y < 128
+    # x: both neighbours present -> the Von Neumann fit
     xo, _ = interp.offset_fixed(900 - 500, 2 * (4000 - 1400))
     assert tp.x == 5 * 256 + xo
-    # corner: both axes missing -> centre; negative coordinates clamp at 0
-    tp = interp.interp_fixed(cand(z, row=0, col=0, missing=0b001001111), CFG, moore=True)
-    assert (tp.x, tp.y) == (0, 0) and tp.flags == interp.FLAG_EDGE
+    # the one-sided estimate grows with the neighbour and points at it
+    z2 = z.copy()
+    z2[2, 1] = 1900
+    tp2 = interp.interp_fixed(cand(z2, row=0, missing=missing), CFG)
+    assert tp2.y > tp.y
+    tp3 = interp.interp_fixed(cand(z[::-1].copy(), row=CFG.rows - 1, missing=0b111000000), CFG)
+    assert tp3.y == (CFG.rows - 1) * 256 - tp.y
+    # neighbour >= centre (ratio >= 1): half a cell
+    z4 = z.copy()
+    z4[2, 1] = 2500
+    assert interp.interp_fixed(cand(z4, row=0, missing=missing), CFG).y == etab[255] == 128
+    # corner: both axes one-sided
+    zc = np.array([[0, 0, 0], [0, 2000, 900], [0, 1200, 400]])
+    tp = interp.interp_fixed(cand(zc, row=0, col=0, missing=0b001001111), CFG, moore=True)
+    assert (tp.x, tp.y) == (etab[(900 * 512 // 2000) >> 1], etab[(1200 * 512 // 2000) >> 1])
+    assert tp.flags == interp.FLAG_EDGE
+    # a weak neighbour (contact towards the border): the cell centre
+    zc[1, 2] = 100
+    assert interp.interp_fixed(cand(zc, row=0, col=0, missing=0b001001111), CFG).x == 0
     # saturated present cell -> bit 1; a saturated value in a missing cell does not count
     full = (1 << CFG.hm_width) - 1
     z = np.array([[10, 20, 10], [20, full, 20], [10, 20, 10]])
@@ -215,3 +234,29 @@ def test_bias_table_monotone_and_improves_both_profiles():
             m = u <= 0.5
             corr = np.interp(u[m] * 256, np.arange(129), tab[k]) / 256
             assert np.sqrt(np.mean((corr - t[m]) ** 2)) < 0.7 * np.sqrt(np.mean((u[m] - t[m]) ** 2))
+
+
+def test_edge_table_monotone_and_accurate():
+    """The one-sided edge table is monotone, 0 for a centred contact, 128 at ratio 1,
+    and recovers offsets towards the neighbour: the float edge estimate of disk contacts
+    at t in [0, 0.5] is within 0.03 cell (noiseless, mean over the other axis)."""
+    etab = interp.edge_table()
+    assert np.all(np.diff(etab) >= 0) and etab[255] == 128
+    t, r = interp.edge_curve("disk")
+    assert etab[int(r[0] * 256) - 1] == 0
+    est = np.interp(r * 256 - 0.5, np.arange(256), etab) / 256
+    assert np.max(np.abs(est - t)[t > 0.02]) < 0.03
+
+
+def test_fixed_vs_float_edges():
+    rng = np.random.default_rng(13)
+    for _ in range(300):
+        z = rng.integers(0, 20000, (3, 3))
+        z[1, 1] = z.max() + int(rng.integers(0, 20000))
+        missing = int(rng.choice([0b000000111, 0b111000000, 0b001001001, 0b100100100,
+                                  0b001001111, 0b111100100]))
+        for moore in (False, True):
+            fx = interp.interp_fixed(cand(z, row=3, col=4, missing=missing), CFG, moore=moore)
+            fl = interp.interp_float(cand(z, row=3, col=4, missing=missing), CFG, moore=moore)
+            assert fx.flags == fl.flags
+            assert abs(fx.x / 256 - fl.x) <= 2.5 / 256 and abs(fx.y / 256 - fl.y) <= 2.5 / 256
