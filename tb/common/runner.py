@@ -50,7 +50,10 @@ def run_cocotb(sim: str, toplevel: str, sources: list, test_module: str,
     sensor config name and seeds); ``parameters`` are Verilog parameters.
     """
     parameters = dict(parameters or {})
-    key = json.dumps([toplevel, sorted(parameters.items()), tag], default=str)
+    # One build folder per pytest item (and parameter set): pytest-xdist workers never
+    # share a folder, so two tests cannot rebuild the same model at the same time.
+    node = os.environ.get("PYTEST_CURRENT_TEST", "").rsplit(" (", 1)[0]
+    key = json.dumps([toplevel, sorted(parameters.items()), tag, node], default=str)
     h = hashlib.sha1(key.encode()).hexdigest()[:10]
     build_dir = BUILD / sim / f"{toplevel}_{h}"
     waves = waves_requested()
