@@ -5,7 +5,8 @@
 // Block space: words 0..63 are a RAM (a heat-map snapshot, e.g. 4 x 6 cells) that the
 // test preloads through mem_we_i/mem_addr_i/mem_wdata_i; any other word address A reads
 // {~A, A} (a pattern the test predicts).  Registered read, BLK_LAT = 1.
-// Tone-plan windows: TONE_TW / TONE_AMP write and read 32-entry memories at TONE_SEL.
+// Tone-plan windows: TONE_TW / TONE_AMP write and read 32-entry memories at TONE_SEL;
+// calibration windows: CAL_OFFSET / CAL_GAIN 8 x 8 memories at (CAL_ROW, CAL_COL).
 // Status inputs: FRAME_COUNT and STATUS set bits come from the test; CTRL_ERRORS and
 // CTRL_LAST_ERR from the port; STATUS bit 4 is set by every port error.
 // Other read-only registers read fixed patterns (see the localparams).
@@ -84,6 +85,19 @@ module fmt_ctrl_tb_top #(
         if (tone_amp_we) tone_amp_mem[tone_sel] <= tone_amp_wdata;
     end
 
+    // calibration window memories, 8 x 8 cells at {CAL_ROW[2:0], CAL_COL[2:0]}
+    wire [4:0]  cal_row;
+    wire [5:0]  cal_col;
+    wire        cal_off_we, cal_gain_we, cal_off_re, cal_gain_re;
+    wire [15:0] cal_off_wdata, cal_gain_wdata;
+    reg  [15:0] cal_off_mem [0:63];
+    reg  [15:0] cal_gain_mem [0:63];
+    wire [5:0]  cal_idx = {cal_row[2:0], cal_col[2:0]};
+    always @(posedge clk) begin
+        if (cal_off_we)  cal_off_mem[cal_idx]  <= cal_off_wdata;
+        if (cal_gain_we) cal_gain_mem[cal_idx] <= cal_gain_wdata;
+    end
+
     /* verilator lint_off PINCONNECTEMPTY */  // unused rw outputs of the register file
     fmt_regfile u_regs (
         .clk(clk), .rst(rst), .reg_we_i(reg_we), .reg_re_i(reg_re), .reg_addr_i(reg_addr),
@@ -96,9 +110,11 @@ module fmt_ctrl_tb_top #(
         .tone_amp_rdata_i(tone_amp_mem[tone_sel]),
         .touch_threshold_o(), .touch_mode_o(), .contact_limit_o(), .track_max_jump_o(),
         .track_hold_jump_o(), .track_hold_off_o(), .track_vel_shift_o(), .track_max_speed_o(),
-        .blob_threshold_o(), .blob_min_cells_o(), .cal_row_o(), .cal_col_o(),
-        .cal_offset_we_o(), .cal_offset_wdata_o(), .cal_offset_re_o(), .cal_offset_rdata_i(16'h0),
-        .cal_gain_we_o(), .cal_gain_wdata_o(), .cal_gain_re_o(), .cal_gain_rdata_i(16'h0),
+        .blob_threshold_o(), .blob_min_cells_o(), .cal_row_o(cal_row), .cal_col_o(cal_col),
+        .cal_offset_we_o(cal_off_we), .cal_offset_wdata_o(cal_off_wdata), .cal_offset_re_o(cal_off_re),
+        .cal_offset_rdata_i(cal_off_mem[cal_idx]),
+        .cal_gain_we_o(cal_gain_we), .cal_gain_wdata_o(cal_gain_wdata), .cal_gain_re_o(cal_gain_re),
+        .cal_gain_rdata_i(cal_gain_mem[cal_idx]),
         .latency_dial_o(), .report_period_o(),
         .frame_count_i(frame_count_i),
         .status_set_i(status_set_i | {3'b000, err_pulse, 4'b0000}), .status_o(),
@@ -114,7 +130,7 @@ module fmt_ctrl_tb_top #(
         .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o());
     /* verilator lint_on PINCONNECTEMPTY */
 
-    wire unused_ok = &{1'b0, tone_tw_re, tone_amp_re};
+    wire unused_ok = &{1'b0, tone_tw_re, tone_amp_re, cal_off_re, cal_gain_re, cal_row[4:3], cal_col[5:3]};
 
 endmodule
 `default_nettype wire

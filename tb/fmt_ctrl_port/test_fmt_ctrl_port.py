@@ -53,6 +53,7 @@ class TB(ClockedTB):
         self.mem = [0] * 64
         self.tone_tw = {}
         self.tone_amp = {}
+        self.cal = {}                 # (CAL_OFFSET or CAL_GAIN, row & 7, col & 7) -> value
         self.frame_count = 0
         self.err_seen = 0
         self.stream = False
@@ -79,12 +80,19 @@ class TB(ClockedTB):
         inputs = {"FRAME_COUNT": self.frame_count, "CTRL_ERRORS": self.model.err_count,
                   "CTRL_LAST_ERR": self.model.err_last,
                   "TONE_TW": self.tone_tw.get(sel, 0), "TONE_AMP": self.tone_amp.get(sel, 0),
+                  **{k: self.cal.get(self._cal_key(k), 0) for k in ("CAL_OFFSET", "CAL_GAIN")},
                   **FIXED_INPUTS}
         return self.regs.read(addr, inputs)
+
+    def _cal_key(self, name):
+        return (name, self.regs.val["CAL_ROW"] & 7, self.regs.val["CAL_COL"] & 7)
 
     def write_reg(self, addr: int, data: int) -> None:
         self._sync_status()
         sel = self.regs.val["TONE_SEL"]
+        for k in ("CAL_OFFSET", "CAL_GAIN"):
+            if addr == regmap.BY_NAME[k].addr:
+                self.cal[self._cal_key(k)] = data & 0xFFFF
         if addr == regmap.BY_NAME["TONE_TW"].addr:
             self.tone_tw[sel] = data & 0xFFFFFFFF
         elif addr == regmap.BY_NAME["TONE_AMP"].addr:
@@ -142,7 +150,7 @@ class TB(ClockedTB):
 
     async def snapshot(self):
         """Read every readable register range (model-checked)."""
-        for a, n in ((0x000, 3), (0x010, 9), (0x020, 10), (0x030, 4), (0x040, 2), (0x080, 9),
+        for a, n in ((0x000, 3), (0x010, 9), (0x020, 10), (0x030, 2), (0x040, 2), (0x080, 9),
                      (0x090, 16)):
             await self.read(a, n)
 
@@ -166,7 +174,10 @@ async def info_and_registers(dut):
     await tb.write(R("SCRATCH"), [0xCAFEF00D])
     await tb.write(R("RUN"), [rng.getrandbits(32) for _ in range(5)])   # RUN..WINDOWS_M, masked
     await tb.write(R("TOUCH_THRESHOLD"), [rng.getrandbits(32) for _ in range(10)])
-    await tb.write(R("CAL_ROW"), [rng.getrandbits(32) for _ in range(2)])
+    for row, col in ((1, 2), (3, 5), (1, 2)):
+        await tb.write(R("CAL_ROW"), [row, col, rng.getrandbits(16), rng.getrandbits(16)])
+    await tb.write(R("CAL_ROW"), [3, 5])
+    await tb.read(R("CAL_ROW"), 4)
     await tb.write(R("LATENCY_DIAL"), [rng.getrandbits(32) for _ in range(2)])
     await tb.snapshot()
     # w1c: set bits from the core side, clear some from the host
@@ -276,6 +287,17 @@ async def bad_frames(dut):
     assert tb.bfm.pending() == 0, "one reply only"
     tb.model.err_count = before + 1
     tb.model.err_last = P.ERR_FRAMING
+    await tb.read(R("CTRL_ERRORS"), 2)
+    await tb.read(R("SCRATCH"))
+    # receive overflow: the host sends on while a long reply goes out; the good reply
+    # completes, then one OVERFLOW error (SEQ 0), the rest is discarded until idle
+    rd = P.req_read(0x51, 0x090, 16)
+    exp = [b"".join(tb.model.burst(rd))]            # the READ reply (model executes it)
+    exp.append(P.error_reply(0, P.ERR_OVERFLOW, 0))
+    tb.model.err_count += 1
+    tb.model.err_last = P.ERR_OVERFLOW
+    more = P.req_write(0x52, R("SCRATCH"), [0xDEADDEAD]) * 3     # 39 bytes, never executed
+    await tb.burst(rd + more, expect=exp, what="overflow")
     await tb.read(R("CTRL_ERRORS"), 2)
     await tb.read(R("SCRATCH"))
     await tb.snapshot()

@@ -6,7 +6,8 @@ socket://127.0.0.1:<free port>: a TCP server inside the cocotb process whose rec
 bytes are driven into the RTL's rxd at the UART bit rate and whose transmitted bytes
 (decoded from txd) are sent back.  fmtctl runs in a subprocess: info, set/get, a
 heat-map snapshot to .npy compared with the preloaded RAM, the latency report, and
-touches (events offered by the test once fmtctl has turned the stream on).
+touches (events offered by the test once fmtctl has turned the stream on), calibrate
+(on the static RAM) and load-cal (a cell read back through the calibration windows).
 
 Plain pytest tests (no simulator): fmtctl on an unreachable port, on a silent server
 (timeout) and on a server answering with a corrupt CRC prints one line on stderr and
@@ -159,6 +160,24 @@ async def fmtctl_end_to_end(dut):
     assert rc == 0, err
     assert re.search(r"first event\s+last 101 min 100 max 140 count 4242", out), out
     assert re.search(r"trigger -> new contact\s+last 301 min 300 max 340 count 7", out), out
+
+    # calibration: a static heat map gives offsets = the map and unit gains (no signal)
+    calf = Path(env_str("OUT_DIR", "/tmp")) / "cal.json"
+    rc, out, err = await tb.fmtctl("calibrate", "--out", str(calf), "--frames", "1", "--yes")
+    assert rc == 0, err
+    cal = json.loads(calf.read_text())
+    assert np.array_equal(np.array(cal["offset"]), hm) and set(np.ravel(cal["gain"])) == {16384}
+    # load-cal of a random calibration, one cell read back through the windows
+    cal["offset"] = [[rng.getrandbits(16) for _ in range(cols)] for _ in range(rows)]
+    cal["gain"] = [[rng.getrandbits(16) for _ in range(cols)] for _ in range(rows)]
+    calf.write_text(json.dumps(cal))
+    rc, out, err = await tb.fmtctl("load-cal", str(calf))
+    assert rc == 0 and out.strip() == f"loaded {rows * cols} cells", (out, err)
+    r, c = rows - 1, cols - 2
+    for args in (("set", "CAL_ROW", str(r)), ("set", "CAL_COL", str(c))):
+        assert (await tb.fmtctl(*args))[0] == 0
+    rc, out, err = await tb.fmtctl("get", "CAL_GAIN")
+    assert out.strip().startswith(f"CAL_GAIN = {cal['gain'][r][c]} "), (out, err)
 
     # errors reported by fmtctl itself: one line, non-zero
     for args in (("set", "FRAME_COUNT", "5"), ("get", "NO_SUCH_REG"), ("set", "PN_RX_DELAY", "64")):
