@@ -35,7 +35,9 @@
 // in progress), an offered event (evs_valid_i) is taken (evs_ready_o) and sent as one
 // event frame of EV_BYTES bytes (evs_data_i, most significant byte first) with a running
 // SEQ.  With the stream off evs_ready_o is 1 (events are dropped; the core decimates
-// with REPORT_DIV).  Timing at 115200 baud: a 24-byte event frame takes 2.7 ms.
+// with REPORT_PERIOD).  Timing at 115200 baud: an event frame (31 bytes) takes 2.7 ms; the
+// default 128-byte receive FIFO holds any request (<= PAYLOAD_MAX + 7 bytes) arriving
+// meanwhile.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -43,7 +45,7 @@ module fmt_ctrl_port #(
     parameter DIV          = 1085,          // clocks per UART bit (125 MHz / 1085 = 115207 baud)
     parameter TIMEOUT_BITS = 40,            // inter-byte timeout inside a frame, in bit times
     parameter PAYLOAD_MAX  = 64,            // request payload buffer, bytes (>= 8; WRITE of up to (PAYLOAD_MAX-2)/4 words)
-    parameter FIFO_AW      = 4,             // receive FIFO depth 2^FIFO_AW bytes
+    parameter FIFO_AW      = 7,             // receive FIFO depth 2^FIFO_AW bytes (distributed RAM)
     parameter BLK_LAT      = 1,             // block read latency: blk_rdata_i valid BLK_LAT cycles after blk_req_o (>= 1)
     parameter EV_BYTES     = 24,            // event payload bytes (multiple of 4)
     parameter REGMAP_ID    = 0,             // 16-bit register-map id reported by INFO
