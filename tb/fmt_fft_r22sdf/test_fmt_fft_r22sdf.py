@@ -12,6 +12,7 @@ window.  Saturation of the twiddle multiplier is tested in tb/fmt_fft_twiddle.
 """
 from __future__ import annotations
 
+import os
 import random
 from pathlib import Path
 
@@ -281,6 +282,8 @@ def test_fmt_fft_r22sdf_default(sim):
 
 
 @pytest.mark.verilator_only
+@pytest.mark.skipif(os.environ.get("FFT_LONG", "0") in ("", "0"),
+                    reason="long: set FFT_LONG=1 (N = 1024 build and run)")
 def test_fmt_fft_r22sdf_n1024(sim):
     """N = 1024 (the largest size; the last twiddle multiplier has 25-bit data)."""
     cfg = params.DEFAULT.replace(name="n1024", n_fft=1024)
