@@ -38,7 +38,9 @@ first twiddle only +-1 and +-j factors occur and the component bound is exactly
 2^m 2^(IN_W-1), which IN_W + m bits hold after the one-bit-per-stage growth (each stage
 adds a bit, the -j swap only moves a component); after the first twiddle the extra guard
 bit leaves a margin of 2 / sqrt(2) over the bound, far above the rounding errors and the
-twiddle magnitudes (<= 1 + 2^-(TW_W-2)).  The saturation logic is there anyway.
+twiddle magnitudes (<= 1 + 2^-(TW_W-2)).  The overflow flag is there anyway
+(the twiddle multipliers flag a result that does not fit; the optional output
+rounding saturates and flags).
 """
 from __future__ import annotations
 
