@@ -221,7 +221,19 @@ async def block_read(dut):
     await tb.writable()
     dut.mem_we_i.value = 0
     cells = tb.cfg.rows * tb.cfg.cols
-    await tb.request(P.req_blkread(tb.next_seq(), regmap.WINDOW_BY_NAME["HEATMAP"].base, cells), "heat map")
+    n0 = len(tb.bfm.start_times)
+    req = P.req_blkread(tb.next_seq(), regmap.WINDOW_BY_NAME["HEATMAP"].base, cells)
+    await tb.request(req, "heat map")
+    # the reply streams without idle bits (each word is fetched while the previous byte is
+    # on the wire) and starts a fixed few clocks after the request's last stop bit
+    starts = tb.bfm.start_times[n0:]
+    byte_ns = 10 * tb.div * tb.period_ns
+    assert len(starts) == 7 + 4 * cells
+    assert all(b - a == byte_ns for a, b in zip(starts, starts[1:])), "gap inside the reply"
+    turn = (starts[0] - tb.bfm.sent_end_ns) // tb.period_ns
+    dut._log.info(f"turnaround: reply start bit {turn} clocks after the request's stop bit "
+                  f"ended (DIV = {tb.div})")
+    assert turn <= tb.div // 2 + 8
     await tb.request(P.req_blkread(tb.next_seq(), 0x8000, 37), "pattern")
     await tb.request(P.req_blkread(tb.next_seq(), 0xFFFE, 4), "address wrap")
     await tb.request(P.req_blkread(tb.next_seq(), 0, 0), "count 0")

@@ -8,6 +8,7 @@ from __future__ import annotations
 import cocotb
 from cocotb.queue import Queue
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, with_timeout
+from cocotb.utils import get_sim_time
 
 
 class UartBfm:
@@ -19,6 +20,8 @@ class UartBfm:
         self.div = div
         self.rx_queue: Queue = Queue()   # (byte, stop_bit_ok) decoded from txd
         self.bit_errors: list[str] = []
+        self.start_times: list[int] = []     # sim time (ns) of each start bit decoded on txd
+        self.sent_end_ns = 0                 # sim time at the end of the last stop bit we drove
         self.rxd.value = 1
         self._mon = cocotb.start_soon(self._monitor())
 
@@ -29,6 +32,7 @@ class UartBfm:
             self.rxd.value = v
             await ClockCycles(self.clk, self.div)
         self.rxd.value = 1
+        self.sent_end_ns = get_sim_time("ns")
 
     async def send(self, data: bytes, gap_bits: int = 0) -> None:
         for b in data:
@@ -51,6 +55,7 @@ class UartBfm:
         half = self.div // 2
         while True:
             await FallingEdge(self.txd)
+            self.start_times.append(get_sim_time("ns"))
             await ClockCycles(self.clk, half)
             if await self._sample() != 0:
                 self.bit_errors.append("start bit not low at its middle")
