@@ -8,6 +8,7 @@ saturated-cell counter (and its clear), reset in the middle of a frame.
 """
 from __future__ import annotations
 
+import os
 import random
 from pathlib import Path
 
@@ -246,6 +247,9 @@ def test_fmt_flatten(sim, cfg):
 
 
 @pytest.mark.verilator_only
+@pytest.mark.skipif(os.environ.get("FMT_LONG", "0") in ("", "0"),
+                    reason="full-size build: set FMT_LONG=1 (the datapath is per column, "
+                           "SMALL and MEDIUM cover it)")
 def test_fmt_flatten_default(sim):
     cfg = params.DEFAULT
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),

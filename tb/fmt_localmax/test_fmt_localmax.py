@@ -11,7 +11,6 @@ neighbourhoods, a reset in the middle of a frame.  The latency from the last row
 """
 from __future__ import annotations
 
-import os
 import random
 from pathlib import Path
 
