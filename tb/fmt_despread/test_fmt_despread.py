@@ -1,6 +1,7 @@
 """cocotb testbench of rtl/fmt_despread.v against sim/fmt/dds.py despread_fixed.
 
-Checks, under both simulators and two ADC widths: the extreme -2^(B-1) x -1 =
+Checks, under both simulators (ADC_BITS 12; ADC_BITS 7 under Icarus, Verilator too
+with FMT_DDS_FULL=1): the extreme -2^(B-1) x -1 =
 +2^(B-1) (no overflow in B + 1 bits), the full-scale corners, random samples and signs
 with a random ce pattern (the output holds when ce = 0, latency 1 sample), and reset.
 """
@@ -18,6 +19,7 @@ from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.dds import despread_fixed
+from fmt_dds_bank.test_fmt_dds_bank import skip_extra_verilator_build
 
 
 class TB(ClockedTB):
@@ -91,6 +93,7 @@ async def random_with_ce(dut):
 
 @pytest.mark.parametrize("adc_bits", [params.DEFAULT.adc_bits, 7])
 def test_fmt_despread(sim, adc_bits):
+    skip_extra_verilator_build(sim, adc_bits != params.DEFAULT.adc_bits)
     run_cocotb(
         sim=sim,
         toplevel="fmt_despread",

@@ -1,7 +1,8 @@
 """cocotb testbench of rtl/fmt_tx.v (fmt_pn_gen + fmt_dds_bank) against
 sim/fmt/pn.py + sim/fmt/dds.py.
 
-Checks, under both simulators (SMALL and MEDIUM): every DAC word bit-exact with the
+Checks, under both simulators (MEDIUM; SMALL under Icarus, Verilator too with
+FMT_DDS_FULL=1): every DAC word bit-exact with the
 model for random PN settings (chip length, PN enable toggled at random times), random
 DDS settings written at random times, and a reset in the middle of a window; and the
 documented alignment: with rx_delay_i = 3, rx_sign_o is the PN sign of the words on
@@ -21,7 +22,7 @@ from common.runner import rtl_sources, run_cocotb
 from common.tb_util import env_int
 from fmt import dds, params
 from fmt.pn import MAXIMAL_TAPS, lfsr_chips
-from fmt_dds_bank.test_fmt_dds_bank import LATENCY, TB as BankTB, build_args
+from fmt_dds_bank.test_fmt_dds_bank import LATENCY, TB as BankTB, build_args, skip_extra_verilator_build
 
 ALIGN_DELAY = 3   # rx_delay_i that lines rx_sign_o up with the words on dac_o
 
@@ -103,6 +104,7 @@ async def bit_exact_pn_and_settings(dut):
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
 def test_fmt_tx(sim, cfg):
+    skip_extra_verilator_build(sim, cfg is params.SMALL)
     p = cfg.verilog_params()
     parameters = {k: p[k] for k in ("ROWS", "LOG2_N", "BIN_LO", "BIN_STEP", "PHASE_BITS",
                                     "AMP_BITS", "SINE_BITS", "DAC_BITS", "PN_BITS")}
