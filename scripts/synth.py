@@ -91,6 +91,8 @@ def main(argv=None) -> int:
     jobs = []   # (label, top, params)
     for name in module_names():
         entries = cfg.get(name, [{}])
+        if entries == []:       # listed with no entries: a sub-block only synthesized inside its parent
+            continue
         for e in entries:
             label = e.get("label", name)
             jobs.append((label, name, e.get("params", {})))
