@@ -500,7 +500,9 @@ def render_md(res, plots, cmd: str) -> str:
          "* Heat maps: `chain.render_heatmaps` per window (default physics: SNR per window at a "
          "finger centred on a cell), quantised as the fixed receive chain (magnitude word = round(2 x "
          "cell), `rx_fixed.accum_fixed` = `fmt_accum`); touch processing `touch.process_frames(fixed=True)` "
-         "= bit-exact twin of `rtl/fmt_touch.v` (confirmed against the RTL by `tb/fmt_touch`); scoring "
+         "= bit-exact twin of `rtl/fmt_touch.v` (`tb/fmt_touch` checks the RTL against it event for event on "
+         "random and scene heat maps of the MEDIUM sensor: that is the RTL confirmation of this model; the "
+         "sweep's own points are not re-run through the RTL); scoring "
          "`run_sim.evaluate`.",
          "* M = 16 needs `fmt_accum` M_LOG2_MAX = 4 (default 3); M = 40 is modelled with an ideal "
          "divider (round half up of sum / 2M): `fmt_accum` divides by 2^m only.",
@@ -510,6 +512,10 @@ def render_md(res, plots, cmd: str) -> str:
          f"* Latency = (M - 1) windows + window end -> event: receive chain {lat['rx_clk']} clk "
          f"({lat['rx_source']}) + touch processing {lat['touch_clk']} clk ({lat['touch_source']}), "
          f"at {lat['clk_per_sample']} x fs: {lat['window_end_to_event_us']:.2f} us at M = 1.",
+         "* The paper's operating point: 4 kHz frames, each integrated over 40 us and reported 40 us "
+         "later, idle for the rest of the 250 us. Here windows follow back to back: 40 us of integration "
+         "is M = 6.5 (M = 8: 49 us, 20.3 kHz frames), and 4 kHz frames are M = 40 (246 us of integration, "
+         "+8 dB: the better use of the idle time the paper suggests).",
          "* Not swept: the fit's widths (8 fractional bits, 9-bit offset quotient) are constants of "
          "`fmt.interp` and the RTL, not parameters.", "",
          "## Frame rate and latency", "",
