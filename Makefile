@@ -21,7 +21,7 @@ SCENE        ?= sim/scenes/default.json
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim test test-model test-rtl lint synth formal clean distclean iverilog
+.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity clean distclean iverilog
 
 all: test
 
@@ -54,8 +54,29 @@ test-model: setup
 test-rtl: setup
 	$(VPY) -m pytest -q -n $(JOBS) tb
 
+# full-size builds that make test leaves out (Verilator only)
+test-long: setup
+	FMT_LONG=1 FFT_LONG=1 $(VPY) -m pytest -q -n $(JOBS) sim/tests tb
+
 lint: setup
 	@bash scripts/lint.sh
+
+# ---- measurements quoted in the README ----------------------------------------------
+# speed against error: sweep M, SNR, interpolator, widths -> build/report/REPORT.md
+report: setup
+	$(VPY) -m fmt.report --full
+
+bench-model: setup
+	$(VPY) scripts/bench_model.py
+
+fft-accuracy: setup
+	$(VPY) scripts/fft_accuracy.py
+
+interp-accuracy: setup
+	$(VPY) scripts/interp_accuracy.py --n 2000
+
+dds-purity: setup
+	$(VPY) scripts/dds_purity.py
 
 synth: setup
 	$(VPY) scripts/synth.py
