@@ -16,12 +16,13 @@
 // frame, values above M_LOG2_MAX are clamped).  Rows leave in the order their pair
 // completes in the FFT's bit-reversed output (sim/fmt/rx_fixed.py row_order), only in
 // the last window of a frame.
-// Latency (ce cycles, M = 1): from the ce edge that takes a window's last ADC sample
-// to the ce edge that loads row r into the outputs: LATENCY0 (fmt_fft_r22sdf, counted
-// from its input register, which the despread register feeds; 22 at N = 256 with the
-// output rounding) + slot(r) (completion slot, rx_fixed.completion_slots) + 1 (pair
-// split) + ITER + 3 (magnitude) + 2 (accum) = 22 + 251 + 18 = 291 for the last row at
-// N = 256 (measured by tb/fmt_rx_array).
+// Latency (M = 1), from the ce edge that takes a window's last ADC sample: the pair
+// split takes slot s of the window on the ce edge LATENCY0 + s + 1 ce cycles later
+// (LATENCY0 of fmt_fft_r22sdf = 22 at N = 256 with the output rounding, counted from
+// its input register, which the despread register feeds); magnitude ITER + 3 and
+// accum 2 stages follow, on every clk (POST_CLK = 1: 17 clk) or on ce (POST_CLK = 0).
+// Last row at N = 256: 274 ce cycles + 17 clk (ce = 1: 291 cycles; 3 x fs: 839 clk).
+// With POST_CLK = 1 out_valid is a one-clk pulse, else it is held for the ce period.
 // Flags (sticky until reset): fft_ovf_o (FFT internal saturation), sat_o (a cell
 // clipped at 2^HM_W - 1).  The magnitude cannot overflow (fmt_magnitude).
 // Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (columns of one pair).
@@ -40,6 +41,8 @@ module fmt_col_pair_rx #(
     parameter FFT_SHIFT  = (ADC_BITS + LOG2_N - 2 > HM_W) ? ADC_BITS + LOG2_N - 2 - HM_W : 0, // S
     parameter FFT_OUT_W  = ADC_BITS + LOG2_N + 2 - FFT_SHIFT,  // FFT output width (X * 2^-S)
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter POST_CLK   = 1,              // 1: split/magnitude/accum advance on every clk (lower
+                                           //    latency at CLK_PER_SAMPLE > 1), 0: on ce
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
     parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
 ) (
@@ -90,6 +93,12 @@ module fmt_col_pair_rx #(
         .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
         .out_re(f_re), .out_im(f_im), .ovf_o(fft_ovf_o));
 
+    // ---- back-end pipeline enable ----
+    // The FFT's out_valid is 1 only on ce cycles: its outputs are taken on ce edges;
+    // the stages after the pair split's input register run on every clk (POST_CLK = 1)
+    // or on ce (POST_CLK = 0).
+    wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
+
     // ---- window / frame bookkeeping (at the FFT output) ----
     reg                  started_q;
     reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
@@ -125,7 +134,7 @@ module fmt_col_pair_rx #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
     ) u_split (
-        .clk(clk), .rst(rst), .ce(ce),
+        .clk(clk), .rst(rst), .ce(post_ce),
         .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
         .in_tag({m_cur, w_first, w_last}),
         .out_valid(ps_valid), .out_row(ps_row),
@@ -141,10 +150,10 @@ module fmt_col_pair_rx #(
     wire             mg_tag_b;
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag_a (
-        .clk(clk), .rst(rst), .ce(ce), .in_valid(ps_valid), .in_re(ps_ar), .in_im(ps_ai),
+        .clk(clk), .rst(rst), .ce(post_ce), .in_valid(ps_valid), .in_re(ps_ar), .in_im(ps_ai),
         .in_tag({ps_row, ps_tag}), .out_valid(mg_valid), .out_mag(mag_a), .out_tag(mg_tag));
     fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag_b (
-        .clk(clk), .rst(rst), .ce(ce), .in_valid(ps_valid), .in_re(ps_br), .in_im(ps_bi),
+        .clk(clk), .rst(rst), .ce(post_ce), .in_valid(ps_valid), .in_re(ps_br), .in_im(ps_bi),
         .in_tag(1'b0), .out_valid(mg_valid_b), .out_mag(mag_b), .out_tag(mg_tag_b));
 
     // ---- accumulation over the frame ----
@@ -156,7 +165,7 @@ module fmt_col_pair_rx #(
         .ROWS(ROWS), .LANES(2), .D_W(MW), .M_LOG2_MAX(M_LOG2_MAX), .HM_W(HM_W),
         .HM_SHIFT(1), .ROW_W(ROW_W), .SH_W(SH_W)
     ) u_acc (
-        .clk(clk), .rst(rst), .ce(ce),
+        .clk(clk), .rst(rst), .ce(post_ce),
         .in_valid(mg_valid), .in_row(mg_row), .in_data({mag_b, mag_a}),
         .in_first(mg_first), .in_last(mg_last), .in_shift(mg_shift),
         .out_valid(out_valid), .out_row(out_row), .out_data(out_hm), .sat_o(sat_o));

@@ -5,12 +5,14 @@
 //             comb pair completes in the FFT's bit-reversed output, each row once per frame
 //   hm_row    row index, hm_frame frame number (wraps, FRAME_W bits, from 0 after reset)
 //   hm_data   column c at [c*HM_W +: HM_W], unsigned
-//   hm_eof    one clk cycle, on the ce cycle after the frame's last row (never with a row)
-// The stream registers run on clk; a beat is emitted on the clk cycle after a ce cycle
-// (so at CLK_PER_SAMPLE x fs at most one beat per ce period).  Frame = M = 2^m_log2_i
+//   hm_eof    one clk cycle after the frame's last row (POST_CLK = 0: one ce period after);
+//             never with a row (rows are at least one ce period apart)
+// The stream registers run on clk; at most one beat per ce period.  Frame = M = 2^m_log2_i
 // windows (see fmt_col_pair_rx); a reset in the middle of a window drops it and the
 // stream restarts with the first full frame.
-// Latency: fmt_col_pair_rx + 1 clk (stream register).
+// Latency: fmt_col_pair_rx + 1 clk (stream register): N = 256, ce = 1: the last row
+// 292 fs cycles after the window's last ADC sample, hm_eof 293; at 3 x fs (POST_CLK = 1)
+// 840 / 841 clk = 280.0 / 280.3 fs cycles (tb/fmt_rx_array measures it).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = OR
 // of the heat-map cell saturations; ovf_o = either (the magnitude cannot overflow).
 // Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed.
@@ -28,6 +30,7 @@ module fmt_rx_array #(
     parameter FRAME_W    = 16,             // frame counter width
     parameter M_LOG2_MAX = 3,              // largest log2 M
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter POST_CLK   = 1,              // back end after the FFT on every clk (see fmt_col_pair_rx)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
     parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
 ) (
@@ -59,7 +62,7 @@ module fmt_rx_array #(
             fmt_col_pair_rx #(
                 .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
                 .ADC_BITS(ADC_BITS), .HM_W(HM_W), .M_LOG2_MAX(M_LOG2_MAX),
-                .TW_DIR(TW_DIR), .ROW_W(ROW_W), .SH_W(SH_W)
+                .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
             ) u_pair (
                 .clk(clk), .rst(rst), .ce(ce),
                 .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
@@ -83,8 +86,11 @@ module fmt_rx_array #(
     wire [PAIRS-1:0]       unused_last  = p_last;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    reg ce_q;          // the pair outputs were updated on the last edge
+    reg ce_q;          // the pair outputs were updated on the last edge (POST_CLK = 0)
     reg eof_pend_q;    // the frame's last row has gone out, hm_eof follows
+    // POST_CLK = 1: the pair outputs are one-clk pulses; 0: held for a ce period, new
+    // on the clk after a ce edge
+    wire fresh = (POST_CLK != 0) ? 1'b1 : ce_q;
 
     always @(posedge clk) begin
         if (rst) begin
@@ -97,10 +103,10 @@ module fmt_rx_array #(
             ce_q     <= ce;
             hm_valid <= 1'b0;
             hm_eof   <= 1'b0;
-            if (ce_q && p_valid[0]) begin
+            if (fresh && p_valid[0]) begin
                 hm_valid <= 1'b1;
                 if (p_last[0]) eof_pend_q <= 1'b1;
-            end else if (ce_q && eof_pend_q) begin
+            end else if (fresh && eof_pend_q) begin
                 hm_eof     <= 1'b1;
                 eof_pend_q <= 1'b0;
             end
@@ -109,7 +115,7 @@ module fmt_rx_array #(
     end
 
     always @(posedge clk) begin
-        if (ce_q && p_valid[0]) begin
+        if (fresh && p_valid[0]) begin
             hm_row  <= p_row[ROW_W-1:0];
             hm_data <= p_hm;
         end

@@ -138,4 +138,5 @@ def test_fmt_accum(sim, rows, d_w):
         test_dir=Path(__file__).parent,
         parameters=p,
         extra_env={k: v for k, v in p.items() if k != "LANES"},
+        build_args=["-CFLAGS", "-O0"] if sim == "verilator" else None,   # compile time dominates
     )

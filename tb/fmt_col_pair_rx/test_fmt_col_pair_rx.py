@@ -63,10 +63,11 @@ class TB(ClockedTB):
             await ReadOnly()
             if ce:
                 i += 1
-                if int(dut.out_valid.value):
-                    v = int(dut.out_hm.value)
-                    outs.append((int(dut.out_row.value), v & ((1 << hw) - 1), v >> hw,
-                                 int(dut.out_last_row.value)))
+            # POST_CLK = 1 (default): out_valid is a one-clk pulse, on any clk
+            if int(dut.out_valid.value):
+                v = int(dut.out_hm.value)
+                outs.append((int(dut.out_row.value), v & ((1 << hw) - 1), v >> hw,
+                             int(dut.out_last_row.value)))
         return outs
 
 

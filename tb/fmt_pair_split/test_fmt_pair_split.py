@@ -150,4 +150,5 @@ def test_fmt_pair_split(sim, cfg_name):
         parameters={"LOG2_N": cfg.log2_n, "ROWS": cfg.rows, "BIN_LO": cfg.bin_lo,
                     "BIN_STEP": cfg.bin_step, "W": w, "TAG_W": 4},
         extra_env={"CFG": cfg_name, "W": w},
+        build_args=["-CFLAGS", "-O0"] if sim == "verilator" else None,   # compile time dominates
     )

@@ -197,12 +197,19 @@ async def reset_mid_window(dut):
     check_exact(tb, adc, rx, 0, beats, eofs)
 
 
-def latency_formula(cfg):
-    """ce cycles from the ce edge that takes a window's last ADC sample to the ce edge
-    that loads its last row into fmt_col_pair_rx's output (M = 1): the despread register
-    is the FFT's input register's predecessor, which latency0 already counts from."""
+POST_STAGES = 1 + (R.MAG_ITER + 3) + 2        # pair split, magnitude, accum
+
+
+def latency_formula(cfg, every=1, post_clk=1):
+    """clk cycles from the ce edge that takes a window's last ADC sample to the edge
+    that puts its last row on the heat-map stream (M = 1).  The pair split takes slot s
+    on the ce edge latency0 + s + 1 ce cycles later (latency0 counts from the FFT input
+    register, which the despread register feeds); the other POST_STAGES - 1 stages take
+    a clk each (POST_CLK = 1) or a ce period each (POST_CLK = 0); the stream register
+    adds 1 clk."""
     lat0 = fft_fixed.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
-    return lat0 + int(R.completion_slots(cfg).max()) + 1 + (R.MAG_ITER + 3) + 2
+    split = (lat0 + int(R.completion_slots(cfg).max()) + 1) * every
+    return split + (POST_STAGES - 1) * (1 if post_clk else every) + 1
 
 
 @cocotb.test()
@@ -223,9 +230,10 @@ async def latency_and_slow_ce(dut):
         lat_row = beats[cfg.rows - 1][0] - last_in  # clk cycles to the last row beat
         lat_eof = eofs[0][0] - last_in
         # the stream register adds one clk after the ce cycle of the accumulator output
-        exp_row = latency_formula(cfg) * every + 1
+        post_clk = env_int("POST_CLK", 1)
+        exp_row = latency_formula(cfg, every, post_clk)
         assert lat_row == exp_row, f"ce every {every}: last row after {lat_row} clk, formula {exp_row}"
-        assert lat_eof == lat_row + every, f"eof {lat_eof} clk after the last sample"
+        assert lat_eof == lat_row + (1 if post_clk else every), f"eof {lat_eof} clk after the last sample"
         res.append((every, lat_row, lat_eof))
     fs_row = res[0][1]
     us = fs_row / (cfg.fs_hz / 1e6)
@@ -234,16 +242,17 @@ async def latency_and_slow_ce(dut):
             f"({us:.3f} us), -> hm_eof: {res[0][2]} fs cycles; at 3 x fs: {res[1][1]} clk "
             f"({res[1][1] / 3:.2f} fs cycles) / eof {res[1][2]} clk; "
             f"8 us budget = {budget} fs cycles, left for touch processing: {budget - res[0][2]} fs cycles "
-            f"({(budget - res[0][2]) / (cfg.fs_hz / 1e6):.3f} us)\n")
-    out = ROOT / "build" / f"rx_latency_{cfg.name}.txt"
+            f"({(budget - res[0][2]) / (cfg.fs_hz / 1e6):.3f} us) at ce = 1, "
+            f"{budget - res[1][2] / 3:.1f} fs cycles = {3 * budget - res[1][2]} processing clk at 3 x fs\n")
+    out = ROOT / "build" / f"rx_latency_{cfg.name}_postclk{env_int('POST_CLK', 1)}.txt"
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     dut._log.info(text)
 
 
-def _run(sim, cfg_name, extra=None, testcase=None):
+def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1):
     cfg = params.get(cfg_name)
-    env = {"CFG": cfg_name}
+    env = {"CFG": cfg_name, "POST_CLK": post_clk}
     env.update(extra or {})
     run_cocotb(
         sim=sim,
@@ -253,7 +262,7 @@ def _run(sim, cfg_name, extra=None, testcase=None):
         test_dir=Path(__file__).parent,
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
                     "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
-                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"'},
+                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"', "POST_CLK": post_clk},
         extra_env=env,
         testcase=testcase,
         build_args=VERILATOR_ARGS if sim == "verilator" else None,
@@ -263,6 +272,11 @@ def _run(sim, cfg_name, extra=None, testcase=None):
 @pytest.mark.parametrize("cfg_name", ["small", "medium"])
 def test_fmt_rx_array(sim, cfg_name):
     _run(sim, cfg_name)
+
+
+def test_fmt_rx_array_post_on_ce(sim):
+    """POST_CLK = 0 (the back end advances on ce): exact and its latency, small size."""
+    _run(sim, "small", testcase="latency_and_slow_ce", post_clk=0)
 
 
 @pytest.mark.verilator_only
