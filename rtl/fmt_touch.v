@@ -29,7 +29,8 @@ module fmt_touch #(
     parameter CNT_W       = 16,                 // monitor counter width
     parameter ROW_IDX_W   = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
     parameter COL_IDX_W   = (COLS > 1) ? $clog2(COLS) : 1,   // column index width
-    parameter LIM_W       = $clog2(MAX_TOUCHES + 1)          // contact limit width
+    parameter LIM_W       = $clog2(MAX_TOUCHES + 1),         // contact limit width
+    parameter CAL_W       = (HM_W > 16) ? HM_W : 16          // calibration data width
 ) (
     input  wire                  clk,
     input  wire                  rst,                // synchronous, active high
@@ -50,7 +51,10 @@ module fmt_touch #(
     input  wire                  cal_sel_i,          // 0 offset, 1 gain (Q2.14)
     input  wire [ROW_IDX_W-1:0]  cal_row_i,          // cell row
     input  wire [COL_IDX_W-1:0]  cal_col_i,          // cell column
-    input  wire [15:0]           cal_data_i,         // value
+    input  wire [CAL_W-1:0]      cal_data_i,         // value (offset: low HM_W bits, gain: Q2.14)
+    input  wire                  cal_re_i,           // read back cal_row_i/cal_col_i/cal_sel_i
+    output wire                  cal_rvalid_o,       // read-back data valid (one cycle)
+    output wire [CAL_W-1:0]      cal_rdata_o,        // read-back value
     input  wire                  sat_clr_i,          // clear the flattening saturation monitor
     // heat-map stream in
     input  wire                  hm_valid_i,         // one row this cycle
@@ -97,7 +101,8 @@ module fmt_touch #(
     wire [COLS-1:0]        f_sat;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    fmt_flatten #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .FRAME_W(FRAME_W), .CNT_W(CNT_W)) u_flatten (
+    fmt_flatten #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .FRAME_W(FRAME_W), .CNT_W(CNT_W),
+                  .CAL_W(CAL_W)) u_flatten (
         .clk(clk), .rst(rst),
         .hm_valid_i(hm_valid_i), .hm_row_i(hm_row_i), .hm_frame_i(hm_frame_i),
         .hm_data_i(hm_data_i), .hm_eof_i(hm_eof_i),
@@ -105,6 +110,7 @@ module fmt_touch #(
         .hm_sat_o(f_sat), .hm_eof_o(f_eof),
         .cal_we_i(cal_we_i), .cal_sel_i(cal_sel_i), .cal_row_i(cal_row_i),
         .cal_col_i(cal_col_i), .cal_data_i(cal_data_i),
+        .cal_re_i(cal_re_i), .cal_rvalid_o(cal_rvalid_o), .cal_rdata_o(cal_rdata_o),
         .sat_clr_i(sat_clr_i), .sat_flag_o(sat_flag_o), .sat_count_o(sat_count_o));
 
     // ---- local maxima -------------------------------------------------------------

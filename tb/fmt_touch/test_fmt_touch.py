@@ -52,6 +52,7 @@ class TB(ClockedTB):
         d.cal_row_i.value = 0
         d.cal_col_i.value = 0
         d.cal_data_i.value = 0
+        d.cal_re_i.value = 0
         d.sat_clr_i.value = 0
         d.ev_ready_i.value = 1
         d.delay_i.value = 0
