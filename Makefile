@@ -21,7 +21,7 @@ SCENE        ?= sim/scenes/default.json
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity clean distclean iverilog
+.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog
 
 all: test
 
@@ -74,6 +74,10 @@ fft-accuracy: setup
 
 interp-accuracy: setup
 	$(VPY) scripts/interp_accuracy.py --n 2000
+
+# regenerate rtl/fmt_regfile.v and docs/REGISTERS.md from sim/fmt/regmap.py
+regmap: setup
+	$(VPY) -m fmt.regmap --write
 
 dds-purity: setup
 	$(VPY) scripts/dds_purity.py

@@ -17,5 +17,9 @@ for f in "${files[@]}"; do
     echo "iverilog parse FAILED: $f"; echo "$out"; fail=1
   fi
 done
+# generated files must match their sources
+if ! out=$(python -m fmt.regmap --check 2>&1); then
+  echo "register map: generated files are stale (python -m fmt.regmap --write)"; echo "$out"; fail=1
+fi
 if [ $fail -ne 0 ]; then exit 1; fi
 echo "lint: ${#files[@]} RTL files clean (verilator -Wall, iverilog -g2005)"
