@@ -1,5 +1,5 @@
 """Blobs: extended contacts (palm, flat hand, cheek).  The paper left this as future
-work; this module defines it.  (No RTL twin yet: model only.)
+work; this module defines it.  RTL twin: ``rtl/fmt_blob.v`` (``blob_stream_fixed``).
 
 Definition:
 
@@ -97,3 +97,23 @@ def split_touches(hm, candidates, blob_threshold: int, blob_min_cells: int):
     for b in blobs:
         inside |= b.mask
     return [c for c in candidates if not inside[c.row, c.col]], blobs
+
+
+def blob_stream_fixed(hm, blob_threshold: int, blob_min_cells: int, max_blobs: int):
+    """Twin of ``rtl/fmt_blob.v``: ``(records, found, overflow)``.
+
+    ``records`` are the first ``max_blobs`` blobs of ``find_blobs`` (largest first, ties
+    by the raster index of the first cell), each a tuple ``(area, cx_q, cy_q, rmin,
+    cmin, rmax, cmax, peak, peak_row, peak_col)`` in the order of the RTL's blob stream;
+    ``found`` is the number of blobs in the frame, ``overflow = found > max_blobs``
+    (the smaller blobs beyond the limit are dropped: the rule is "keep the max_blobs
+    first in the blob order").  The RTL needs ``blob_threshold >= 1`` (the centroid
+    divides by sum(z) > 0); the unit-weight fallback of ``find_blobs`` for an all-zero
+    region (threshold 0) has no RTL counterpart.
+    """
+    if blob_threshold < 1:
+        raise ValueError("the RTL twin needs blob_threshold >= 1")
+    blobs = find_blobs(hm, blob_threshold, blob_min_cells)
+    recs = [(b.area, b.cx_q, b.cy_q, b.bbox[0], b.bbox[1], b.bbox[2], b.bbox[3], b.peak,
+             b.peak_rc[0], b.peak_rc[1]) for b in blobs[:max_blobs]]
+    return recs, len(blobs), len(blobs) > max_blobs

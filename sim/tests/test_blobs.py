@@ -72,3 +72,32 @@ def test_small_region_is_not_a_blob():
     z[1:3, 1:4] = 5000                               # 6 cells
     assert find_blobs(z, 1000, 12) == []
     assert len(find_blobs(z, 1000, 6)) == 1
+
+
+def test_blob_stream_fixed_order_limit_and_bounds():
+    """The RTL twin: largest first, ties by the first cell's raster index, the first
+    max_blobs kept, overflow when more; centroid within 0.5 LSB of the float value."""
+    from fmt.blobs import blob_stream_fixed
+    rng = np.random.default_rng(9)
+    z = np.zeros((8, 10), dtype=np.int64)
+    z[0, 0] = 7                                  # 1 cell, first in raster order
+    z[0, 8:10] = 9                               # 2 cells
+    z[3:5, 3:5] = [[5, 9], [9, 2]]               # 4 cells, peak 9 twice: first (3, 4)
+    z[7, 9] = 3                                  # 1 cell, last
+    recs, found, over = blob_stream_fixed(z, 1, 1, 8)
+    assert found == 4 and not over
+    assert [r[0] for r in recs] == [4, 2, 1, 1]
+    assert (recs[2][3], recs[2][4]) == (0, 0) and (recs[3][3], recs[3][4]) == (7, 9)
+    assert recs[0][7:] == (9, 3, 4) and recs[0][3:7] == (3, 3, 4, 4)
+    # cx = (5*3 + 9*4 + 9*3 + 2*4) * 256 / 25, round half up
+    assert recs[0][1] == (86 * 256 + 12) // 25
+    recs2, found2, over2 = blob_stream_fixed(z, 1, 1, 3)
+    assert recs2 == recs[:3] and found2 == 4 and over2
+    assert blob_stream_fixed(z, 1, 2, 8)[1] == 2
+    with pytest.raises(ValueError):
+        blob_stream_fixed(z, 0, 1, 8)
+    for _ in range(20):
+        hm = np.where(rng.random((30, 40)) < 0.5, rng.integers(1, 65536, (30, 40)), 0)
+        recs, found, _ = blob_stream_fixed(hm, 1, 1, 1000)
+        for r, b in zip(recs, find_blobs(hm, 1, 1)):
+            assert abs(r[1] - b.cx * 256) <= 0.5 and abs(r[2] - b.cy * 256) <= 0.5

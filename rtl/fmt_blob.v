@@ -1,0 +1,692 @@
+// fmt_blob -- blob detection: 4-connected regions of z >= blob_threshold_i with at least
+// blob_min_cells_i cells, streamed out largest first (twin: sim/fmt/blobs.py,
+// blob_stream_fixed).
+//
+// Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,
+// stored in an inferred RAM of 2 x ROWS words of COLS*HM_W bits (two frame buffers, as
+// in fmt_localmax: the next frame may arrive while this one is finished).  The frame is
+// labelled in raster order as soon as a prefix of rows is present:
+//   F : fetch the next row (synchronous RAM read), threshold it when it becomes current
+//   L : run-serial labelling, one step per cycle.  The current row's remaining on-cells
+//       R give the next run M (lowest run of R).  The previous row's labels P (one label
+//       per column, 0 = background) under M are looked at:
+//         two different labels A, B     -> MERGE(A <- B): B is renamed A in P and in the
+//                                          current row's labels C; the run is retried
+//         one label A                   -> ADD(A): C[M] = A, the run is done
+//         none                          -> NEW(L): lowest free label, C[M] = L
+//       The row ends with its last run (or in one cycle when it has no run): the labels
+//       of P that are no longer in C are closed (their region is complete), P = C.
+//       After the last row every live label is closed.  Labels are slots 1..NL,
+//       NL = 2*ceil(COLS/2) + 6: every label that can be live in two rows (P and C,
+//       ceil(COLS/2) runs each) plus the closed labels still in the pipeline to the close
+//       engine, so the labelling never runs out of labels and never waits (a NEW waits
+//       for a free slot only if that bound were wrong; nothing is ever dropped).
+//   X2..X4: masked sums of the run (area, sum z, sum z*c, sum z*r = r * sum z, peak and
+//       its first column, first/last column), 8-column groups then totals
+//   A : the command updates the per-label accumulators (registers): NEW writes the run,
+//       ADD combines the run, MERGE combines label B into A (B is free again).
+//   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
+//       inserted into a sorted list of MAX_BLOBS entries (area descending, ties by the
+//       raster index of the region's first cell ascending); the smallest falls off.
+// After the frame's hm_eof, once every row is labelled and every label closed, the list
+// is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
+// same for cy) by two pipelined fmt_div (QW + 1 cycles, QW = max index width + 8), one
+// blob per cycle, then blob_eof_o (also for a frame without blobs).
+//
+// Fixed point: blob_cx_o, blob_cy_o are unsigned Q8.8 cells from the centre of cell
+// (0, 0), zero-extended to 16 bits; exact (round half up of the exact rational).
+// Sums are wide enough for a frame of saturated cells: nothing can overflow.
+// blob_threshold_i must be >= 1 (sum z > 0); with 0 an all-zero region would divide
+// by 0 (fmt_div then returns all ones) -- the model refuses threshold 0.
+//
+// Latency (processing-clock cycles, measured by tb/fmt_blob): the labelling takes
+// max(1, runs + merges) cycles per row; from the last row beat to blob_eof_o about
+// ROWS + extra runs + merges + QW + 10 + blobs when the last row to arrive is row 0
+// (worst arrival order).  Throughput: a frame must be finished (blob_eof_o) before the
+// frame after the next one ends (hm_eof), else overrun_o (sticky).  See the README.
+//
+// Settings are used live: change them between frames.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_blob #(
+    parameter ROWS      = `FMT_ROWS,            // heat-map rows
+    parameter COLS      = `FMT_COLS,            // heat-map columns
+    parameter HM_W      = `FMT_HM_W,            // cell width, unsigned
+    parameter MAX_BLOBS = 8,                    // blob list length (blobs reported per frame)
+    parameter FRAME_W   = 16,                   // frame number width
+    parameter ROW_IDX_W = (ROWS > 1) ? $clog2(ROWS) : 1,    // row index width
+    parameter COL_IDX_W = (COLS > 1) ? $clog2(COLS) : 1,    // column index width
+    parameter AREA_W    = $clog2(ROWS * COLS + 1),          // area / min-cells / found width
+    parameter CNT_W     = $clog2(MAX_BLOBS + 1)             // blob count width
+) (
+    input  wire                   clk,
+    input  wire                   rst,               // synchronous, active high
+    // settings
+    input  wire [HM_W-1:0]        blob_threshold_i,  // cell is "on" when z >= threshold (>= 1)
+    input  wire [AREA_W-1:0]      blob_min_cells_i,  // region of >= this many cells is a blob
+    // heat-map stream in
+    input  wire                   hm_valid_i,        // one row this cycle
+    input  wire [ROW_IDX_W-1:0]   hm_row_i,          // row index
+    input  wire [FRAME_W-1:0]     hm_frame_i,        // frame number (taken with hm_eof_i)
+    input  wire [COLS*HM_W-1:0]   hm_data_i,         // column c at [c*HM_W +: HM_W]
+    input  wire                   hm_eof_i,          // end of frame
+    // blob stream out
+    output reg                    blob_valid_o,      // one blob
+    output reg  [FRAME_W-1:0]     blob_frame_o,      // frame number (with valid and eof)
+    output reg  [AREA_W-1:0]      blob_area_o,       // cells
+    output reg  [15:0]            blob_cx_o,         // centroid column, Q8.8
+    output reg  [15:0]            blob_cy_o,         // centroid row, Q8.8
+    output reg  [ROW_IDX_W-1:0]   blob_rmin_o,       // bounding box, inclusive
+    output reg  [COL_IDX_W-1:0]   blob_cmin_o,
+    output reg  [ROW_IDX_W-1:0]   blob_rmax_o,
+    output reg  [COL_IDX_W-1:0]   blob_cmax_o,
+    output reg  [HM_W-1:0]        blob_peak_o,       // largest z of the blob
+    output reg  [ROW_IDX_W-1:0]   blob_peak_row_o,   // first cell (raster order) holding it
+    output reg  [COL_IDX_W-1:0]   blob_peak_col_o,
+    output reg                    blob_eof_o,        // after the frame's last blob
+    output reg  [CNT_W-1:0]       blob_count_o,      // blobs emitted (with blob_eof_o)
+    output reg  [AREA_W-1:0]      blob_found_o,      // blobs in the frame (with blob_eof_o)
+    output reg                    blob_overflow_o,   // found > MAX_BLOBS (with blob_eof_o)
+    output reg                    blob_incomplete_o, // frame had missing rows: no blobs
+    // monitor
+    output reg                    overflow_flag_o,   // sticky: some frame had > MAX_BLOBS blobs
+    output reg                    overrun_o          // sticky: frames arrived faster than processed
+);
+
+    // ---- sizes -------------------------------------------------------------------------
+    // label slots 1..NL: every label live in two rows (P and C) plus the labels closed
+    // at a row end that the close engine has not released yet (<= 6 cycles)
+    localparam NL     = 2 * ((COLS + 1) / 2) + 6;
+    localparam LBL_W  = $clog2(NL + 1);
+    localparam SZ_W   = HM_W + AREA_W;               // sum z
+    localparam SX_W   = SZ_W + COL_IDX_W;            // sum z*c
+    localparam SY_W   = SZ_W + ROW_IDX_W;            // sum z*r
+    localparam IDXMX  = (ROW_IDX_W > COL_IDX_W) ? ROW_IDX_W : COL_IDX_W;
+    localparam QW     = IDXMX + 8;                   // centroid quotient bits (Q8.8)
+    localparam DL     = QW + 1;                      // fmt_div latency
+    localparam NUM_W  = ((SX_W > SY_W) ? SX_W : SY_W) + 9;
+    localparam GS     = 8;                           // columns per partial-sum group
+    localparam NG     = (COLS + GS - 1) / GS;
+    localparam GSZ_W  = HM_W + 4;                    // group sum of <= 8 cells
+    localparam GSX_W  = GSZ_W + COL_IDX_W;
+    localparam ADDR_W = $clog2(2 * ROWS);
+    localparam RW     = COLS * HM_W;
+    localparam IDX_W  = ROW_IDX_W + COL_IDX_W;
+    localparam MB     = MAX_BLOBS;
+    // accumulator / list entry fields
+    localparam O_AREA = 0;
+    localparam O_SZ   = O_AREA + AREA_W;
+    localparam O_SX   = O_SZ + SZ_W;
+    localparam O_SY   = O_SX + SX_W;
+    localparam O_RMIN = O_SY + SY_W;
+    localparam O_RMAX = O_RMIN + ROW_IDX_W;
+    localparam O_CMIN = O_RMAX + ROW_IDX_W;
+    localparam O_CMAX = O_CMIN + COL_IDX_W;
+    localparam O_PEAK = O_CMAX + COL_IDX_W;
+    localparam O_PR   = O_PEAK + HM_W;
+    localparam O_PC   = O_PR + ROW_IDX_W;
+    localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
+    localparam E_W    = O_FC + COL_IDX_W;
+
+    localparam integer ROWS_I = ROWS;
+    localparam integer MB_I   = MAX_BLOBS;
+    localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
+    localparam [ROW_IDX_W:0]   ROWS_R   = ROWS_I[ROW_IDX_W:0];
+    localparam [AREA_W-1:0]    MB_A     = MB_I[AREA_W-1:0];
+    localparam integer LAST_ROW_I = ROWS - 1;
+    localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
+
+    integer i, g;
+
+    // ---- combine two partial regions: X precedes Y's peak in ties unless Y's peak cell
+    // comes first in raster order; first cell = the smaller raster key
+    function [E_W-1:0] combine;
+        input [E_W-1:0] x;
+        input [E_W-1:0] y;
+        reg y_peak, x_first;
+        begin
+            combine = x;
+            combine[O_AREA +: AREA_W] = x[O_AREA +: AREA_W] + y[O_AREA +: AREA_W];
+            combine[O_SZ +: SZ_W]     = x[O_SZ +: SZ_W] + y[O_SZ +: SZ_W];
+            combine[O_SX +: SX_W]     = x[O_SX +: SX_W] + y[O_SX +: SX_W];
+            combine[O_SY +: SY_W]     = x[O_SY +: SY_W] + y[O_SY +: SY_W];
+            if (y[O_RMAX +: ROW_IDX_W] > x[O_RMAX +: ROW_IDX_W])
+                combine[O_RMAX +: ROW_IDX_W] = y[O_RMAX +: ROW_IDX_W];
+            if (y[O_CMIN +: COL_IDX_W] < x[O_CMIN +: COL_IDX_W])
+                combine[O_CMIN +: COL_IDX_W] = y[O_CMIN +: COL_IDX_W];
+            if (y[O_CMAX +: COL_IDX_W] > x[O_CMAX +: COL_IDX_W])
+                combine[O_CMAX +: COL_IDX_W] = y[O_CMAX +: COL_IDX_W];
+            y_peak = (y[O_PEAK +: HM_W] > x[O_PEAK +: HM_W]) ||
+                     ((y[O_PEAK +: HM_W] == x[O_PEAK +: HM_W]) &&
+                      ({y[O_PR +: ROW_IDX_W], y[O_PC +: COL_IDX_W]} <
+                       {x[O_PR +: ROW_IDX_W], x[O_PC +: COL_IDX_W]}));
+            if (y_peak) begin
+                combine[O_PEAK +: HM_W]    = y[O_PEAK +: HM_W];
+                combine[O_PR +: ROW_IDX_W] = y[O_PR +: ROW_IDX_W];
+                combine[O_PC +: COL_IDX_W] = y[O_PC +: COL_IDX_W];
+            end
+            x_first = ({x[O_RMIN +: ROW_IDX_W], x[O_FC +: COL_IDX_W]} <
+                       {y[O_RMIN +: ROW_IDX_W], y[O_FC +: COL_IDX_W]});
+            if (!x_first) begin
+                combine[O_RMIN +: ROW_IDX_W] = y[O_RMIN +: ROW_IDX_W];
+                combine[O_FC +: COL_IDX_W]   = y[O_FC +: COL_IDX_W];
+            end
+        end
+    endfunction
+
+    // ---- frame buffers and arrival bookkeeping (as fmt_localmax) ----------------------
+    reg [RW-1:0]         mem [0:2*ROWS-1];
+    reg [ROWS-1:0]       arr_q [0:1];
+    reg [1:0]            eofs_q;
+    reg [FRAME_W-1:0]    frm_q [0:1];
+    reg                  wb_q, pb_q;
+
+    wire [ADDR_W-1:0] wr_addr = (wb_q ? ROWS_A : {ADDR_W{1'b0}})
+                              + {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
+    always @(posedge clk) begin
+        if (hm_valid_i) mem[wr_addr] <= hm_data_i;
+    end
+    wire [ROWS-1:0] arr_p = arr_q[pb_q];
+
+    localparam [1:0] S_RUN = 2'd0, S_EMIT = 2'd1, S_WAIT = 2'd2;
+    reg [1:0] state_q;
+
+    // ---- F: fetch ----------------------------------------------------------------------
+    reg [ROW_IDX_W:0]   fr_q;                 // next row to fetch (ROWS = all fetched)
+    reg                 nx_v_q;
+    reg [ROW_IDX_W-1:0] nx_row_q;
+    reg [RW-1:0]        nx_z_q;
+    reg                 cur_v_q;
+    reg [ROW_IDX_W-1:0] cur_row_q;
+    reg [RW-1:0]        cur_z_q;
+    reg [COLS-1:0]      rem_q;                // on-cells of the current row not yet labelled
+    wire                row_done;             // the label stage finishes its row this cycle
+    wire                take  = nx_v_q && (!cur_v_q || row_done);
+    wire                fr_in = (fr_q < ROWS_R);
+    wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
+    wire                fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!nx_v_q || take);
+    wire [ADDR_W-1:0]   rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
+                                + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
+    always @(posedge clk) begin
+        if (fetch) nx_z_q <= mem[rd_addr];
+    end
+    reg [COLS-1:0] nx_on;
+    always @(*) begin
+        for (i = 0; i < COLS; i = i + 1)
+            nx_on[i] = (nx_z_q[i*HM_W +: HM_W] >= blob_threshold_i);
+    end
+
+    // ---- L: labelling ------------------------------------------------------------------
+    reg [COLS*LBL_W-1:0] p_q, c_q;            // labels of the previous / current row
+    reg [NL:1]           livep_q, livec_q;    // labels present in P / in C
+    reg [NL:1]           free_q;              // free label slots
+    reg [NL:1]           pend_q;              // closed labels waiting for the close engine
+
+    // rem + lowest set bit clears the lowest run (its carry stops above the run)
+    wire [COLS-1:0] r_low = rem_q & (~rem_q + 1'b1);
+    wire [COLS-1:0] r_sum = rem_q + r_low;
+    wire [COLS-1:0] run_m = rem_q & ~r_sum;                // lowest run of rem_q
+    wire has_run = |rem_q;
+
+    reg [LBL_W-1:0] la, lb, lfree;
+    reg [NL:1] lb_bit, lfree_bit;
+    always @(*) begin
+        la = {LBL_W{1'b0}};
+        for (i = COLS - 1; i >= 0; i = i - 1)
+            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) la = p_q[i*LBL_W +: LBL_W];
+        lb = {LBL_W{1'b0}};
+        for (i = COLS - 1; i >= 0; i = i - 1)
+            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}} && p_q[i*LBL_W +: LBL_W] != la)
+                lb = p_q[i*LBL_W +: LBL_W];
+        lfree = {LBL_W{1'b0}};
+        for (i = NL; i >= 1; i = i - 1)
+            if (free_q[i]) lfree = i[LBL_W-1:0];
+        for (i = 1; i <= NL; i = i + 1) begin
+            lb_bit[i]    = (lb == i[LBL_W-1:0]);
+            lfree_bit[i] = (lfree == i[LBL_W-1:0]);
+        end
+    end
+    wire ha = (la != {LBL_W{1'b0}});
+    wire hb = (lb != {LBL_W{1'b0}});
+    wire fa = (lfree != {LBL_W{1'b0}});
+    wire do_merge = cur_v_q && has_run && hb;
+    wire do_run   = cur_v_q && has_run && !hb && (ha || fa);
+    wire do_new   = do_run && !ha;
+    wire [LBL_W-1:0] lrun = ha ? la : lfree;
+    wire last_row = (cur_row_q == LAST_ROW);
+    assign row_done = cur_v_q && (!has_run || (do_run && ((rem_q & ~run_m) == {COLS{1'b0}})));
+
+    // next label vectors and live masks of this cycle's step
+    reg [COLS*LBL_W-1:0] p_nx, c_nx;
+    reg [NL:1]           livep_nx, livec_nx;
+    always @(*) begin
+        p_nx = p_q;
+        c_nx = c_q;
+        livep_nx = livep_q;
+        livec_nx = livec_q;
+        if (do_merge) begin
+            for (i = 0; i < COLS; i = i + 1) begin
+                if (p_q[i*LBL_W +: LBL_W] == lb) p_nx[i*LBL_W +: LBL_W] = la;
+                if (c_q[i*LBL_W +: LBL_W] == lb) c_nx[i*LBL_W +: LBL_W] = la;
+            end
+            for (i = 1; i <= NL; i = i + 1) begin
+                if (i[LBL_W-1:0] == la && livec_q[i] == 1'b0) livec_nx[i] = |(livec_q & lb_bit);
+            end
+            livep_nx = livep_nx & ~lb_bit;
+            livec_nx = livec_nx & ~lb_bit;
+        end
+        if (do_run) begin
+            for (i = 0; i < COLS; i = i + 1)
+                if (run_m[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
+            for (i = 1; i <= NL; i = i + 1)
+                if (i[LBL_W-1:0] == lrun) livec_nx[i] = 1'b1;
+        end
+    end
+    wire [NL:1] close_k = last_row ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
+
+    // ---- X1: command register ---------------------------------------------------------
+    localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
+    reg                 x1_v_q, x1_end_q, x1_last_q;
+    reg [1:0]           x1_op_q;
+    reg [LBL_W-1:0]     x1_a_q, x1_b_q;
+    reg [COLS-1:0]      x1_m_q;
+    reg [RW-1:0]        x1_zm_q;
+    reg [ROW_IDX_W-1:0] x1_row_q;
+    reg [NL:1]          x1_k_q;
+    reg [RW-1:0]        zm;
+    always @(*) begin
+        for (i = 0; i < COLS; i = i + 1)
+            zm[i*HM_W +: HM_W] = run_m[i] ? cur_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
+    end
+
+    // ---- X2: group sums, run extent ---------------------------------------------------
+    reg                 x2_v_q, x2_end_q, x2_last_q;
+    reg [1:0]           x2_op_q;
+    reg [LBL_W-1:0]     x2_a_q, x2_b_q;
+    reg [ROW_IDX_W-1:0] x2_row_q;
+    reg [NL:1]          x2_k_q;
+    reg [NG*GSZ_W-1:0]  x2_gs_q;
+    reg [NG*GSX_W-1:0]  x2_gx_q;
+    reg [NG*HM_W-1:0]   x2_gm_q;
+    reg [NG*COL_IDX_W-1:0] x2_gc_q;
+    reg [AREA_W-1:0]    x2_cnt_q;
+    reg [COL_IDX_W-1:0] x2_cmin_q, x2_cmax_q;
+    reg [NG*GSZ_W-1:0]  gs;
+    reg [NG*GSX_W-1:0]  gx;
+    reg [NG*HM_W-1:0]   gm;
+    reg [NG*COL_IDX_W-1:0] gc;
+    reg [AREA_W-1:0]    cnt;
+    reg [COL_IDX_W-1:0] cmin, cmax;
+    reg [HM_W-1:0]      zc;
+    always @(*) begin
+        gs = {(NG*GSZ_W){1'b0}};
+        gx = {(NG*GSX_W){1'b0}};
+        gm = {(NG*HM_W){1'b0}};
+        gc = {(NG*COL_IDX_W){1'b0}};
+        for (g = 0; g < NG; g = g + 1) begin
+            for (i = g * GS; i < g * GS + GS; i = i + 1) begin
+                if (i < COLS) begin
+                    zc = x1_zm_q[i*HM_W +: HM_W];
+                    gs[g*GSZ_W +: GSZ_W] = gs[g*GSZ_W +: GSZ_W] + {{(GSZ_W-HM_W){1'b0}}, zc};
+                    gx[g*GSX_W +: GSX_W] = gx[g*GSX_W +: GSX_W]
+                                         + {{(GSX_W-HM_W){1'b0}}, zc} * i[COL_IDX_W-1:0];
+                    if (zc > gm[g*HM_W +: HM_W]) begin    // strict: first maximum
+                        gm[g*HM_W +: HM_W] = zc;
+                        gc[g*COL_IDX_W +: COL_IDX_W] = i[COL_IDX_W-1:0];
+                    end
+                end
+            end
+        end
+        cnt = {AREA_W{1'b0}};
+        cmin = {COL_IDX_W{1'b0}};
+        cmax = {COL_IDX_W{1'b0}};
+        for (i = COLS - 1; i >= 0; i = i - 1) begin
+            cnt = cnt + {{(AREA_W-1){1'b0}}, x1_m_q[i]};
+            if (x1_m_q[i]) cmin = i[COL_IDX_W-1:0];
+        end
+        for (i = 0; i < COLS; i = i + 1)
+            if (x1_m_q[i]) cmax = i[COL_IDX_W-1:0];
+    end
+
+    // ---- X3: totals -----------------------------------------------------------------------
+    reg                 x3_v_q, x3_end_q, x3_last_q;
+    reg [1:0]           x3_op_q;
+    reg [LBL_W-1:0]     x3_a_q, x3_b_q;
+    reg [ROW_IDX_W-1:0] x3_row_q;
+    reg [NL:1]          x3_k_q;
+    reg [AREA_W-1:0]    x3_cnt_q;
+    reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q, x3_pc_q;
+    reg [HM_W-1:0]      x3_pk_q;
+    reg [SZ_W-1:0]      x3_s_q;
+    reg [SX_W-1:0]      x3_sx_q;
+    reg [SZ_W-1:0]      ts;
+    reg [SX_W-1:0]      tx;
+    reg [HM_W-1:0]      tpk;
+    reg [COL_IDX_W-1:0] tpc;
+    always @(*) begin
+        ts = {SZ_W{1'b0}};
+        tx = {SX_W{1'b0}};
+        tpk = {HM_W{1'b0}};
+        tpc = x2_cmin_q;                      // all-zero run (threshold 0): first cell
+        for (g = 0; g < NG; g = g + 1) begin
+            ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            tx = tx + {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            if (x2_gm_q[g*HM_W +: HM_W] > tpk) begin
+                tpk = x2_gm_q[g*HM_W +: HM_W];
+                tpc = x2_gc_q[g*COL_IDX_W +: COL_IDX_W];
+            end
+        end
+    end
+
+    // ---- X4: sum z*r --------------------------------------------------------------------
+    reg                 x4_v_q, x4_end_q, x4_last_q;
+    reg [1:0]           x4_op_q;
+    reg [LBL_W-1:0]     x4_a_q, x4_b_q;
+    reg [NL:1]          x4_k_q;
+    reg [E_W-1:0]       x4_e_q;               // the run as an entry
+    reg [E_W-1:0]       run_e;
+    always @(*) begin
+        run_e = {E_W{1'b0}};
+        run_e[O_AREA +: AREA_W]   = x3_cnt_q;
+        run_e[O_SZ +: SZ_W]       = x3_s_q;
+        run_e[O_SX +: SX_W]       = x3_sx_q;
+        run_e[O_SY +: SY_W]       = {{(SY_W-SZ_W){1'b0}}, x3_s_q} * x3_row_q;
+        run_e[O_RMIN +: ROW_IDX_W] = x3_row_q;
+        run_e[O_RMAX +: ROW_IDX_W] = x3_row_q;
+        run_e[O_CMIN +: COL_IDX_W] = x3_cmin_q;
+        run_e[O_CMAX +: COL_IDX_W] = x3_cmax_q;
+        run_e[O_PEAK +: HM_W]      = x3_pk_q;
+        run_e[O_PR +: ROW_IDX_W]   = x3_row_q;
+        run_e[O_PC +: COL_IDX_W]   = x3_pc_q;
+        run_e[O_FC +: COL_IDX_W]   = x3_cmin_q;
+    end
+
+    // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
+    reg [E_W-1:0] acc_q [1:NL];
+    reg [LBL_W-1:0] cpick;
+    reg [NL:1]      cpick_bit;
+    always @(*) begin
+        cpick = {LBL_W{1'b0}};
+        for (i = NL; i >= 1; i = i - 1)
+            if (pend_q[i]) cpick = i[LBL_W-1:0];
+        for (i = 1; i <= NL; i = i + 1)
+            cpick_bit[i] = (cpick == i[LBL_W-1:0]) && pend_q[i];
+    end
+    wire cl_go = |pend_q;
+    reg           cl_v_q;
+    reg [E_W-1:0] cl_e_q;
+    wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
+    wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
+    wire              cl_blob = cl_v_q && (cl_area >= blob_min_cells_i);
+
+    reg [MB-1:0]  l_v_q;
+    reg [E_W-1:0] l_e_q [0:MB-1];
+    reg [MB-1:0]  better;
+    always @(*) begin
+        for (i = 0; i < MB; i = i + 1)
+            better[i] = l_v_q[i] &&
+                ((l_e_q[i][O_AREA +: AREA_W] > cl_area) ||
+                 ((l_e_q[i][O_AREA +: AREA_W] == cl_area) &&
+                  ({l_e_q[i][O_RMIN +: ROW_IDX_W], l_e_q[i][O_FC +: COL_IDX_W]} < cl_key)));
+    end
+    reg [AREA_W-1:0] found_q;
+    reg              lab_done_q;              // the last row's command has been applied
+
+    // ---- emission -----------------------------------------------------------------------
+    reg [CNT_W-1:0]   em_i_q, em_n_q;
+    reg [FRAME_W-1:0] em_frame_q;
+    reg               em_incomplete_q, em_over_q;
+    reg [AREA_W-1:0]  em_found_q;
+    wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
+    wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
+    /* verilator lint_off UNUSEDSIGNAL */   // entry mux: the dividers use only the sums
+    reg [E_W-1:0]     em_e;
+    /* verilator lint_on UNUSEDSIGNAL */
+    always @(*) begin
+        em_e = l_e_q[0];
+        for (i = 0; i < MB; i = i + 1)
+            if (em_i_q == i[CNT_W-1:0]) em_e = l_e_q[i];
+    end
+    wire [NUM_W-1:0] num_x = {{(NUM_W-SX_W-8){1'b0}}, em_e[O_SX +: SX_W], 8'd0}
+                           + {{(NUM_W-SZ_W+1){1'b0}}, em_e[O_SZ+1 +: SZ_W-1]};
+    wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_e[O_SY +: SY_W], 8'd0}
+                           + {{(NUM_W-SZ_W+1){1'b0}}, em_e[O_SZ+1 +: SZ_W-1]};
+    // valid_o duplicates dl_v_q; ovf_o needs sum z = 0 (threshold 0, unsupported; the
+    // quotient is then all ones)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire          dx_v, dy_v, dx_ovf, dy_ovf;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [QW-1:0] qx, qy;
+    fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_x (
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_x), .den_i(em_e[O_SZ +: SZ_W]),
+        .valid_o(dx_v), .quot_o(qx), .ovf_o(dx_ovf));
+    fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_y (
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_y), .den_i(em_e[O_SZ +: SZ_W]),
+        .valid_o(dy_v), .quot_o(qy), .ovf_o(dy_ovf));
+    // index and end token travel beside the dividers
+    reg [DL-1:0]       dl_v_q, dl_t_q;
+    reg [CNT_W-1:0]    dl_i_q [0:DL-1];
+    wire               out_v   = dl_v_q[DL-1];
+    wire               out_tok = dl_t_q[DL-1];
+    wire [CNT_W-1:0]   out_i   = dl_i_q[DL-1];
+    /* verilator lint_off UNUSEDSIGNAL */   // entry mux: the sums are not output
+    reg [E_W-1:0]      out_e;
+    /* verilator lint_on UNUSEDSIGNAL */
+    always @(*) begin
+        out_e = l_e_q[0];
+        for (i = 0; i < MB; i = i + 1)
+            if (out_i == i[CNT_W-1:0]) out_e = l_e_q[i];
+    end
+
+    wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
+                   || cl_v_q || cl_go;
+    wire complete  = (arr_p == {ROWS{1'b1}});
+    wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
+    wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
+                   && fr_in && !arr_p[fr_row];
+    wire releasing = (state_q == S_WAIT) && out_tok;
+    wire over      = (found_q > MB_A);
+
+    always @(posedge clk) begin
+        // ---- datapath registers (no reset needed) ----
+        if (take) begin
+            cur_z_q   <= nx_z_q;
+            cur_row_q <= nx_row_q;
+        end
+        if (fetch) nx_row_q <= fr_row;
+        x1_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
+        x1_a_q   <= do_merge ? la : lrun;
+        x1_b_q   <= lb;
+        x1_m_q   <= (do_run) ? run_m : {COLS{1'b0}};
+        x1_zm_q  <= zm;
+        x1_row_q <= cur_row_q;
+        x1_end_q <= row_done;
+        x1_last_q <= row_done && last_row;
+        x1_k_q   <= close_k;
+        x2_op_q <= x1_op_q;  x2_a_q <= x1_a_q;  x2_b_q <= x1_b_q;  x2_row_q <= x1_row_q;
+        x2_end_q <= x1_end_q;  x2_last_q <= x1_last_q;  x2_k_q <= x1_k_q;
+        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_gm_q <= gm;  x2_gc_q <= gc;
+        x2_cnt_q <= cnt;  x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
+        x3_op_q <= x2_op_q;  x3_a_q <= x2_a_q;  x3_b_q <= x2_b_q;  x3_row_q <= x2_row_q;
+        x3_end_q <= x2_end_q;  x3_last_q <= x2_last_q;  x3_k_q <= x2_k_q;
+        x3_cnt_q <= x2_cnt_q;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
+        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= tpk;  x3_pc_q <= tpc;
+        x4_op_q <= x3_op_q;  x4_a_q <= x3_a_q;  x4_b_q <= x3_b_q;
+        x4_end_q <= x3_end_q;  x4_last_q <= x3_last_q;  x4_k_q <= x3_k_q;
+        x4_e_q <= run_e;
+        // accumulators
+        if (x4_v_q) begin
+            case (x4_op_q)
+                OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
+                OP_ADD:   acc_q[x4_a_q] <= combine(acc_q[x4_a_q], x4_e_q);
+                OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_q[x4_b_q]);
+                default:  ;
+            endcase
+        end
+        if (cl_go) cl_e_q <= acc_q[cpick];
+        // emission side registers
+        dl_i_q[0] <= em_i_q;
+        for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
+        blob_area_o     <= out_e[O_AREA +: AREA_W];
+        blob_cx_o       <= {{(16-QW){1'b0}}, qx};
+        blob_cy_o       <= {{(16-QW){1'b0}}, qy};
+        blob_rmin_o     <= out_e[O_RMIN +: ROW_IDX_W];
+        blob_cmin_o     <= out_e[O_CMIN +: COL_IDX_W];
+        blob_rmax_o     <= out_e[O_RMAX +: ROW_IDX_W];
+        blob_cmax_o     <= out_e[O_CMAX +: COL_IDX_W];
+        blob_peak_o     <= out_e[O_PEAK +: HM_W];
+        blob_peak_row_o <= out_e[O_PR +: ROW_IDX_W];
+        blob_peak_col_o <= out_e[O_PC +: COL_IDX_W];
+        blob_frame_o    <= em_frame_q;
+
+        if (rst) begin
+            arr_q[0] <= {ROWS{1'b0}};
+            arr_q[1] <= {ROWS{1'b0}};
+            eofs_q   <= 2'b00;
+            wb_q     <= 1'b0;
+            pb_q     <= 1'b0;
+            state_q  <= S_RUN;
+            fr_q     <= {(ROW_IDX_W+1){1'b0}};
+            nx_v_q   <= 1'b0;
+            cur_v_q  <= 1'b0;
+            rem_q    <= {COLS{1'b0}};
+            p_q      <= {(COLS*LBL_W){1'b0}};
+            c_q      <= {(COLS*LBL_W){1'b0}};
+            livep_q  <= {NL{1'b0}};
+            livec_q  <= {NL{1'b0}};
+            free_q   <= {NL{1'b1}};
+            pend_q   <= {NL{1'b0}};
+            x1_v_q   <= 1'b0;
+            x2_v_q   <= 1'b0;
+            x3_v_q   <= 1'b0;
+            x4_v_q   <= 1'b0;
+            cl_v_q   <= 1'b0;
+            l_v_q    <= {MB{1'b0}};
+            found_q  <= {AREA_W{1'b0}};
+            lab_done_q <= 1'b0;
+            em_i_q   <= {CNT_W{1'b0}};
+            em_n_q   <= {CNT_W{1'b0}};
+            em_frame_q <= {FRAME_W{1'b0}};
+            em_incomplete_q <= 1'b0;
+            em_over_q  <= 1'b0;
+            em_found_q <= {AREA_W{1'b0}};
+            dl_v_q   <= {DL{1'b0}};
+            dl_t_q   <= {DL{1'b0}};
+            blob_valid_o      <= 1'b0;
+            blob_eof_o        <= 1'b0;
+            blob_count_o      <= {CNT_W{1'b0}};
+            blob_found_o      <= {AREA_W{1'b0}};
+            blob_overflow_o   <= 1'b0;
+            blob_incomplete_o <= 1'b0;
+            overflow_flag_o   <= 1'b0;
+            overrun_o         <= 1'b0;
+        end else begin
+            // ---- arrivals ----
+            if (hm_valid_i) arr_q[wb_q][hm_row_i] <= 1'b1;
+            if (hm_eof_i) begin
+                eofs_q[wb_q] <= 1'b1;
+                frm_q[wb_q]  <= hm_frame_i;
+                wb_q         <= ~wb_q;
+                if (pb_q != wb_q && !releasing) overrun_o <= 1'b1;
+            end
+
+            // ---- fetch / current row ----
+            if (fetch) fr_q <= fr_q + 1'b1;
+            if (fetch) nx_v_q <= 1'b1;
+            else if (take) nx_v_q <= 1'b0;
+            if (take) begin
+                cur_v_q <= 1'b1;
+                rem_q   <= nx_on;
+            end else if (row_done) begin
+                cur_v_q <= 1'b0;
+                rem_q   <= {COLS{1'b0}};
+            end else if (do_run) begin
+                rem_q   <= rem_q & ~run_m;
+            end
+
+            // ---- labelling state ----
+            if (row_done) begin
+                p_q     <= last_row ? {(COLS*LBL_W){1'b0}} : c_nx;
+                c_q     <= {(COLS*LBL_W){1'b0}};
+                livep_q <= last_row ? {NL{1'b0}} : livec_nx;
+                livec_q <= {NL{1'b0}};
+            end else begin
+                p_q     <= p_nx;
+                c_q     <= c_nx;
+                livep_q <= livep_nx;
+                livec_q <= livec_nx;
+            end
+            free_q <= (free_q & ~(do_new ? lfree_bit : {NL{1'b0}}))
+                    | (do_merge ? lb_bit : {NL{1'b0}})
+                    | cpick_bit;
+            x1_v_q <= do_merge || do_run || row_done;
+            x2_v_q <= x1_v_q;
+            x3_v_q <= x2_v_q;
+            x4_v_q <= x3_v_q;
+            pend_q <= (pend_q & ~cpick_bit) | ((x4_v_q && x4_end_q) ? x4_k_q : {NL{1'b0}});
+            if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
+            cl_v_q <= cl_go;
+
+            // ---- sorted insertion of a closed blob ----
+            if (cl_blob) begin
+                if (found_q != {AREA_W{1'b1}}) found_q <= found_q + 1'b1;
+                for (i = 0; i < MB; i = i + 1) begin
+                    if (!better[i]) begin
+                        if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
+                            l_v_q[i] <= 1'b1;
+                            l_e_q[i] <= cl_e_q;
+                        end else begin
+                            l_v_q[i] <= l_v_q[(i == 0) ? 0 : i - 1];
+                            l_e_q[i] <= l_e_q[(i == 0) ? 0 : i - 1];
+                        end
+                    end
+                end
+            end
+
+            // ---- finish, emit, release ----
+            if (fin_ok || fin_abort) begin
+                state_q         <= S_EMIT;
+                em_i_q          <= {CNT_W{1'b0}};
+                em_n_q          <= (fin_ok && complete) ? (over ? MB_A[CNT_W-1:0] : found_q[CNT_W-1:0])
+                                                        : {CNT_W{1'b0}};
+                em_frame_q      <= frm_q[pb_q];
+                em_incomplete_q <= !(fin_ok && complete);
+                em_over_q       <= fin_ok && complete && over;
+                em_found_q      <= (fin_ok && complete) ? found_q : {AREA_W{1'b0}};
+            end
+            if (em_issue) em_i_q <= em_i_q + 1'b1;
+            if (em_tok) state_q <= S_WAIT;
+            dl_v_q <= {dl_v_q[DL-2:0], em_issue};
+            dl_t_q <= {dl_t_q[DL-2:0], em_tok};
+            blob_valid_o <= out_v;
+            blob_eof_o   <= out_tok;
+            if (out_tok) begin
+                blob_count_o      <= em_n_q;
+                blob_found_o      <= em_found_q;
+                blob_overflow_o   <= em_over_q;
+                blob_incomplete_o <= em_incomplete_q;
+                if (em_over_q) overflow_flag_o <= 1'b1;
+            end
+            if (releasing) begin
+                state_q      <= S_RUN;
+                l_v_q        <= {MB{1'b0}};
+                found_q      <= {AREA_W{1'b0}};
+                lab_done_q   <= 1'b0;
+                fr_q         <= {(ROW_IDX_W+1){1'b0}};
+                arr_q[pb_q]  <= {ROWS{1'b0}};
+                eofs_q[pb_q] <= 1'b0;
+                pb_q         <= ~pb_q;
+                // an aborted frame leaves labels behind: start clean
+                p_q     <= {(COLS*LBL_W){1'b0}};
+                c_q     <= {(COLS*LBL_W){1'b0}};
+                livep_q <= {NL{1'b0}};
+                livec_q <= {NL{1'b0}};
+                free_q  <= {NL{1'b1}};
+            end
+        end
+    end
+
+endmodule
+
+`default_nettype wire
