@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0x0B3E.
+// Register map id 0x02D9.
 `default_nettype none
 
 module fmt_regfile (
@@ -80,6 +80,9 @@ module fmt_regfile (
     input  wire lat_trig_armed_i,                   // LAT_TRIG_ARMED (ro): A trigger is waiting for its new-contact event
     output wire lat_clear_we_o,                     // LAT_CLEAR (strobe): Write 1: clear the latency statistics and histograms (clear_i)
     output wire lat_clear_wdata_o,                  // LAT_CLEAR: write data
+    output wire snap_req_we_o,                      // SNAP_REQ (strobe): Write 1: capture the next whole raw frame into the HEATMAP block window (fmt_core)
+    output wire snap_req_wdata_o,                   // SNAP_REQ: write data
+    input  wire [31:0] snap_status_i,               // SNAP_STATUS (ro): Heat-map snapshot: bit 31 = a snapshot is complete, bit 30 = a capture is pending, bits 15
     output reg  [31:0] reg_rdata_o                  // read data, the cycle after reg_re_i
 );
 
@@ -133,6 +136,8 @@ module fmt_regfile (
     localparam [15:0] A_LAT_TRIG_COUNT = 16'h009B;
     localparam [15:0] A_LAT_TRIG_ARMED = 16'h009C;
     localparam [15:0] A_LAT_CLEAR = 16'h009F;
+    localparam [15:0] A_SNAP_REQ = 16'h00A0;
+    localparam [15:0] A_SNAP_STATUS = 16'h00A1;
 
     // write decode
     wire wr_scratch = reg_we_i && (reg_addr_i == A_SCRATCH);
@@ -163,6 +168,7 @@ module fmt_regfile (
     wire wr_status = reg_we_i && (reg_addr_i == A_STATUS);
     wire wr_sat_clear = reg_we_i && (reg_addr_i == A_SAT_CLEAR);
     wire wr_lat_clear = reg_we_i && (reg_addr_i == A_LAT_CLEAR);
+    wire wr_snap_req = reg_we_i && (reg_addr_i == A_SNAP_REQ);
     assign tone_tw_we_o    = wr_tone_tw;
     assign tone_tw_wdata_o = reg_wdata_i[31:0];
     assign tone_tw_re_o    = reg_re_i && (reg_addr_i == A_TONE_TW);
@@ -179,6 +185,8 @@ module fmt_regfile (
     assign sat_clear_wdata_o = reg_wdata_i[0:0];
     assign lat_clear_we_o    = wr_lat_clear;
     assign lat_clear_wdata_o = reg_wdata_i[0:0];
+    assign snap_req_we_o    = wr_snap_req;
+    assign snap_req_wdata_o = reg_wdata_i[0:0];
 
     always @(posedge clk) begin
         if (rst) begin
@@ -286,6 +294,8 @@ module fmt_regfile (
                 A_LAT_TRIG_COUNT: reg_rdata_o <= lat_trig_count_i;
                 A_LAT_TRIG_ARMED: reg_rdata_o <= {31'h0, lat_trig_armed_i};
                 A_LAT_CLEAR: reg_rdata_o <= 32'h0;
+                A_SNAP_REQ: reg_rdata_o <= 32'h0;
+                A_SNAP_STATUS: reg_rdata_o <= snap_status_i;
                 default: reg_rdata_o <= 32'h0;
             endcase
         end

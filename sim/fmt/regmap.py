@@ -164,6 +164,12 @@ REGISTERS: list[Reg] = [
     R("LAT_TRIG_COUNT", 0x09B, 32, "ro", 0, "Triggers measured."),
     R("LAT_TRIG_ARMED", 0x09C, 1, "ro", 0, "A trigger is waiting for its new-contact event."),
     R("LAT_CLEAR", 0x09F, 1, "strobe", 0, "Write 1: clear the latency statistics and histograms (clear_i)."),
+    # ---- heat-map snapshot (fmt_core) ------------------------------------------------------
+    R("SNAP_REQ", 0x0A0, 1, "strobe", 0,
+      "Write 1: capture the next whole raw frame into the HEATMAP block window (fmt_core)."),
+    R("SNAP_STATUS", 0x0A1, 32, "ro", 0,
+      "Heat-map snapshot: bit 31 = a snapshot is complete, bit 30 = a capture is pending, "
+      "bits 15..0 = frame number of the snapshot."),
 ]
 
 WINDOWS: list[Window] = [

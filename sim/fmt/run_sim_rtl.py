@@ -1,0 +1,532 @@
+"""``make sim`` through the RTL: a scene through ``fmt_core`` under Verilator, the
+fixed-point model in lockstep as the reference.
+
+    python -m fmt.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
+        [--frames F] [--cps 3] [--sim verilator] [--no-plot] [--quiet]
+
+The simulation top ``tb/fmt_core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
+channel ``fmt_channel_sim`` (DAC words x coupling matrix + file noise -> ADC words) +
+a coupling-update player + loggers; Python is off the per-sample path:
+
+1. The scene becomes a coupling plan (:func:`coupling_plan`): the channel matrix G (16
+   fraction bits, ADC LSB per DAC LSB) at sample 0 and stamped updates -- at every window
+   boundary where the coupling changed (moving contacts: the map at the window's first
+   sample, held for the window) and at every sample where a contact's touch starts or
+   ends inside a window (the exact onset sample).  Updates too close together to be
+   loaded in time (one pending-matrix write per clk) are merged into the later one; the
+   model uses the same list, so this costs no exactness.  Noise: white Gaussian words
+   with the scene's sigma, 4 fraction bits, NOISE_LEN samples per column repeating.
+2. The model reference (:func:`model_reference`): ``fmt_tx_fixed`` (DDS + PN) ->
+   3-sample DAC delay -> :func:`channel_fixed` (int64 twin of ``channel_sim_fixed``) ->
+   1-sample ADC register -> ``rx_heatmaps_fixed`` (PN receive delay 4 samples) ->
+   ``touch.process_frames(fixed=True)`` with the scene's calibration.
+3. The cocotb test ``run_scene`` in ``tb/fmt_core/test_fmt_core.py`` programs the
+   registers (calibration, settings, REPORT_PERIOD 0) through the core's local bus,
+   runs the clock and reads the status; the loggers write every heat-map beat, every
+   event and every receiver frame end with its clk cycle.
+4. :func:`analyse` compares heat maps and events bit for bit (events sorted by ID per
+   frame, time stamps excepted), measures latency and accuracy and writes
+   ``<out>/<scene>/report.json``, ``heatmap.png`` and ``latency_hist.png``.
+
+Cycle conventions: cycle 0 = the first clk edge with rst low; channel sample k is formed
+at cycle k * CPS (the ce edges); the receiver takes ADC sample j (= channel sample j - 1)
+at cycle j * CPS; a frame ends at the receiver's last sample of its last window.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import channel as _channel
+from . import dds as _dds
+from . import params as _params
+from . import pn as _pn
+from . import rx_fixed as _rx
+from . import scene as _scene
+from . import sensor as _sensor
+from .settings import TouchSettings
+from .tracking import TrackParams
+
+ROOT = Path(__file__).resolve().parents[2]
+COUP_BITS, COUP_FRAC = 16, 16
+NOISE_BITS, NOISE_FRAC = 16, 4
+DAC_DELAY = 3            # channel sample k multiplies DDS sample k - 3 (fmt_tx + channel input)
+ADC_DELAY = 1            # receiver sample j = channel sample j - 1 (channel output register)
+PN_RX_DELAY = DAC_DELAY + ADC_DELAY   # PN_RX_DELAY register value that aligns the despreaders
+LOAD_MARGIN = 6          # clk cycles of slack per update load
+TYPE_NAMES = {0: "new", 1: "move", 2: "lift", 3: "blob"}
+
+
+def noise_len(cfg) -> int:
+    """Noise samples per column in the channel's file (repeats after this many)."""
+    return 1 << 17 if cfg.rows * cfg.cols >= 400 else 1 << 12
+
+
+def upd_len(cfg) -> int:
+    """Capacity of the coupling-update record memory of the simulation top."""
+    return 1 << 20 if cfg.rows * cfg.cols >= 400 else 1 << 15
+
+
+def job_dir(cfg, cps: int) -> Path:
+    """Fixed folder per build (the file names are Verilog parameters: a fixed path keeps
+    the Verilator build reusable between scenes)."""
+    return ROOT / "build" / "sim_rtl" / f"{cfg.name}_c{cps}"
+
+
+def dac_peak(cfg) -> int:
+    """Peak DDS word of a full-amplitude row (the DAC LSB per unit tone)."""
+    d = _dds.dds_bank_fixed(cfg.n_fft, cfg=cfg)
+    return int(np.abs(d).max())
+
+
+def coupling_scale(cfg) -> float:
+    """Coupling units -> channel G integer: TONE_LSB ADC LSB per unit coupling at the
+    DDS peak word, COUP_FRAC fraction bits."""
+    return _sensor.TONE_LSB / dac_peak(cfg) * (1 << COUP_FRAC)
+
+
+def quantise_g(g: np.ndarray, scale: float) -> np.ndarray:
+    return np.clip(np.rint(g * scale), 0, (1 << COUP_BITS) - 1).astype(np.int64)
+
+
+def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
+    """(g0, updates): the integer matrix in effect from sample 0 and the list of
+    (stamp, G) updates, spaced so that the simulation top's player loads each one (one
+    write per changed cell, then the commit) before its stamp."""
+    cfg = scene.cfg
+    n = cfg.n_fft
+    nw = -(-n_samples // n)
+    wc = _channel.window_coupling(scene, 0, nw)
+    scale = coupling_scale(cfg)
+    by_w = {}
+    for w, mask, m0, _m1 in wc.partial:
+        by_w.setdefault(w, []).append((mask, m0))
+    raw = []
+    for w in range(nw):
+        parts = by_w.get(w, [])
+        cuts = {0}
+        for mask, _ in parts:
+            ch = np.nonzero(np.diff(mask.astype(np.int8)))[0] + 1
+            cuts.update(int(c) for c in ch)
+        for s in sorted(cuts):
+            g = wc.g0[w].copy()
+            for mask, m0 in parts:
+                if mask[s]:
+                    g += m0
+            raw.append((w * n + s, quantise_g(g, scale)))
+    g0 = raw[0][1]
+    kept = [(0, g0)]
+    for stamp, g in raw[1:]:
+        if np.array_equal(g, kept[-1][1]):
+            continue
+        while True:
+            prev_stamp, prev_g = kept[-1]
+            writes = int(np.count_nonzero(g != prev_g))
+            if len(kept) == 1 or prev_stamp * cps + writes + LOAD_MARGIN < stamp * cps:
+                break
+            kept.pop()            # too close: the later update replaces it
+        if len(kept) == 1 and kept[0][0] * cps + int(np.count_nonzero(g != kept[0][1])) + LOAD_MARGIN >= stamp * cps:
+            continue              # cannot load before the stamp right after reset: skip
+        if not np.array_equal(g, kept[-1][1]):
+            kept.append((stamp, g))
+    return g0, kept[1:]
+
+
+def plan_records(cfg, g0, updates) -> list[int]:
+    """64-bit player records (see fmt_core_sim_top.v)."""
+    rec = []
+    prev = np.zeros_like(g0)
+    for stamp, g in [(0, g0)] + list(updates):
+        rr, cc = np.nonzero(g != prev)
+        for r, c in zip(rr.tolist(), cc.tolist()):
+            rec.append((1 << 60) | (r << 52) | (c << 44) | int(g[r, c]))
+        rec.append((2 << 60) | int(stamp))
+        prev = g
+    rec.append(0)
+    return rec
+
+
+def write_records(path, rec) -> None:
+    Path(path).write_text("".join(f"{v:016x}\n" for v in rec))
+
+
+def make_noise(scene: _scene.Scene, length: int) -> np.ndarray:
+    sigma = _channel.scene_noise_sigma(scene)
+    rng = np.random.default_rng(scene.seed + 1000)
+    lim = (1 << (NOISE_BITS - 1)) - 1
+    v = np.rint(rng.standard_normal((length, scene.cfg.cols)) * sigma * (1 << NOISE_FRAC))
+    return np.clip(v, -lim, lim).astype(np.int64)
+
+
+def channel_fixed(dac, g0, updates, noise, adc_bits: int = 12):
+    """int64 twin of ``fmt_channel_sim`` / ``dds.channel_sim_fixed`` (same formula:
+    round half up of sum_r dac*G + noise << 12, >> 16, clip); int64 is exact here
+    (|dac| < 2^11, G < 2^16, ROWS <= 64).  Returns (adc, clipped samples)."""
+    dac = np.asarray(dac, dtype=np.int64)
+    n = dac.shape[0]
+    out = np.empty((n, g0.shape[1]), dtype=np.int64)
+    stamps = [0] + [int(s) for s, _ in updates] + [n]
+    mats = [g0] + [g for _, g in updates]
+    for i, g in enumerate(mats):
+        a, b = min(stamps[i], n), min(stamps[i + 1], n)
+        if b > a:
+            out[a:b] = dac[a:b] @ g
+    if noise is not None:
+        out += noise[np.arange(n) % noise.shape[0]] << (COUP_FRAC - NOISE_FRAC)
+    y = (out + (1 << (COUP_FRAC - 1))) >> COUP_FRAC
+    lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
+    clip = int(np.count_nonzero(((y < lo) | (y > hi)).any(axis=1)))
+    return np.clip(y, lo, hi), clip
+
+
+@dataclass
+class Reference:
+    heatmaps: np.ndarray     # (frames, rows, cols)
+    events: list             # per frame, fmt.touch events
+    clipped: int
+
+
+def pn_of(scene):
+    enable, chip_len, _d, _rx = _channel.pn_settings(scene)
+    return enable, chip_len
+
+
+def model_reference(scene: _scene.Scene, g0, updates, noise, frames: int, settings, cal) -> Reference:
+    from . import touch as _touch
+    cfg = scene.cfg
+    spf = scene.samples_per_frame
+    n = frames * spf
+    enable, chip_len = pn_of(scene)
+    dds = _dds.fmt_tx_fixed(n, cfg, pn_enable=enable, chip_len=chip_len)
+    dac = np.zeros_like(dds)
+    dac[DAC_DELAY:] = dds[:n - DAC_DELAY]
+    adc_ch, clipped = channel_fixed(dac, g0, updates, noise, cfg.adc_bits)
+    adc = np.zeros_like(adc_ch)
+    adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
+    _tx, rx = _pn.pn_signs(n, chip_len=chip_len, enable=enable, rx_delay=PN_RX_DELAY, bits=cfg.pn_bits)
+    rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
+    m_log2 = int(round(math.log2(scene.m)))
+    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m_log2=m_log2)
+    evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
+                                frame_period_s=scene.frame_period_s)
+    return Reference(hm, evs, clipped)
+
+
+def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
+    """(name, value) register writes of a run: PN, M, touch settings, every frame
+    reported, no extra delay."""
+    cfg = scene.cfg
+    enable, chip_len = pn_of(scene)
+    tp = TrackParams.from_settings(cfg, settings, scene.frame_period_s)
+    return [
+        ("PN_RX_DELAY", PN_RX_DELAY), ("PN_ENABLE", int(enable)), ("PN_CHIP_LEN", chip_len),
+        ("WINDOWS_M", scene.m),
+        ("TOUCH_THRESHOLD", settings.threshold),
+        ("TOUCH_MODE", int(settings.neighbourhood == "moore") | (2 if settings.bias_correction else 0)),
+        ("CONTACT_LIMIT", settings.max_touches if settings.max_touches is not None else cfg.max_touches),
+        ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_HOLD_JUMP", tp.hold_jump_q),
+        ("TRACK_HOLD_OFF", tp.hold_off_frames), ("TRACK_VEL_SHIFT", tp.vel_shift),
+        ("TRACK_MAX_SPEED", tp.max_speed_v),
+        ("LATENCY_DIAL", 0), ("REPORT_PERIOD", 0),
+    ]
+
+
+def cal_writes(cfg, cal) -> list:
+    """(name, value) writes loading the calibration (offset, gain) through the windows."""
+    out = []
+    if cal is None:
+        return out
+    off, gain = cal
+    for r in range(cfg.rows):
+        out.append(("CAL_ROW", r))
+        for c in range(cfg.cols):
+            out += [("CAL_COL", c), ("CAL_OFFSET", int(off[r, c])), ("CAL_GAIN", int(gain[r, c]))]
+    return out
+
+
+# ---- logs ------------------------------------------------------------------------------
+def parse_logs(d: Path, cfg):
+    hm_rows, eof, evs, fend = {}, [], [], {}
+    w = cfg.hm_width
+    mask = (1 << w) - 1
+    for line in (d / "hm.log").read_text().splitlines():
+        p = line.split()
+        if p[0] == "R":
+            word = int(p[4], 16)
+            hm_rows.setdefault(int(p[3]), {})[int(p[2])] = (
+                int(p[1]), [(word >> (c * w)) & mask for c in range(cfg.cols)])
+        elif p[0] == "E":
+            eof.append((int(p[1]), int(p[2])))
+    for line in (d / "ev.log").read_text().splitlines():
+        p = line.split()
+        if p[0] == "V":
+            v = [int(x) for x in p[1:]]
+            evs.append({"cycle": v[0], "frame": v[1], "id": v[2], "type_code": v[3], "x_q": v[4],
+                        "y_q": v[5], "strength": v[6], "axis_major_q": v[7], "axis_minor_q": v[8],
+                        "angle": v[9], "flags": v[10], "last": v[11], "time": v[12],
+                        "type": TYPE_NAMES[v[3]]})
+    for line in (d / "fe.log").read_text().splitlines():
+        p = line.split()
+        if p[0] == "F":
+            fend[int(p[2])] = int(p[1])
+    return hm_rows, eof, evs, fend
+
+
+def _key(e) -> tuple:
+    g = (lambda k: e[k]) if isinstance(e, dict) else (lambda k: getattr(e, k))
+    return (g("frame") & 0xFFFF, g("id"), g("type_code"), g("x_q"), g("y_q"), g("strength"),
+            g("axis_major_q"), g("axis_minor_q"), g("angle"), g("flags"))
+
+
+def _stats(v) -> dict:
+    if not v:
+        return {"n": 0, "min": None, "median": None, "max": None}
+    a = np.asarray(v, dtype=np.float64)
+    return {"n": int(a.size), "min": float(a.min()), "median": float(np.median(a)), "max": float(a.max())}
+
+
+def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict, frames: int,
+            wall_s: float, out_dir: Path | None, plot: bool, cal) -> dict:
+    from . import run_sim as _run_sim
+    cfg = scene.cfg
+    clk_hz = cfg.fs_hz * cps
+    hm_rows, eof, evs, fend = parse_logs(d, cfg)
+    # heat maps, frame by frame
+    n_rtl = len(eof)
+    mism = {"heatmap_frames": 0, "event_frames": 0, "first": None}
+    rtl_hm = np.zeros((n_rtl, cfg.rows, cfg.cols), dtype=np.int64)
+    dropped = 0
+    for f in range(frames):
+        rows = hm_rows.get(f & 0xFFFF)
+        if f >= n_rtl or rows is None or len(rows) != cfg.rows:
+            dropped += 1
+            continue
+        for r, (_c, cells) in rows.items():
+            rtl_hm[f, r] = cells
+        if not np.array_equal(rtl_hm[f], ref.heatmaps[f]):
+            mism["heatmap_frames"] += 1
+            if mism["first"] is None:
+                mism["first"] = f"heat map of frame {f}"
+    # events, per frame sorted by ID
+    per = {}
+    for e in evs:
+        per.setdefault(e["frame"], []).append(e)
+    for f in range(min(frames, n_rtl)):
+        got = sorted((_key(e) for e in per.get(f & 0xFFFF, [])), key=lambda t: t[1])
+        exp = sorted((_key(e) for e in ref.events[f]), key=lambda t: t[1])
+        if got != exp:
+            mism["event_frames"] += 1
+            if mism["first"] is None:
+                mism["first"] = f"events of frame {f}: RTL {got} model {exp}"
+    # latency: frame end -> first / last event of the frame
+    first_lat, last_lat = [], []
+    for f, es in per.items():
+        if f in fend and es:
+            first_lat.append((min(e["cycle"] for e in es) - fend[f]) / clk_hz * 1e6)
+            last_lat.append((max(e["cycle"] for e in es) - fend[f]) / clk_hz * 1e6)
+    # onset -> first new event of that contact after the onset (true onset sample)
+    onset_lat = []
+    fs = cfg.fs_hz
+    new_evs = [e for e in evs if e["type"] == "new"]
+    for c in scene.contacts:
+        if c.active is None:
+            continue
+        for on, off in c.intervals_samples(fs):
+            on_cyc = int(on) * cps
+            if on_cyc <= 0 or int(on) >= frames * scene.samples_per_frame:
+                continue
+            x, y = c.position(on / fs)
+            for e in new_evs:
+                if e["cycle"] > on_cyc and math.hypot(e["x_q"] / 256 * cfg.pitch_mm - x,
+                                                      e["y_q"] / 256 * cfg.pitch_mm - y) <= _run_sim.MATCH_MM:
+                    onset_lat.append((e["cycle"] - on_cyc) / clk_hz * 1e6)
+                    break
+    # accuracy from the RTL events
+    frame_events = [per.get(f & 0xFFFF, []) for f in range(min(frames, n_rtl))]
+    det = _run_sim.detections(frame_events, cfg)
+    acc = _run_sim.evaluate(scene.replace(frames=len(det)), det)
+    rate = None
+    if len(eof) > 1:
+        rate = (len(eof) - 1) / ((eof[-1][0] - eof[0][0]) / clk_hz)
+    rep = {
+        "scene": scene.name, "sensor": cfg.name, "path": "rtl", "clk_per_sample": cps,
+        "frames": n_rtl, "frames_requested": frames,
+        "frames_dropped": dropped + int(status.get("EV_DROP_COUNT", 0)),
+        "ev_drop_count": int(status.get("EV_DROP_COUNT", 0)),
+        "heatmap_rate_hz": rate,
+        "events": len(evs),
+        "latency_us": {"window_end_to_event": _stats(first_lat),
+                       "window_end_to_last_event": _stats(last_lat),
+                       "onset_to_event": _stats(onset_lat)},
+        "latency_fs_cycles": {"window_end_to_event_max": (max(first_lat) * fs / 1e6) if first_lat else None,
+                              "window_end_to_last_event_max": (max(last_lat) * fs / 1e6) if last_lat else None},
+        "position_error_mm": acc["position_error_mm"],
+        "jitter_mm": acc["jitter_mm"],
+        "missed": acc["missed"], "false": acc["false"],
+        "golden_mismatches": mism["heatmap_frames"] + mism["event_frames"],
+        "golden_detail": mism,
+        "sim_frames_per_s": n_rtl / max(wall_s, 1e-9),
+        "sim_wall_s": wall_s,
+        "clipped_samples_model": ref.clipped,
+        "status": status,
+    }
+    if out_dir is not None:
+        od = Path(out_dir) / scene.name
+        od.mkdir(parents=True, exist_ok=True)
+        if plot and n_rtl:
+            try:
+                from . import flatten as _flatten
+                from . import plots as _plots
+                flat = _flatten.flatten(rtl_hm, cal[0], cal[1], cfg) if cal is not None else rtl_hm
+                _plots.heatmap_with_tracks(flat, scene.replace(frames=n_rtl),
+                                           _run_sim.tracks(frame_events, cfg), od / "heatmap.png")
+                rep["png"] = str(od / "heatmap.png")
+                latency_histogram(first_lat, last_lat, onset_lat, od / "latency_hist.png")
+                rep["latency_png"] = str(od / "latency_hist.png")
+            except Exception as exc:          # plots are a convenience, never fatal
+                rep["plot_error"] = repr(exc)
+        (od / "report.json").write_text(json.dumps(rep, indent=1) + "\n")
+        rep["report"] = str(od / "report.json")
+    return rep
+
+
+def latency_histogram(first, last, onset, path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    for v, lab in ((first, "window end -> first event"), (last, "window end -> last event"),
+                   (onset, "onset -> new-contact event")):
+        if v:
+            ax.hist(v, bins=40, alpha=0.6, label=lab)
+    ax.axvline(8.0, color="k", ls="--", lw=1, label="8 us")
+    ax.set_xlabel("latency (us)")
+    ax.set_ylabel("count")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# ---- the run ---------------------------------------------------------------------------
+def sim_parameters(cfg, cps: int, d: Path) -> dict:
+    return {"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n, "BIN_LO": cfg.bin_lo,
+            "HM_W": cfg.hm_width, "MAX_TOUCHES": cfg.max_touches, "CLK_PER_SAMPLE": cps,
+            "EV_DEPTH": 2048, "UART_DIV": 4, "TW_DIR": f'"{ROOT / "rtl"}/"',
+            "NOISE_LEN": noise_len(cfg), "NOISE_FILE": f'"{d / "noise.hex"}"',
+            "UPD_LEN": upd_len(cfg), "UPD_FILE": f'"{d / "upd.hex"}"',
+            "HM_LOG": f'"{d / "hm.log"}"', "EV_LOG": f'"{d / "ev.log"}"', "FE_LOG": f'"{d / "fe.log"}"'}
+
+
+def sim_sources() -> list:
+    sys.path.insert(0, str(ROOT / "tb"))
+    rtl = sorted(p for p in (ROOT / "rtl").glob("fmt_*.v"))
+    return rtl + [ROOT / "sim" / "verilog" / "fmt_channel_sim.v",
+                  ROOT / "tb" / "fmt_core" / "fmt_core_sim_top.v"]
+
+
+def build_args(sim: str, fast_sim: bool = True) -> list:
+    """Build options; fast_sim: optimise the model (long runs) rather than the build (tests)."""
+    args = [f'-DFMT_ROM_DIR="{ROOT / "rtl"}/"']
+    if sim == "verilator":
+        args += ["-O3", "--x-assign", "fast", "--x-initial", "fast"] if fast_sim else ["-CFLAGS", "-O0"]
+    return args
+
+
+def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene"):
+    """Write the job folder (records, noise, job.json) and compute the reference."""
+    from . import run_sim as _run_sim
+    cfg = scene.cfg
+    settings = settings or TouchSettings()
+    d = job_dir(cfg, cps)
+    d.mkdir(parents=True, exist_ok=True)
+    n = frames * scene.samples_per_frame
+    g0, updates = coupling_plan(scene, n, cps)
+    rec = plan_records(cfg, g0, updates)
+    if len(rec) > upd_len(cfg):
+        raise ValueError(f"{len(rec)} update records > capacity {upd_len(cfg)}: fewer frames")
+    write_records(d / "upd.hex", rec)
+    noise = make_noise(scene, noise_len(cfg))
+    _dds.write_noise_hex(d / "noise.hex", noise, NOISE_BITS)
+    if cal == "scene":
+        cal = _run_sim.calibration(scene)
+        cal = (np.asarray(cal[0], dtype=np.int64), np.asarray(cal[1], dtype=np.int64))
+    ref = model_reference(scene, g0, updates, noise, frames, settings, cal)
+    # cycles: all frames end, plus the post-processing tail
+    run_cycles = (n + 4) * cps + 2 * scene.samples_per_frame * cps + 1000
+    job = {"frames": frames, "cps": cps, "run_cycles": run_cycles,
+           "reset_cycles": int(np.count_nonzero(g0)) + 16,
+           "cal": cal_writes(cfg, cal), "regs": register_writes(scene, settings),
+           "out": str(d / "result.json"), "n_updates": len(updates)}
+    for f in ("hm.log", "ev.log", "fe.log", "result.json"):
+        (d / f).unlink(missing_ok=True)
+    (d / "job.json").write_text(json.dumps(job))
+    return d, ref, cal, len(updates)
+
+
+def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int = 3,
+        sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None) -> dict:
+    sys.path.insert(0, str(ROOT / "tb"))
+    from common.runner import run_cocotb
+    frames = frames or scene.frames
+    scene = scene.replace(frames=frames)
+    t0 = time.perf_counter()
+    d, ref, cal, n_upd = prepare(scene, frames, cps, settings)
+    t1 = time.perf_counter()
+    env = {"FMT_CORE_JOB": str(d / "job.json"), "FMT_QUIET": int(quiet)}
+    run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=sim_sources(),
+               test_module="test_fmt_core", test_dir=ROOT / "tb" / "fmt_core",
+               testcase="run_scene", parameters=sim_parameters(scene.cfg, cps, d),
+               extra_env=env, build_args=build_args(sim), tag="run_sim_rtl")
+    res = json.loads((d / "result.json").read_text())
+    rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal)
+    rep["model_s"] = t1 - t0
+    rep["coupling_updates"] = n_upd
+    rep["upd_late"] = res.get("upd_late")
+    if out_dir is not None:
+        Path(rep["report"]).write_text(json.dumps({k: v for k, v in rep.items() if k != "report"},
+                                                  indent=1) + "\n")
+    return rep
+
+
+def _summary(rep: dict) -> str:
+    f = lambda v: "n/a" if v is None else f"{v:.3f}"
+    lat = rep["latency_us"]
+    pe = rep["position_error_mm"]
+    return (f"{rep['scene']} (RTL, {rep['sensor']}, {rep['clk_per_sample']} clk/sample): "
+            f"{rep['frames']} frames, dropped {rep['frames_dropped']}, "
+            f"golden mismatches {rep['golden_mismatches']}, "
+            f"window end -> event max {f(lat['window_end_to_event']['max'])} us "
+            f"(last {f(lat['window_end_to_last_event']['max'])} us), onset -> event median "
+            f"{f(lat['onset_to_event']['median'])} us, position rms {f(pe['rms'])} mm, "
+            f"edge rms {f(pe['rms_edge'])} mm, jitter {f(rep['jitter_mm']['max'])} mm, "
+            f"{rep['sim_frames_per_s']:.1f} frames/s simulated")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description="Run a scene through the RTL (fmt_core) under Verilator.")
+    ap.add_argument("--scene", default=str(ROOT / "sim" / "scenes" / "default.json"))
+    ap.add_argument("--out", default=str(ROOT / "build" / "sim"))
+    ap.add_argument("--frames", type=int, default=None)
+    ap.add_argument("--cps", type=int, default=3, help="clk cycles per sample (CLK_PER_SAMPLE)")
+    ap.add_argument("--sim", default="verilator", choices=("verilator", "icarus"))
+    ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--quiet", action="store_true")
+    a = ap.parse_args(argv)
+    sc = _scene.load(a.scene)
+    rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet)
+    print(_summary(rep))
+    print(f"report: {rep['report']}")
+    return 0 if rep["golden_mismatches"] == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
