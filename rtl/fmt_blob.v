@@ -33,6 +33,18 @@
 // same for cy) by two pipelined fmt_div (QW + 1 cycles, QW = max index width + 8), one
 // blob per cycle, then blob_eof_o (also for a frame without blobs).
 //
+// Membership (for removing the fingers inside blobs): the label of every cell at the
+// end of its row is stored (lr_mem), with, per row r and label, whether the label
+// closed at the end of row r was a blob (cf_q).  After the frame a pass from the last
+// row up resolves every cell in one cycle per row: a row-r label that touches an
+// on-cell of row r+1 takes that cell's (already known) status, otherwise its region
+// ended in row r and cf_q tells.  The result (every blob, also those beyond MAX_BLOBS:
+// blobs.blob_mask_fixed) is a ROWS x COLS bit RAM read by row: mask_rd_row_i ->
+// mask_rd_data_o one cycle later.  mask_ready_o (with mask_frame_o) marks it written;
+// it stays readable until the next frame's pass starts (that frame is labelled; never
+// before its last row), reads in between return 0.  An incomplete frame gives
+// mask_ready_o with an all-zero mask.
+//
 // Fixed point: blob_cx_o, blob_cy_o are unsigned Q8.8 cells from the centre of cell
 // (0, 0), zero-extended to 16 bits; exact (round half up of the exact rational).
 // Sums are wide enough for a frame of saturated cells: nothing can overflow.
@@ -40,10 +52,14 @@
 // by 0 (fmt_div then returns all ones) -- the model refuses threshold 0.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_blob): the labelling takes
-// max(1, runs + merges) cycles per row; from the last row beat to blob_eof_o about
-// ROWS + extra runs + merges + QW + 10 + blobs when the last row to arrive is row 0
-// (worst arrival order).  Throughput: a frame must be finished (blob_eof_o) before the
-// frame after the next one ends (hm_eof), else overrun_o (sticky).  See the README.
+// max(1, runs + merges) cycles per row and starts as soon as rows 0..r are present;
+// after the last labelled row: 4 pipeline cycles, one cycle per closed label, then
+// the emission (QW + 3 + blobs cycles) and, in parallel, the membership pass (ROWS + 2).
+// 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
+// 42..47 cycles, -> mask_ready_o 56..61 cycles.  Worst case (checkerboard: 600 runs,
+// every label slot live) 680 cycles from the first row beat to the end: within the
+// 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
+// membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
 // Settings are used live: change them between frames.
 `default_nettype none
@@ -89,6 +105,11 @@ module fmt_blob #(
     output reg  [AREA_W-1:0]      blob_found_o,      // blobs in the frame (with blob_eof_o)
     output reg                    blob_overflow_o,   // found > MAX_BLOBS (with blob_eof_o)
     output reg                    blob_incomplete_o, // frame had missing rows: no blobs
+    // blob membership of the cells (all blobs, also those beyond MAX_BLOBS)
+    output reg                    mask_ready_o,      // the frame's mask is written (one cycle)
+    output reg  [FRAME_W-1:0]     mask_frame_o,      // its frame number (with mask_ready_o)
+    input  wire [ROW_IDX_W-1:0]   mask_rd_row_i,     // row to read
+    output wire [COLS-1:0]        mask_rd_data_o,    // next cycle: bit c = cell (row, c) in a blob
     // monitor
     output reg                    overflow_flag_o,   // sticky: some frame had > MAX_BLOBS blobs
     output reg                    overrun_o          // sticky: frames arrived faster than processed
@@ -285,6 +306,12 @@ module fmt_blob #(
     end
     wire [NL:1] close_k = last_row ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
 
+    // labels of every row at its end (after its merges), for the membership pass
+    reg [COLS*LBL_W-1:0] lr_mem [0:ROWS-1];
+    always @(posedge clk) begin
+        if (row_done) lr_mem[cur_row_q] <= c_nx;
+    end
+
     // ---- X1: command register ---------------------------------------------------------
     localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
     reg                 x1_v_q, x1_end_q, x1_last_q;
@@ -384,6 +411,7 @@ module fmt_blob #(
     reg [1:0]           x4_op_q;
     reg [LBL_W-1:0]     x4_a_q, x4_b_q;
     reg [NL:1]          x4_k_q;
+    reg [ROW_IDX_W-1:0] x4_row_q;
     reg [E_W-1:0]       x4_e_q;               // the run as an entry
     reg [E_W-1:0]       run_e;
     always @(*) begin
@@ -416,6 +444,11 @@ module fmt_blob #(
     wire cl_go = |pend_q;
     reg           cl_v_q;
     reg [E_W-1:0] cl_e_q;
+    reg [ROW_IDX_W-1:0] crow_q [1:NL];        // row at whose end the label was closed
+    reg [ROW_IDX_W-1:0] cl_row_q;
+    reg [LBL_W-1:0]     cl_lbl_q;
+    reg [NL:1]          cf_q [0:ROWS-1];      // cf_q[r][l]: label l closed at the end of
+                                              // row r was a blob
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
     wire              cl_blob = cl_v_q && (cl_area >= blob_min_cells_i);
@@ -479,13 +512,66 @@ module fmt_blob #(
             if (out_i == i[CNT_W-1:0]) out_e = l_e_q[i];
     end
 
+    // ---- M: membership pass, rows ROWS-1 down to 0, one per cycle ---------------------
+    // A label of row r (labels at the row's end: the connected parts of the regions
+    // within rows 0..r) whose cells touch an on-cell of row r+1 continues into the region
+    // of that cell, whose status is known from row r+1's mask; otherwise its region ended
+    // with row r and was closed at the end of row r+1 (the last row's labels: at its own
+    // end): cf_q holds whether it was a blob.
+    reg                  bw_run_q;            // reading rows
+    reg [ROW_IDX_W-1:0]  bw_r_q;              // next row to read
+    reg                  bw_v_q;              // lr_rd_q holds row bw_row_q
+    reg [ROW_IDX_W-1:0]  bw_row_q;
+    reg [COLS*LBL_W-1:0] lr_rd_q, lrn_q;      // labels of row r and of row r+1
+    reg [COLS-1:0]       mn_q;                // mask of row r+1
+    reg [COLS-1:0]       mask_mem [0:ROWS-1];
+    reg [COLS-1:0]       mask_rd_q;
+    reg                  mask_ok_q;           // the mask holds a complete frame
+    reg                  bw_busy_q;           // the frame's membership pass is not done
+    reg                  tok_q;               // the frame's blob_eof went out
+    always @(posedge clk) begin
+        if (bw_run_q) lr_rd_q <= lr_mem[bw_r_q];
+    end
+    wire                 bw_first = (bw_row_q == LAST_ROW);
+    wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
+    wire [NL:1]          cfr      = cf_q[cf_row];
+    reg [COLS-1:0]  bw_d, bw_dv, bw_m;
+    reg [NL:1]      bw_cont, bw_st;
+    reg [LBL_W-1:0] lc;
+    always @(*) begin
+        for (i = 0; i < COLS; i = i + 1) begin
+            bw_d[i]  = (lr_rd_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) && !bw_first
+                     && (lrn_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}});
+            bw_dv[i] = bw_d[i] && mn_q[i];
+        end
+        bw_cont = {NL{1'b0}};
+        bw_st   = {NL{1'b0}};
+        for (g = 1; g <= NL; g = g + 1)
+            for (i = 0; i < COLS; i = i + 1)
+                if (lr_rd_q[i*LBL_W +: LBL_W] == g[LBL_W-1:0]) begin
+                    bw_cont[g] = bw_cont[g] | bw_d[i];
+                    bw_st[g]   = bw_st[g] | bw_dv[i];
+                end
+        for (i = 0; i < COLS; i = i + 1) begin
+            lc = lr_rd_q[i*LBL_W +: LBL_W];
+            bw_m[i] = 1'b0;
+            for (g = 1; g <= NL; g = g + 1)
+                if (lc == g[LBL_W-1:0]) bw_m[i] = bw_cont[g] ? bw_st[g] : cfr[g];
+        end
+    end
+    always @(posedge clk) begin
+        if (bw_v_q) mask_mem[bw_row_q] <= bw_m;
+        mask_rd_q <= mask_mem[mask_rd_row_i];
+    end
+    assign mask_rd_data_o = mask_rd_q & {COLS{mask_ok_q}};
+
     wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
                    || cl_v_q || cl_go;
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
     wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
                    && fr_in && !arr_p[fr_row];
-    wire releasing = (state_q == S_WAIT) && out_tok;
+    wire releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
     always @(posedge clk) begin
@@ -515,6 +601,7 @@ module fmt_blob #(
         x4_op_q <= x3_op_q;  x4_a_q <= x3_a_q;  x4_b_q <= x3_b_q;
         x4_end_q <= x3_end_q;  x4_last_q <= x3_last_q;  x4_k_q <= x3_k_q;
         x4_e_q <= run_e;
+        x4_row_q <= x3_row_q;
         // accumulators
         if (x4_v_q) begin
             case (x4_op_q)
@@ -524,7 +611,16 @@ module fmt_blob #(
                 default:  ;
             endcase
         end
-        if (cl_go) cl_e_q <= acc_q[cpick];
+        if (cl_go) begin
+            cl_e_q   <= acc_q[cpick];
+            cl_row_q <= crow_q[cpick];
+            cl_lbl_q <= cpick;
+        end
+        if (x4_v_q && x4_end_q) begin
+            for (i = 1; i <= NL; i = i + 1)
+                if (x4_k_q[i]) crow_q[i] <= x4_row_q;
+        end
+        if (cl_v_q) cf_q[cl_row_q][cl_lbl_q] <= (cl_area >= blob_min_cells_i);
         // emission side registers
         dl_i_q[0] <= em_i_q;
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
@@ -573,6 +669,14 @@ module fmt_blob #(
             em_found_q <= {AREA_W{1'b0}};
             dl_v_q   <= {DL{1'b0}};
             dl_t_q   <= {DL{1'b0}};
+            bw_run_q  <= 1'b0;
+            bw_r_q    <= {ROW_IDX_W{1'b0}};
+            bw_v_q    <= 1'b0;
+            bw_busy_q <= 1'b0;
+            tok_q     <= 1'b0;
+            mask_ok_q <= 1'b0;
+            mask_ready_o <= 1'b0;
+            mask_frame_o <= {FRAME_W{1'b0}};
             blob_valid_o      <= 1'b0;
             blob_eof_o        <= 1'b0;
             blob_count_o      <= {CNT_W{1'b0}};
@@ -655,6 +759,37 @@ module fmt_blob #(
                 em_over_q       <= fin_ok && complete && over;
                 em_found_q      <= (fin_ok && complete) ? found_q : {AREA_W{1'b0}};
             end
+            // membership pass (complete frames), in parallel with the emission
+            mask_ready_o <= 1'b0;
+            if (fin_ok) begin
+                bw_run_q  <= 1'b1;
+                bw_r_q    <= LAST_ROW;
+                bw_busy_q <= 1'b1;
+                mask_ok_q <= 1'b0;
+            end
+            if (fin_abort) begin
+                mask_ready_o <= 1'b1;
+                mask_frame_o <= frm_q[pb_q];
+                mask_ok_q    <= 1'b0;
+            end
+            bw_v_q   <= bw_run_q;
+            bw_row_q <= bw_r_q;
+            if (bw_run_q) begin
+                if (bw_r_q == {ROW_IDX_W{1'b0}}) bw_run_q <= 1'b0;
+                else                             bw_r_q   <= bw_r_q - 1'b1;
+            end
+            if (bw_v_q) begin
+                lrn_q <= lr_rd_q;
+                mn_q  <= bw_m;
+                if (bw_row_q == {ROW_IDX_W{1'b0}}) begin
+                    bw_busy_q    <= 1'b0;
+                    mask_ready_o <= 1'b1;
+                    mask_frame_o <= em_frame_q;
+                    mask_ok_q    <= 1'b1;
+                end
+            end
+            if (out_tok) tok_q <= 1'b1;
+
             if (em_issue) em_i_q <= em_i_q + 1'b1;
             if (em_tok) state_q <= S_WAIT;
             dl_v_q <= {dl_v_q[DL-2:0], em_issue};
@@ -670,6 +805,7 @@ module fmt_blob #(
             end
             if (releasing) begin
                 state_q      <= S_RUN;
+                tok_q        <= 1'b0;
                 l_v_q        <= {MB{1'b0}};
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;

@@ -117,3 +117,14 @@ def blob_stream_fixed(hm, blob_threshold: int, blob_min_cells: int, max_blobs: i
     recs = [(b.area, b.cx_q, b.cy_q, b.bbox[0], b.bbox[1], b.bbox[2], b.bbox[3], b.peak,
              b.peak_rc[0], b.peak_rc[1]) for b in blobs[:max_blobs]]
     return recs, len(blobs), len(blobs) > max_blobs
+
+
+def blob_mask_fixed(hm, blob_threshold: int, blob_min_cells: int) -> np.ndarray:
+    """Twin of the membership mask of ``rtl/fmt_blob.v`` (``mask_rd_data_o``): bool
+    (rows, cols), True for the cells of every blob (also those beyond the RTL's
+    MAX_BLOBS list); the same cells ``split_touches`` removes fingers from."""
+    z = np.asarray(hm, dtype=np.int64)
+    inside = np.zeros(z.shape, dtype=bool)
+    for b in find_blobs(z, blob_threshold, blob_min_cells):
+        inside |= b.mask
+    return inside

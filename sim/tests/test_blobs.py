@@ -101,3 +101,14 @@ def test_blob_stream_fixed_order_limit_and_bounds():
         recs, found, _ = blob_stream_fixed(hm, 1, 1, 1000)
         for r, b in zip(recs, find_blobs(hm, 1, 1)):
             assert abs(r[1] - b.cx * 256) <= 0.5 and abs(r[2] - b.cy * 256) <= 0.5
+
+
+def test_blob_mask_fixed_is_union_of_blob_masks():
+    from fmt.blobs import blob_mask_fixed
+    z = np.zeros((6, 8), dtype=np.int64)
+    z[0, 0:3] = 10                 # 3 cells
+    z[2:5, 5] = 10                 # 3 cells
+    z[5, 0] = 10                   # 1 cell
+    m = blob_mask_fixed(z, 5, 3)
+    assert m.sum() == 6 and m[0, 0] and m[4, 5] and not m[5, 0]
+    assert not blob_mask_fixed(z, 5, 4).any()

@@ -24,7 +24,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt.blobs import blob_stream_fixed, label_regions
+from fmt.blobs import blob_mask_fixed, blob_stream_fixed, label_regions
 
 MAX_BLOBS = 8
 
@@ -40,9 +40,11 @@ class TB(ClockedTB):
         self.div_lat = max((self.rows - 1).bit_length(), (self.cols - 1).bit_length()) + 9
         self.cycle = 0
         self.frames = []
+        self.masks = []            # (frame, mask, cycle of mask_ready) per frame
         self.cur = []
         self.set(1000, 3)
-        for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i"):
+        for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i",
+                  "mask_rd_row_i"):
             getattr(dut, s).value = 0
         self.mon = None
 
@@ -50,6 +52,7 @@ class TB(ClockedTB):
         await super().reset(cycles)
         if self.mon is None:
             self.mon = cocotb.start_soon(self.monitor())
+            cocotb.start_soon(self.mask_reader())
 
     def set(self, threshold, min_cells):
         self.thr, self.minc = threshold, min_cells
@@ -81,6 +84,26 @@ class TB(ClockedTB):
                                         cycle=self.cycle))
                 self.cur = []
 
+    async def mask_reader(self):
+        """On mask_ready_o read the whole mask back through the read port, one row per
+        cycle (data one cycle after the address)."""
+        d = self.dut
+        while True:
+            await RisingEdge(self.clk)
+            await ReadOnly()
+            if int(d.rst.value) or not int(d.mask_ready_o.value):
+                continue
+            frame, cyc = int(d.mask_frame_o.value), self.cycle
+            m = np.zeros((self.rows, self.cols), dtype=bool)
+            for r in range(self.rows):
+                await self.writable()
+                d.mask_rd_row_i.value = r
+                await RisingEdge(self.clk)
+                await ReadOnly()
+                v = int(d.mask_rd_data_o.value)
+                m[r] = [(v >> c) & 1 for c in range(self.cols)]
+            self.masks.append((frame, m, cyc))
+
     def pack(self, row) -> int:
         v = 0
         for c, x in enumerate(row):
@@ -92,7 +115,7 @@ class TB(ClockedTB):
         and at most one merge), closes, divider and list."""
         on = np.asarray(hm) >= self.thr
         runs = int((on[:, 1:] & ~on[:, :-1]).sum() + on[:, 0].sum())
-        return self.rows + 2 * runs + 2 * self.mb + self.div_lat + 40
+        return 2 * self.rows + 2 * runs + 2 * self.mb + self.div_lat + 40
 
     def schedule(self, rng, hms, first_frame=0, gap_p=0.0, order=None):
         """Rows of each frame (random order unless given), random gaps, eof right after
@@ -145,6 +168,13 @@ class TB(ClockedTB):
             await RisingEdge(self.clk)
         raise AssertionError(f"only {len(self.frames)} of {n_frames} frames came out")
 
+    async def drain_masks(self, n_masks, timeout=20000):
+        for _ in range(timeout):
+            if len(self.masks) >= n_masks:
+                return
+            await RisingEdge(self.clk)
+        raise AssertionError(f"only {len(self.masks)} of {n_masks} masks came out")
+
     def expect(self, rec, hm, frame):
         want, found, over = blob_stream_fixed(hm, self.thr, self.minc, self.mb)
         got = [x[:10] for x in rec["blobs"]]
@@ -160,16 +190,23 @@ class TB(ClockedTB):
         return found
 
     async def run_frames(self, rng, hms, first_frame=0, gap_p=0.0, order=None):
-        """Drive, check; returns per frame (last row -> blob_eof, hm_eof -> blob_eof,
-        blobs found)."""
-        n0 = len(self.frames)
+        """Drive, check the blob streams and the membership masks; returns per frame
+        (last row -> blob_eof, hm_eof -> blob_eof, blobs found, last row -> mask_ready)."""
+        n0, m0 = len(self.frames), len(self.masks)
         marks = await self.drive(self.schedule(rng, hms, first_frame, gap_p, order))
         await self.drain(n0 + len(hms))
+        await self.drain_masks(m0 + len(hms))
         out = []
         for i, hm in enumerate(hms):
             rec = self.frames[n0 + i]
-            found = self.expect(rec, hm, (first_frame + i) & 0xFFFF)
-            out.append((rec["cycle"] - marks[i][0], rec["cycle"] - marks[i][1], found))
+            frame = (first_frame + i) & 0xFFFF
+            found = self.expect(rec, hm, frame)
+            mframe, mask, mcyc = self.masks[m0 + i]
+            want = blob_mask_fixed(hm, self.thr, self.minc)
+            assert mframe == frame
+            assert np.array_equal(mask, want), f"frame {frame}: mask\n{mask.astype(int)}\nwant\n{want.astype(int)}"
+            out.append((rec["cycle"] - marks[i][0], rec["cycle"] - marks[i][1], found,
+                        mcyc - marks[i][0]))
         return out
 
 
@@ -276,7 +313,7 @@ async def random_bitmaps(dut):
             hms = [bitmap_hm(nrng, random_on(nrng, tb.rows, tb.cols, density), thr)
                    for _ in range(2)]
             res = await tb.run_frames(rng, hms, frame, gap_p=rng.choice([0.0, 0.3]))
-            n_over += sum(found > tb.mb for _, _, found in res)
+            n_over += sum(found > tb.mb for _, _, found, _ in res)
             frame += 2
     if tb.rows * tb.cols >= 80:                        # too few cells on SMALL
         assert n_over > 0, "no frame exceeded MAX_BLOBS"
@@ -298,7 +335,7 @@ async def shapes(dut):
         assert label_regions(hms[0], 1000)[1] == 1
         res = await tb.run_frames(rng, hms, frame)
         if minc == 1:                                # the checkerboard overflows the list
-            assert max(found for _, _, found in res) > tb.mb
+            assert max(found for _, _, found, _ in res) > tb.mb
         frame += len(hms)
     # min-cells exactly at a region's area, and one above
     z = bitmap_hm(nrng, maps["U"], 1000)
@@ -321,7 +358,7 @@ async def palms(dut):
     hms.append(np.full((tb.rows, tb.cols), 300, dtype=np.int64))       # nothing on
     res = await tb.run_frames(rng, hms, 40, gap_p=0.2)
     if tb.rows * tb.cols >= 80:
-        assert all(found >= 1 for _, _, found in res[:3]), "the palm is a blob"
+        assert all(found >= 1 for _, _, found, _ in res[:3]), "the palm is a blob"
     assert res[3][2] == 0
 
 
@@ -343,6 +380,8 @@ async def reset_mid_frame(dut):
     await tb.drain(n0 + 1)
     rec = tb.frames[n0]
     assert rec["incomplete"] == 1 and rec["count"] == 0 and rec["blobs"] == []
+    await tb.drain_masks(1)
+    assert tb.masks[-1][0] == 3 and not tb.masks[-1][1].any()
     hms = [bitmap_hm(nrng, random_on(nrng, tb.rows, tb.cols, 0.5), 1000) for _ in range(2)]
     await tb.run_frames(rng, hms, 4)
 
@@ -362,22 +401,23 @@ async def latency(dut):
     order = sorted(range(tb.rows), key=lambda r: slot(cfg.bins[r]))
     tb.set(1500, 6)
     hms = [palm_scene(cfg, nrng) for _ in range(2)] + [np.zeros((tb.rows, tb.cols), np.int64)]
-    for (from_row, from_eof, n), hm in zip(await tb.run_frames(rng, hms, 100, order=order), hms):
+    for (from_row, from_eof, n, mlat), hm in zip(await tb.run_frames(rng, hms, 100, order=order), hms):
         on = hm >= tb.thr
         runs = int((on[:, 1:] & ~on[:, :-1]).sum() + on[:, 0].sum())
         dut._log.info(f"latency: last row -> blob_eof {from_row} cycles, hm_eof -> blob_eof "
-                      f"{from_eof} cycles, {n} blobs, {runs} runs")
+                      f"{from_eof} cycles, last row -> mask_ready {mlat} cycles, {n} blobs, {runs} runs")
         assert from_row <= tb.rows + 2 * runs + tb.div_lat + 12 + min(n, tb.mb), "latency bound"
+        assert mlat <= 2 * tb.rows + 2 * runs + 12, "mask latency bound"
     # worst cases: processing time (rows in order, one per cycle) against 3N cycles
     period = 3 * (1 << bits)
     maps = shape_maps(tb.rows, tb.cols)
     tb.set(1000, 1)
     for name in ("checker", "comb", "comb2", "stairs"):
         hm = bitmap_hm(nrng, maps[name], 1000)
-        (from_row, from_eof, n), = await tb.run_frames(rng, [hm], 200, order=list(range(tb.rows)))
-        total = from_row + tb.rows
-        dut._log.info(f"worst case {name}: last row -> blob_eof {from_row} cycles, first row "
-                      f"-> blob_eof {total}, frame period {period}")
+        (from_row, from_eof, n, mlat), = await tb.run_frames(rng, [hm], 200, order=list(range(tb.rows)))
+        total = max(from_row, mlat) + tb.rows
+        dut._log.info(f"worst case {name}: last row -> blob_eof {from_row} cycles, -> mask_ready "
+                      f"{mlat}, first row -> done {total}, frame period {period}")
         assert total < period, "a frame must be processed within the frame period"
 
 
