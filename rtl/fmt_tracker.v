@@ -18,8 +18,8 @@
 //            MAX_TOUCHES^2 candidate matrix (unassigned touches and slots), pipelined
 //            in two stages (per-touch minima over the slots, registered; then the
 //            minimum over the touches), picks the smallest D, ties to the smallest
-//            index t * 2^SB + s; the pair is assigned, a move event issued and the
-//            slot's velocity/prediction updated:
+//            index t * 2^SB + s; the pair is assigned; in the next cycle a move event
+//            is issued and the slot's velocity/prediction updated:
 //              e = (x << VF) - p;  v = clamp(v + (e >>> vel_shift_i), +-max_speed_i);
 //              p = (x << VF) + v.
 //            No candidate left -> LIFT.
@@ -233,17 +233,28 @@ module fmt_tracker #(
     end
 
     // ---- the matched pair's update (one shared datapath) ------------------------
-    wire [TD_W-1:0]   m_touch = touch_q[m_t*TD_W +: TD_W];
+    // registered pair: the slot update and the move event happen the cycle after the
+    // tree's stage B (a MATCH phase-0 cycle), off the tree's critical path
+    reg               mv_q;
+    reg [SB-1:0]      mv_s_q, mv_t_q;
+    // Variable-index reads are written as AND-OR selects over constant slices (and the
+    // writes below as per-entry enables): a part-select at a computed offset would
+    // synthesize to a barrel shifter over the whole vector.
+    reg [TD_W-1:0]    m_touch, n_touch;
+    reg [P_W-1:0]     m_px, m_py;
+    reg [V_W-1:0]     m_vx, m_vy;
+    reg [GEN_W-1:0]   m_gen, l_gen, f_gen_old;
+    reg [15:0]        l_lx, l_ly;
     wire [15:0]       m_x     = m_touch[TD_W-1 -: 16];
     wire [15:0]       m_y     = m_touch[TD_W-17 -: 16];
     wire [V_W-1:0]    m_vx_new, m_vy_new;
     wire [P_W-1:0]    m_px_new, m_py_new;
 
     fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_velx (
-        .meas_i(m_x), .p_i(px_q[m_s*P_W +: P_W]), .v_i(vx_q[m_s*V_W +: V_W]),
+        .meas_i(m_x), .p_i(m_px), .v_i(m_vx),
         .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vx_new), .p_o(m_px_new));
     fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_vely (
-        .meas_i(m_y), .p_i(py_q[m_s*P_W +: P_W]), .v_i(vy_q[m_s*V_W +: V_W]),
+        .meas_i(m_y), .p_i(m_py), .v_i(m_vy),
         .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vy_new), .p_o(m_py_new));
 
     // ---- lifts: lowest active unmatched slot whose hold-off expires --------------
@@ -284,8 +295,35 @@ module fmt_tracker #(
             end
         end
     end
-    wire [TD_W-1:0]  n_touch = touch_q[n_t*TD_W +: TD_W];
-    wire [GEN_W-1:0] f_gen   = gen_q[f_s*GEN_W +: GEN_W] + 1'b1;
+    // selects of the registered pair, the lifted slot, the new touch and its slot
+    integer q_i;
+    always @* begin
+        m_touch = {TD_W{1'b0}};
+        n_touch = {TD_W{1'b0}};
+        m_px = {P_W{1'b0}};
+        m_py = {P_W{1'b0}};
+        m_vx = {V_W{1'b0}};
+        m_vy = {V_W{1'b0}};
+        m_gen = {GEN_W{1'b0}};
+        l_gen = {GEN_W{1'b0}};
+        f_gen_old = {GEN_W{1'b0}};
+        l_lx = 16'd0;
+        l_ly = 16'd0;
+        for (q_i = 0; q_i < MT; q_i = q_i + 1) begin
+            m_touch = m_touch | (touch_q[q_i*TD_W +: TD_W] & {TD_W{mv_t_q == q_i[SB-1:0]}});
+            n_touch = n_touch | (touch_q[q_i*TD_W +: TD_W] & {TD_W{n_t == q_i[SB-1:0]}});
+            m_px  = m_px  | (px_q[q_i*P_W +: P_W] & {P_W{mv_s_q == q_i[SB-1:0]}});
+            m_py  = m_py  | (py_q[q_i*P_W +: P_W] & {P_W{mv_s_q == q_i[SB-1:0]}});
+            m_vx  = m_vx  | (vx_q[q_i*V_W +: V_W] & {V_W{mv_s_q == q_i[SB-1:0]}});
+            m_vy  = m_vy  | (vy_q[q_i*V_W +: V_W] & {V_W{mv_s_q == q_i[SB-1:0]}});
+            m_gen = m_gen | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{mv_s_q == q_i[SB-1:0]}});
+            l_gen = l_gen | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{l_s == q_i[SB-1:0]}});
+            f_gen_old = f_gen_old | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{f_s == q_i[SB-1:0]}});
+            l_lx  = l_lx  | (lx_q[q_i*16 +: 16] & {16{l_s == q_i[SB-1:0]}});
+            l_ly  = l_ly  | (ly_q[q_i*16 +: 16] & {16{l_s == q_i[SB-1:0]}});
+        end
+    end
+    wire [GEN_W-1:0] f_gen   = f_gen_old + 1'b1;
     wire [SB-1:0]    f_next  = ({1'b0, f_s} == MT - 1) ? {SB{1'b0}} : f_s + 1'b1;
 
     // ---- the sequencer ------------------------------------------------------------
@@ -299,17 +337,17 @@ module fmt_tracker #(
         gen_type = T_MOVE;
         gen_data = {TD_W{1'b0}};
         case (state_q)
-            S_MATCH: if (mph_q && m_found) begin
+            S_MATCH: if (mv_q) begin
                 gen_ev = 1'b1;
-                gen_id = {gen_q[m_s*GEN_W +: GEN_W], m_s};
+                gen_id = {m_gen, mv_s_q};
                 gen_type = T_MOVE;
                 gen_data = m_touch;
             end
             S_LIFT: if (l_found) begin
                 gen_ev = 1'b1;
-                gen_id = {gen_q[l_s*GEN_W +: GEN_W], l_s};
+                gen_id = {l_gen, l_s};
                 gen_type = T_LIFT;
-                gen_data = {lx_q[l_s*16 +: 16], ly_q[l_s*16 +: 16], {(TD_W-32){1'b0}}};
+                gen_data = {l_lx, l_ly, {(TD_W-32){1'b0}}};
             end
             S_NEW: if (n_found && f_found) begin
                 gen_ev = 1'b1;
@@ -344,6 +382,9 @@ module fmt_tracker #(
             ly_q           <= {(MT*16){1'b0}};
             next_slot_q    <= {SB{1'b0}};
             mph_q          <= 1'b0;
+            mv_q           <= 1'b0;
+            mv_s_q         <= {SB{1'b0}};
+            mv_t_q         <= {SB{1'b0}};
             rk_q           <= {(MTP*KW){1'b1}};
             ri_q           <= {(MTP*LW){1'b0}};
             pend_q         <= 1'b0;
@@ -371,11 +412,15 @@ module fmt_tracker #(
                 if (tp_valid_i) begin
                     frame_q <= tp_frame_i;
                     if (tcnt_q < MT) begin
-                        touch_q[tcnt_q*TD_W +: TD_W] <= {tp_x_i, tp_y_i, tp_strength_i,
-                            tp_axis_major_i, tp_axis_minor_i, tp_angle_i, tp_flags_i};
-                        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                            dist_q[(tcnt_q*MTP+s_i)*DW +: DW] <= dnew[s_i*DW +: DW];
-                            cand_q[tcnt_q*MTP+s_i] <= cnew[s_i];
+                        for (t_i = 0; t_i < MT; t_i = t_i + 1) begin
+                            if (tcnt_q == t_i[TCW-1:0]) begin
+                                touch_q[t_i*TD_W +: TD_W] <= {tp_x_i, tp_y_i, tp_strength_i,
+                                    tp_axis_major_i, tp_axis_minor_i, tp_angle_i, tp_flags_i};
+                                for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+                                    dist_q[(t_i*MTP+s_i)*DW +: DW] <= dnew[s_i*DW +: DW];
+                                    cand_q[t_i*MTP+s_i] <= cnew[s_i];
+                                end
+                            end
                         end
                         tcnt_q <= tcnt_q + 1'b1;
                     end else begin
@@ -390,6 +435,20 @@ module fmt_tracker #(
                 overrun_flag_o <= 1'b1;
             end
 
+            // ---- the matched pair's slot update (one cycle after stage B) --------------
+            mv_q <= 1'b0;
+            for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+                if (mv_q && mv_s_q == s_i[SB-1:0]) begin
+                    vx_q[s_i*V_W +: V_W] <= m_vx_new;
+                    vy_q[s_i*V_W +: V_W] <= m_vy_new;
+                    px_q[s_i*P_W +: P_W] <= m_px_new;
+                    py_q[s_i*P_W +: P_W] <= m_py_new;
+                    miss_q[s_i*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
+                    lx_q[s_i*16 +: 16] <= m_x;
+                    ly_q[s_i*16 +: 16] <= m_y;
+                end
+            end
+
             // ---- matching / lifts / news / update -------------------------------------
             case (state_q)
                 S_MATCH: begin
@@ -400,13 +459,9 @@ module fmt_tracker #(
                     end else if (m_found) begin
                         tused_q[m_t] <= 1'b1;
                         sused_q[m_s] <= 1'b1;
-                        vx_q[m_s*V_W +: V_W] <= m_vx_new;
-                        vy_q[m_s*V_W +: V_W] <= m_vy_new;
-                        px_q[m_s*P_W +: P_W] <= m_px_new;
-                        py_q[m_s*P_W +: P_W] <= m_py_new;
-                        miss_q[m_s*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
-                        lx_q[m_s*16 +: 16] <= m_x;
-                        ly_q[m_s*16 +: 16] <= m_y;
+                        mv_q   <= 1'b1;
+                        mv_s_q <= m_s;
+                        mv_t_q <= m_t;
                     end else begin
                         state_q <= S_LIFT;
                     end
@@ -421,14 +476,18 @@ module fmt_tracker #(
                         if (f_found) begin
                             act_q[f_s]  <= 1'b1;
                             sused_q[f_s] <= 1'b1;
-                            gen_q[f_s*GEN_W +: GEN_W] <= f_gen;
-                            px_q[f_s*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-1 -: 16], {VF{1'b0}}};
-                            py_q[f_s*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-17 -: 16], {VF{1'b0}}};
-                            vx_q[f_s*V_W +: V_W] <= {V_W{1'b0}};
-                            vy_q[f_s*V_W +: V_W] <= {V_W{1'b0}};
-                            miss_q[f_s*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
-                            lx_q[f_s*16 +: 16] <= n_touch[TD_W-1 -: 16];
-                            ly_q[f_s*16 +: 16] <= n_touch[TD_W-17 -: 16];
+                            for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+                                if (f_s == s_i[SB-1:0]) begin
+                                    gen_q[s_i*GEN_W +: GEN_W] <= f_gen;
+                                    px_q[s_i*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-1 -: 16], {VF{1'b0}}};
+                                    py_q[s_i*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-17 -: 16], {VF{1'b0}}};
+                                    vx_q[s_i*V_W +: V_W] <= {V_W{1'b0}};
+                                    vy_q[s_i*V_W +: V_W] <= {V_W{1'b0}};
+                                    miss_q[s_i*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
+                                    lx_q[s_i*16 +: 16] <= n_touch[TD_W-1 -: 16];
+                                    ly_q[s_i*16 +: 16] <= n_touch[TD_W-17 -: 16];
+                                end
+                            end
                             next_slot_q <= f_next;
                         end else begin
                             noslot_flag_o <= 1'b1;
