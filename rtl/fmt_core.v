@@ -28,7 +28,7 @@
 // RUN = 0 forces dac_o to 0 (combinational, no extra latency).  TONE_TW / TONE_AMP
 // ({enable, amplitude}) write the DDS bank through its settings port and read back a shadow copy (reset
 // values = the DDS reset plan).  CAL_OFFSET / CAL_GAIN write fmt_touch's calibration
-// memory; fmt_touch has no read-back port, so reads of these windows return 0.
+// memory and read a copy refreshed through its read-back port (see below).
 // BLOB_THRESHOLD / BLOB_MIN_CELLS are not used (fmt_touch has no blob detection).
 //
 // Block-read space (BLKREAD): HEATMAP words 0 .. ROWS*COLS-1 = the snapshot (cell (r,c)
@@ -124,9 +124,10 @@ module fmt_core #(
 
     // ---------------------------------------------------------------- sample strobe
     reg  [CPS_W-1:0] ce_cnt_q;
+    localparam [CPS_W-1:0] CPS_LAST = CPS[CPS_W-1:0] - 1'b1;
     wire             ce = (ce_cnt_q == {CPS_W{1'b0}});
     always @(posedge clk) begin
-        if (rst || ce_cnt_q == CPS - 1) ce_cnt_q <= {CPS_W{1'b0}};
+        if (rst || ce_cnt_q == CPS_LAST) ce_cnt_q <= {CPS_W{1'b0}};
         else                            ce_cnt_q <= ce_cnt_q + 1'b1;
     end
     assign ce_o = ce;
@@ -204,8 +205,9 @@ module fmt_core #(
     wire [ROWS*DAC_BITS-1:0] dac;
     wire                     rx_sign;
     wire [9:0]               chip1    = (r_chip_len == 10'd0) ? 10'd1 : r_chip_len;
-    wire [CHIP_W-1:0]        chip_clk = chip1 * CPS;
-    wire [DLY_W-1:0]         dly_clk  = r_rx_delay * CPS;
+    localparam [2:0]         CPS3     = CPS[2:0];
+    wire [CHIP_W-1:0]        chip_clk = {2'b00, chip1} * CPS3;
+    wire [DLY_W-1:0]         dly_clk  = {2'b00, r_rx_delay} * CPS3;
     /* verilator lint_off PINCONNECTEMPTY */  // tx_sign_o, chip_start_o: not needed outside fmt_tx
     fmt_tx #(
         .ROWS(ROWS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
@@ -280,7 +282,35 @@ module fmt_core #(
     wire [31:0]      now;
     wire             flat_sat, lm_ovf, lm_overrun, trk_drop, trk_noslot, trk_overrun, ev_ovf;
     wire [15:0]      flat_sat_cnt, lm_drop_cnt, ev_drop_cnt, ev_skip_cnt;
-    wire [LIM_W-1:0] limit = (r_limit > MAX_TOUCHES) ? MAX_TOUCHES[LIM_W-1:0] : r_limit[LIM_W-1:0];
+    wire [LIM_W-1:0] limit = ({27'd0, r_limit} > MAX_TOUCHES) ? MAX_TOUCHES[LIM_W-1:0] : r_limit[LIM_W-1:0];
+
+    // calibration read-back: the windows CAL_OFFSET / CAL_GAIN read a copy of the cell
+    // at (CAL_ROW, CAL_COL) that a small loop refreshes through fmt_touch's read port
+    // (offset, then gain, each answered a few cycles later, in cycles without a
+    // heat-map beat): read a window at least 16 cycles after moving the selectors or
+    // writing the cell (the control port is far slower than that)
+    localparam CAL_W = (HM_W > 16) ? HM_W : 16;
+    reg  [1:0]       rb_state_q;                 // 0 ask offset, 1 wait, 2 ask gain, 3 wait
+    reg  [15:0]      rb_off_q, rb_gain_q;
+    wire             cal_wr   = cal_off_we | cal_gain_we;
+    wire             cal_re   = !cal_wr && (rb_state_q == 2'd0 || rb_state_q == 2'd2);
+    wire             cal_sel  = cal_wr ? cal_gain_we : (rb_state_q == 2'd2);
+    wire             cal_rvalid;
+    wire [CAL_W-1:0] cal_rdata;
+    always @(posedge clk) begin
+        if (rst) begin
+            rb_state_q <= 2'd0;
+            rb_off_q   <= 16'd0;
+            rb_gain_q  <= 16'd0;
+        end else begin
+            case (rb_state_q)
+                2'd0:    if (cal_re) rb_state_q <= 2'd1;
+                2'd1:    if (cal_rvalid) begin rb_off_q <= cal_rdata[15:0]; rb_state_q <= 2'd2; end
+                2'd2:    if (cal_re) rb_state_q <= 2'd3;
+                default: if (cal_rvalid) begin rb_gain_q <= cal_rdata[15:0]; rb_state_q <= 2'd0; end
+            endcase
+        end
+    end
     fmt_touch #(
         .ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_TOUCHES(MAX_TOUCHES), .FRAME_W(16),
         .ID_W(8), .TIME_W(32), .EV_DEPTH(EV_DEPTH), .V_W(22), .HOLD_W(12), .CNT_W(16),
@@ -291,9 +321,10 @@ module fmt_core #(
         .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .hold_jump_i(r_hold_jump),
         .hold_off_i(r_hold_off), .vel_shift_i(r_vel_shift), .max_speed_i(r_max_speed),
         .delay_i(r_lat_dial), .report_period_i(r_report_period),
-        .cal_we_i(cal_off_we | cal_gain_we), .cal_sel_i(cal_gain_we),
+        .cal_we_i(cal_wr), .cal_sel_i(cal_sel),
         .cal_row_i(r_cal_row[ROW_W-1:0]), .cal_col_i(r_cal_col[COL_W-1:0]),
-        .cal_data_i(cal_gain_we ? cal_gain_wdata : cal_off_wdata),
+        .cal_data_i({{(CAL_W - 16){1'b0}}, cal_gain_we ? cal_gain_wdata : cal_off_wdata}),
+        .cal_re_i(cal_re), .cal_rvalid_o(cal_rvalid), .cal_rdata_o(cal_rdata),
         .sat_clr_i(sat_clr_we & sat_clr_wd),
         .hm_valid_i(hm_valid), .hm_row_i(hm_row), .hm_frame_i(hm_frame), .hm_data_i(hm_data),
         .hm_eof_i(hm_eof),
@@ -442,9 +473,9 @@ module fmt_core #(
         .track_max_speed_o(r_max_speed), .blob_threshold_o(r_blob_thr),
         .blob_min_cells_o(r_blob_min), .cal_row_o(r_cal_row), .cal_col_o(r_cal_col),
         .cal_offset_we_o(cal_off_we), .cal_offset_wdata_o(cal_off_wdata), .cal_offset_re_o(cal_off_re),
-        .cal_offset_rdata_i(16'd0),
+        .cal_offset_rdata_i(rb_off_q),
         .cal_gain_we_o(cal_gain_we), .cal_gain_wdata_o(cal_gain_wdata), .cal_gain_re_o(cal_gain_re),
-        .cal_gain_rdata_i(16'd0),
+        .cal_gain_rdata_i(rb_gain_q),
         .latency_dial_o(r_lat_dial), .report_period_o(r_report_period),
         .frame_count_i(frames_q), .status_set_i(status_set), .status_o(r_status),
         .ctrl_errors_i(err_count), .ctrl_last_err_i(err_last),
