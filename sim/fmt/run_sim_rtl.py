@@ -75,10 +75,10 @@ def upd_len(cfg) -> int:
     return 1 << 20 if cfg.rows * cfg.cols >= 400 else 1 << 15
 
 
-def job_dir(cfg, cps: int) -> Path:
+def job_dir(cfg, cps: int, tag: str = "") -> Path:
     """Fixed folder per build (the file names are Verilog parameters: a fixed path keeps
-    the Verilator build reusable between scenes)."""
-    return ROOT / "build" / "sim_rtl" / f"{cfg.name}_c{cps}"
+    the Verilator build reusable between scenes); ``tag`` separates concurrent users."""
+    return ROOT / "build" / "sim_rtl" / f"{cfg.name}_c{cps}{'_' + tag if tag else ''}"
 
 
 def dac_peak(cfg) -> int:
@@ -441,12 +441,12 @@ def build_args(sim: str, fast_sim: bool = True) -> list:
     return args
 
 
-def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene"):
+def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene", tag: str = ""):
     """Write the job folder (records, noise, job.json) and compute the reference."""
     from . import run_sim as _run_sim
     cfg = scene.cfg
     settings = settings or TouchSettings()
-    d = job_dir(cfg, cps)
+    d = job_dir(cfg, cps, tag)
     d.mkdir(parents=True, exist_ok=True)
     n = frames * scene.samples_per_frame
     g0, updates = coupling_plan(scene, n, cps)
@@ -479,7 +479,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
     frames = frames or scene.frames
     scene = scene.replace(frames=frames)
     t0 = time.perf_counter()
-    d, ref, cal, n_upd = prepare(scene, frames, cps, settings)
+    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag="" if sim == "verilator" else sim)
     t1 = time.perf_counter()
     env = {"FMT_CORE_JOB": str(d / "job.json"), "FMT_QUIET": int(quiet)}
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=sim_sources(),

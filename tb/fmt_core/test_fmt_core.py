@@ -247,7 +247,7 @@ def small_tap_scene(frames: int) -> _scene.Scene:
 
 def _run(sim, scene, cps, uart, settings):
     cfg = scene.cfg
-    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None)
+    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None, tag=f"tb_{sim}")
     # slack after the last frame for the UART phase
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
                test_module="test_fmt_core", test_dir=Path(__file__).parent, testcase="run_scene",
