@@ -33,13 +33,16 @@
 // same for cy) by two pipelined fmt_div (QW + 1 cycles, QW = max index width + 8), one
 // blob per cycle, then blob_eof_o (also for a frame without blobs).
 //
-// Membership (for removing the fingers inside blobs): the label of every cell at the
-// end of its row is stored (lr_mem), with, per row r and label, whether the label
-// closed at the end of row r was a blob (cf_q).  After the frame a pass from the last
-// row up resolves every cell in one cycle per row: a row-r label that touches an
-// on-cell of row r+1 takes that cell's (already known) status, otherwise its region
-// ended in row r and cf_q tells.  The result (every blob, also those beyond MAX_BLOBS:
-// blobs.blob_mask_fixed) is a ROWS x COLS bit RAM read by row: mask_rd_row_i ->
+// Membership (for removing the fingers inside blobs): the labelling stores the label
+// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
+// of row r, whether it continued into row r+1 and as which label (after the merges of
+// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
+// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
+// the last row up gives, one row per cycle, the status of every label of row r: the
+// status of its continuation in row r+1 (known from the previous step) or, when it did
+// not continue, its close record; each cell takes its label's status.  The result
+// (every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed) is a ROWS x COLS
+// bit RAM read by row: mask_rd_row_i ->
 // mask_rd_data_o one cycle later.  mask_ready_o (with mask_frame_o) marks it written;
 // it stays readable until the next frame's pass starts (that frame is labelled; never
 // before its last row), reads in between return 0.  An incomplete frame gives
@@ -130,7 +133,7 @@ module fmt_blob #(
     localparam GS     = 8;                           // columns per partial-sum group
     localparam NG     = (COLS + GS - 1) / GS;
     localparam GSZ_W  = HM_W + 4;                    // group sum of <= 8 cells
-    localparam GSX_W  = GSZ_W + COL_IDX_W;
+    localparam GSX_W  = GSZ_W + 3;                   // group sum of z * (c mod 8)
     localparam ADDR_W = $clog2(2 * ROWS);
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;
@@ -158,7 +161,7 @@ module fmt_blob #(
     localparam integer LAST_ROW_I = ROWS - 1;
     localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
 
-    integer i, g;
+    integer i, g, b;
 
     // ---- combine two partial regions: X precedes Y's peak in ties unless Y's peak cell
     // comes first in raster order; first cell = the smaller raster key
@@ -197,6 +200,7 @@ module fmt_blob #(
     endfunction
 
     // ---- frame buffers and arrival bookkeeping (as fmt_localmax) ----------------------
+    (* ram_style = "block" *)                 // one write, one read port: block RAM
     reg [RW-1:0]         mem [0:2*ROWS-1];
     reg [ROWS-1:0]       arr_q [0:1];
     reg [1:0]            eofs_q;
@@ -306,10 +310,25 @@ module fmt_blob #(
     end
     wire [NL:1] close_k = last_row ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
 
-    // labels of every row at its end (after its merges), for the membership pass
-    reg [COLS*LBL_W-1:0] lr_mem [0:ROWS-1];
+    // Records for the membership pass: the labels of every row at its end (after its
+    // merges), and, written at the end of row r+1 about the labels of row r, which of
+    // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
+    // by the merges of row r+1).
+    reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
+    always @(*) begin
+        for (i = 1; i <= NL; i = i + 1) begin
+            alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
+            alias_nx[(i-1)*LBL_W +: LBL_W] =
+                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == lb) ? la : alias_q[(i-1)*LBL_W +: LBL_W];
+        end
+    end
+    wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
+    reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
+    reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
     always @(posedge clk) begin
         if (row_done) lr_mem[cur_row_q] <= c_nx;
+        if (row_done && cur_row_q != {ROW_IDX_W{1'b0}})
+            fr_mem[cur_row_q - 1'b1] <= {cont_rec, alias_nx};
     end
 
     // ---- X1: command register ---------------------------------------------------------
@@ -356,8 +375,11 @@ module fmt_blob #(
                 if (i < COLS) begin
                     zc = x1_zm_q[i*HM_W +: HM_W];
                     gs[g*GSZ_W +: GSZ_W] = gs[g*GSZ_W +: GSZ_W] + {{(GSZ_W-HM_W){1'b0}}, zc};
-                    gx[g*GSX_W +: GSX_W] = gx[g*GSX_W +: GSX_W]
-                                         + {{(GSX_W-HM_W){1'b0}}, zc} * i[COL_IDX_W-1:0];
+                    // z * (c mod 8) by shifts (constants: no multiplier)
+                    for (b = 0; b < 3; b = b + 1)
+                        if ((((i - g * GS) >> b) & 1) == 1)
+                            gx[g*GSX_W +: GSX_W] = gx[g*GSX_W +: GSX_W]
+                                                 + ({{(GSX_W-HM_W){1'b0}}, zc} << b);
                     if (zc > gm[g*HM_W +: HM_W]) begin    // strict: first maximum
                         gm[g*HM_W +: HM_W] = zc;
                         gc[g*COL_IDX_W +: COL_IDX_W] = i[COL_IDX_W-1:0];
@@ -398,7 +420,11 @@ module fmt_blob #(
         tpc = x2_cmin_q;                      // all-zero run (threshold 0): first cell
         for (g = 0; g < NG; g = g + 1) begin
             ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            // sum z*c = sum over groups of (sum z*(c mod 8) + 8g * sum z), shift-add
             tx = tx + {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            for (b = 0; b < COL_IDX_W; b = b + 1)
+                if ((((g * GS) >> b) & 1) == 1)
+                    tx = tx + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
             if (x2_gm_q[g*HM_W +: HM_W] > tpk) begin
                 tpk = x2_gm_q[g*HM_W +: HM_W];
                 tpc = x2_gc_q[g*COL_IDX_W +: COL_IDX_W];
@@ -447,8 +473,6 @@ module fmt_blob #(
     reg [ROW_IDX_W-1:0] crow_q [1:NL];        // row at whose end the label was closed
     reg [ROW_IDX_W-1:0] cl_row_q;
     reg [LBL_W-1:0]     cl_lbl_q;
-    reg [NL:1]          cf_q [0:ROWS-1];      // cf_q[r][l]: label l closed at the end of
-                                              // row r was a blob
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
     wire              cl_blob = cl_v_q && (cl_area >= blob_min_cells_i);
@@ -514,49 +538,61 @@ module fmt_blob #(
 
     // ---- M: membership pass, rows ROWS-1 down to 0, one per cycle ---------------------
     // A label of row r (labels at the row's end: the connected parts of the regions
-    // within rows 0..r) whose cells touch an on-cell of row r+1 continues into the region
-    // of that cell, whose status is known from row r+1's mask; otherwise its region ended
-    // with row r and was closed at the end of row r+1 (the last row's labels: at its own
-    // end): cf_q holds whether it was a blob.
+    // within rows 0..r) that continued into row r+1 as label a has the status of a in
+    // row r+1 (sn_q, the previous step); otherwise its region ended with row r and was
+    // closed at the end of row r+1 (the last row's labels: at its own end), and cf_mem
+    // (per label, by row) holds whether it was a blob.
     reg                  bw_run_q;            // reading rows
     reg [ROW_IDX_W-1:0]  bw_r_q;              // next row to read
-    reg                  bw_v_q;              // lr_rd_q holds row bw_row_q
+    reg                  bw_v_q;              // lr_rd_q, fr_rd_q hold row bw_row_q
     reg [ROW_IDX_W-1:0]  bw_row_q;
-    reg [COLS*LBL_W-1:0] lr_rd_q, lrn_q;      // labels of row r and of row r+1
-    reg [COLS-1:0]       mn_q;                // mask of row r+1
+    reg [COLS*LBL_W-1:0] lr_rd_q;             // labels of row r
+    reg [NL*(LBL_W+1)-1:0] fr_rd_q;           // continuation record of row r
+    reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg [COLS-1:0]       mask_mem [0:ROWS-1];
     reg [COLS-1:0]       mask_rd_q;
     reg                  mask_ok_q;           // the mask holds a complete frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) lr_rd_q <= lr_mem[bw_r_q];
+        if (bw_run_q) begin
+            lr_rd_q <= lr_mem[bw_r_q];
+            fr_rd_q <= fr_mem[bw_r_q];
+        end
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
     wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
-    wire [NL:1]          cfr      = cf_q[cf_row];
-    reg [COLS-1:0]  bw_d, bw_dv, bw_m;
-    reg [NL:1]      bw_cont, bw_st;
-    reg [LBL_W-1:0] lc;
-    always @(*) begin
-        for (i = 0; i < COLS; i = i + 1) begin
-            bw_d[i]  = (lr_rd_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) && !bw_first
-                     && (lrn_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}});
-            bw_dv[i] = bw_d[i] && mn_q[i];
+    // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
+    // was a blob (written by the close engine, read for row cf_row)
+    wire [NL:1]          cfr;
+    genvar gl;
+    generate
+        for (gl = 1; gl <= NL; gl = gl + 1) begin : g_cf
+            localparam [LBL_W-1:0] LBL = gl;
+            reg cf_mem [0:ROWS-1];
+            always @(posedge clk) begin
+                if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= (cl_area >= blob_min_cells_i);
+            end
+            assign cfr[gl] = cf_mem[cf_row];
         end
-        bw_cont = {NL{1'b0}};
-        bw_st   = {NL{1'b0}};
-        for (g = 1; g <= NL; g = g + 1)
-            for (i = 0; i < COLS; i = i + 1)
-                if (lr_rd_q[i*LBL_W +: LBL_W] == g[LBL_W-1:0]) begin
-                    bw_cont[g] = bw_cont[g] | bw_d[i];
-                    bw_st[g]   = bw_st[g] | bw_dv[i];
-                end
+    endgenerate
+    // status of the labels of row r, then of its cells
+    reg [NL:1]      bw_s;
+    reg [COLS-1:0]  bw_m;
+    reg [LBL_W-1:0] la_r, lc;
+    always @(*) begin
+        for (g = 1; g <= NL; g = g + 1) begin
+            la_r = fr_rd_q[(g-1)*LBL_W +: LBL_W];
+            bw_s[g] = cfr[g];
+            if (!bw_first && fr_rd_q[NL*LBL_W + g - 1])
+                for (i = 1; i <= NL; i = i + 1)
+                    if (la_r == i[LBL_W-1:0]) bw_s[g] = sn_q[i];
+        end
         for (i = 0; i < COLS; i = i + 1) begin
             lc = lr_rd_q[i*LBL_W +: LBL_W];
             bw_m[i] = 1'b0;
             for (g = 1; g <= NL; g = g + 1)
-                if (lc == g[LBL_W-1:0]) bw_m[i] = bw_cont[g] ? bw_st[g] : cfr[g];
+                if (lc == g[LBL_W-1:0]) bw_m[i] = bw_s[g];
         end
     end
     always @(posedge clk) begin
@@ -620,7 +656,6 @@ module fmt_blob #(
             for (i = 1; i <= NL; i = i + 1)
                 if (x4_k_q[i]) crow_q[i] <= x4_row_q;
         end
-        if (cl_v_q) cf_q[cl_row_q][cl_lbl_q] <= (cl_area >= blob_min_cells_i);
         // emission side registers
         dl_i_q[0] <= em_i_q;
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
@@ -652,6 +687,7 @@ module fmt_blob #(
             livep_q  <= {NL{1'b0}};
             livec_q  <= {NL{1'b0}};
             free_q   <= {NL{1'b1}};
+            alias_q  <= alias_id;
             pend_q   <= {NL{1'b0}};
             x1_v_q   <= 1'b0;
             x2_v_q   <= 1'b0;
@@ -710,6 +746,7 @@ module fmt_blob #(
             end
 
             // ---- labelling state ----
+            alias_q <= row_done ? alias_id : alias_nx;
             if (row_done) begin
                 p_q     <= last_row ? {(COLS*LBL_W){1'b0}} : c_nx;
                 c_q     <= {(COLS*LBL_W){1'b0}};
@@ -779,8 +816,7 @@ module fmt_blob #(
                 else                             bw_r_q   <= bw_r_q - 1'b1;
             end
             if (bw_v_q) begin
-                lrn_q <= lr_rd_q;
-                mn_q  <= bw_m;
+                sn_q  <= bw_s;
                 if (bw_row_q == {ROW_IDX_W{1'b0}}) begin
                     bw_busy_q    <= 1'b0;
                     mask_ready_o <= 1'b1;
@@ -819,6 +855,7 @@ module fmt_blob #(
                 livep_q <= {NL{1'b0}};
                 livec_q <= {NL{1'b0}};
                 free_q  <= {NL{1'b1}};
+                alias_q <= alias_id;
             end
         end
     end
