@@ -1,23 +1,36 @@
-// fmt_dds_chan -- one DDS row: settings registers, phase accumulator, LUT-based
-// amplitude scaling, rounding and PN bi-phase sign.  The sine table is outside
-// (fmt_dds_rom2, shared by two rows): this block drives its address and takes the
-// registered table word back.
+// fmt_dds_chan -- one DDS channel engine: computes the words of SLOTS rows (a row per
+// slot), one row per processing edge, with one phase adder, one amplitude product and
+// one sine-table port (fmt_dds_rom2, outside: this block drives its address and takes
+// the registered table word back).  fmt_dds_bank runs SLOTS = ROWS_PER_ENGINE = R and
+// supplies the shared control (slot counter, delayed settings bus, delayed PN sign).
 //
-// Sample k (k-th ce edge after reset; register values in effect before that edge):
-//   edge k   : phase += tw (phase of sample k = sum of the tuning words of samples
-//              0..k-1, modulo 2^PHASE_BITS, 0 after reset); the table reads
-//              rom[phase >> (PHASE_BITS - TABLE_ADDR)]; amp, enable, tx_sign of
-//              sample k are registered beside it.
-//   edge k+1 : partial-product sums (see below).
-//   edge k+2 : dac_o = enable ? (tx_sign ? -r : r) : 0.
-// So the word of sample k is on dac_o after ce edge k+2 (3 registers, latency 3
-// samples counted from the phase register).
+// Per slot c: settings registers tw (PHASE_BITS), amp (AMP_BITS, unsigned), en (1),
+// written through cfg_we_i[c] / cfg_sel_i (0 tuning word, 1 amplitude, 2 enable, 3
+// ignored) / cfg_data_i (LSB-aligned), at the edge where cfg_we_i[c] = 1 (the bank
+// delays the settings bus per slot so that every slot sees exactly the writes made
+// before the ce edge of its sample, see fmt_dds_bank).  Slots >= ACTIVE carry no row:
+// tw = 0, en = 0, no output.
+//
+// Phase: a ring of SLOTS registers; ph[0] holds the phase of the slot processed at the
+// next edge with proc_i = 1; at that edge ph[SLOTS-1] <= ph[0] + tw[slot] and the
+// others move down one place (SLOTS = 1: an ordinary accumulator).  Reset: all 0.
+//
+// Pipeline (advances when pe_i = 1; R = 1: pe_i = ce, R > 1: every clk):
+//   edge E   (processing of slot c = slot_i): the table reads rom[ph[0] >> (PHASE_BITS
+//            - TABLE_ADDR)]; amp[c], en[c] (0 unless proc_i) and sign_i registered.
+//   edge E+1 : partial-product sums (see below).
+//   edge E+2 : res = en ? (sign ? -r : r) : 0 (combinational from the E+1 registers),
+//              written into the staging register of slot c when stg_we_i[c] = 1
+//              (c < SLOTS-1).
+// Output: at an edge with ce_i = 1, dac_o[c] <= staging[c] (c < SLOTS-1) and
+// dac_o[SLOTS-1] <= res (the last slot's word computed at that very edge), so all rows
+// of the engine change together, at ce edges only.
 //
 // Amplitude product, LUT only (no DSP48E): p = s * amp with s the SINE_BITS-bit signed
 // table word and amp the AMP_BITS-bit unsigned amplitude, formed as the shift-add of
 // the partial products s << i for the set bits of amp, in two halves (low and high
-// amplitude bits) registered at edge k+1 and added at edge k+2.  No `*` operator
-// appears, so neither XST nor Yosys can map it to a DSP48E.
+// amplitude bits) registered at edge E+1 and added after it.  No `*` operator appears,
+// so neither XST nor Yosys can map it to a DSP48E.
 // Rounding: r = (p + 2^(SH-1)) >> SH, SH = SINE_BITS + AMP_BITS - DAC_BITS
 // (round half up; the 2^(SH-1) is folded into the low half).  The sign is applied
 // after rounding, so the words of +1 and -1 are exact negatives.
@@ -26,9 +39,7 @@
 // so for DAC_BITS > AMP_BITS), so -r never overflows: no saturation is needed.
 // Full amplitude (2^AMP_BITS - 1) gives a peak of (2^AMP_BITS - 1) / 2^AMP_BITS of the
 // DAC range (2040 of 2047 for 16/8/12 bits).
-// Settings: a write (cfg_we_i = 1, any clk cycle, ce not needed) takes effect at the
-// next clk edge.  While disabled the accumulator keeps running (phase continuity) and
-// the output is 0.  Twin: sim/fmt/dds.py dds_bank_fixed.
+// Twin: sim/fmt/dds.py dds_bank_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -38,18 +49,32 @@ module fmt_dds_chan #(
     parameter SINE_BITS  = `FMT_SINE_BITS,    // sine table word width (signed)
     parameter AMP_BITS   = `FMT_AMP_BITS,     // amplitude width (unsigned, >= 2)
     parameter DAC_BITS   = `FMT_DAC_BITS,     // output word width (signed), <= SINE_BITS + AMP_BITS
-    parameter [PHASE_BITS-1:0] TW_RESET = 0   // tuning word after reset
+    parameter SLOTS      = 1,                 // rows served by this engine (time-multiplex factor R)
+    parameter ACTIVE     = SLOTS,             // slots 0..ACTIVE-1 carry a row (1..SLOTS)
+    parameter [PHASE_BITS-1:0] TW_RESET = 0,  // tuning word of slot 0 after reset
+    parameter [PHASE_BITS-1:0] TW_STEP  = 0,  // slot c resets to TW_RESET + c * TW_STEP
+    parameter SLOT_W     = (SLOTS > 1) ? $clog2(SLOTS) : 1  // width of slot_i
 ) (
-    input  wire                         clk,
-    input  wire                         rst,         // synchronous, active high
-    input  wire                         ce,          // sample strobe
-    input  wire                         cfg_we_i,    // write one setting of this row
-    input  wire [1:0]                   cfg_sel_i,   // 0 tuning word, 1 amplitude, 2 enable
-    input  wire [PHASE_BITS-1:0]        cfg_data_i,  // value (LSB-aligned)
-    input  wire                         tx_sign_i,   // PN sign of this sample, 1 = multiply by -1
-    output wire [TABLE_ADDR-1:0]        addr_o,      // table address (registered phase, top bits)
-    input  wire signed [SINE_BITS-1:0]  sine_i,      // table word of addr_o at the last ce edge
-    output reg  signed [DAC_BITS-1:0]   dac_o        // output word, registered
+    input  wire                          clk,
+    input  wire                          rst,         // synchronous, active high
+    input  wire                          pe_i,        // pipeline advance (see header)
+    input  wire                          proc_i,      // process slot slot_i at this edge
+    input  wire [SLOT_W-1:0]             slot_i,      // slot processed at this edge
+    input  wire                          sign_i,      // PN sign of that slot's sample, 1 = -1
+    // idle slots (ACTIVE..SLOTS-1) have no settings registers: their bits are not used
+    /* verilator lint_off UNUSEDSIGNAL */
+    input  wire [SLOTS-1:0]              cfg_we_i,    // write one setting of slot c
+    input  wire [2*SLOTS-1:0]            cfg_sel_i,   // slot c at [2c +: 2]: 0 tw, 1 amp, 2 enable
+    input  wire [SLOTS*PHASE_BITS-1:0]   cfg_data_i,  // slot c at [c*PHASE_BITS +: PHASE_BITS]
+    /* verilator lint_on UNUSEDSIGNAL */
+    output wire [TABLE_ADDR-1:0]         addr_o,      // table address (ring head, top bits)
+    input  wire signed [SINE_BITS-1:0]   sine_i,      // table word of addr_o at the last pe edge
+    // bit SLOTS-1 is not used: the last slot has no staging register (see header)
+    /* verilator lint_off UNUSEDSIGNAL */
+    input  wire [SLOTS-1:0]              stg_we_i,    // staging write of slot c (c < SLOTS-1)
+    /* verilator lint_on UNUSEDSIGNAL */
+    input  wire                          ce_i,        // sample strobe: outputs load at this edge
+    output wire [ACTIVE*DAC_BITS-1:0]    dac_o        // slot c at [c*DAC_BITS +: DAC_BITS], signed
 );
 
     localparam PW   = SINE_BITS + AMP_BITS;         // product width (signed)
@@ -58,18 +83,88 @@ module fmt_dds_chan #(
     localparam [PW-1:0] HALF = (SH > 0) ? ({{(PW - 1){1'b0}}, 1'b1} << SHM1) : {PW{1'b0}};
     localparam LO_BITS = AMP_BITS / 2;              // amplitude bits summed in the low half
 
-    // settings
-    reg [PHASE_BITS-1:0] tw_q;
-    reg [AMP_BITS-1:0]   amp_q;
-    reg                  en_q;
-    // datapath
-    reg [PHASE_BITS-1:0] phase_q;
+    // ---------------------------------------------------------------- settings
+    wire [SLOTS*PHASE_BITS-1:0] tw_all;
+    wire [SLOTS*AMP_BITS-1:0]   amp_all;
+    wire [SLOTS-1:0]            en_all;
+
+    genvar c;
+    generate
+        for (c = 0; c < SLOTS; c = c + 1) begin : g_set
+            if (c < ACTIVE) begin : g_row
+                localparam [PHASE_BITS-1:0] TW_C = TW_RESET + c * TW_STEP;
+                reg [PHASE_BITS-1:0] tw_q;
+                reg [AMP_BITS-1:0]   amp_q;
+                reg                  en_q;
+                always @(posedge clk) begin
+                    if (rst) begin
+                        tw_q  <= TW_C;
+                        amp_q <= {AMP_BITS{1'b1}};
+                        en_q  <= 1'b1;
+                    end else if (cfg_we_i[c]) begin
+                        case (cfg_sel_i[2*c +: 2])
+                            2'd0:    tw_q  <= cfg_data_i[c*PHASE_BITS +: PHASE_BITS];
+                            2'd1:    amp_q <= cfg_data_i[c*PHASE_BITS +: AMP_BITS];
+                            2'd2:    en_q  <= cfg_data_i[c*PHASE_BITS];
+                            default: ;
+                        endcase
+                    end
+                end
+                assign tw_all[c*PHASE_BITS +: PHASE_BITS] = tw_q;
+                assign amp_all[c*AMP_BITS +: AMP_BITS]    = amp_q;
+                assign en_all[c]                          = en_q;
+            end else begin : g_idle
+                assign tw_all[c*PHASE_BITS +: PHASE_BITS] = {PHASE_BITS{1'b0}};
+                assign amp_all[c*AMP_BITS +: AMP_BITS]    = {AMP_BITS{1'b0}};
+                assign en_all[c]                          = 1'b0;
+            end
+        end
+    endgenerate
+
+    // settings of the slot processed at this edge (an R:1 multiplexer per bit)
+    reg [PHASE_BITS-1:0] tw_s;
+    reg [AMP_BITS-1:0]   amp_s;
+    reg                  en_s;
+    integer k;
+    always @* begin
+        tw_s  = tw_all[PHASE_BITS-1:0];
+        amp_s = amp_all[AMP_BITS-1:0];
+        en_s  = en_all[0];
+        for (k = 1; k < SLOTS; k = k + 1) begin
+            if (slot_i == k[SLOT_W-1:0]) begin
+                tw_s  = tw_all[k*PHASE_BITS +: PHASE_BITS];
+                amp_s = amp_all[k*AMP_BITS +: AMP_BITS];
+                en_s  = en_all[k];
+            end
+        end
+    end
+
+    // ---------------------------------------------------------------- phase ring
+    reg [SLOTS*PHASE_BITS-1:0] ph_q;   // ph[i] at [i*PHASE_BITS +: PHASE_BITS]
+    wire [PHASE_BITS-1:0] ph_head = ph_q[PHASE_BITS-1:0];
+    wire [PHASE_BITS-1:0] ph_next = ph_head + tw_s;
+
+    assign addr_o = ph_head[PHASE_BITS-1 -: TABLE_ADDR];
+
+    generate
+        if (SLOTS > 1) begin : g_ring
+            always @(posedge clk) begin
+                if (rst)         ph_q <= {(SLOTS*PHASE_BITS){1'b0}};
+                else if (proc_i) ph_q <= {ph_next, ph_q[SLOTS*PHASE_BITS-1:PHASE_BITS]};
+            end
+        end else begin : g_acc
+            always @(posedge clk) begin
+                if (rst)         ph_q <= {PHASE_BITS{1'b0}};
+                else if (proc_i) ph_q <= ph_next;
+            end
+        end
+    endgenerate
+
+    // ---------------------------------------------------------------- product pipeline
     reg [AMP_BITS-1:0]   amp1_q;
     reg                  en1_q, sg1_q, en2_q, sg2_q;
     reg signed [PW-1:0]  pp_lo_q, pp_hi_q;
     reg signed [PW-1:0]  pp_lo_d, pp_hi_d;
-
-    assign addr_o = phase_q[PHASE_BITS-1 -: TABLE_ADDR];
 
     wire signed [PW-1:0] s_ext = {{AMP_BITS{sine_i[SINE_BITS-1]}}, sine_i};
 
@@ -90,13 +185,10 @@ module fmt_dds_chan #(
     wire signed [PW-1:0]       sum_w = pp_lo_q + pp_hi_q;
     /* verilator lint_on UNUSEDSIGNAL */
     wire signed [DAC_BITS-1:0] r_w   = sum_w[PW-1:SH];
+    wire signed [DAC_BITS-1:0] res_w = !en2_q ? {DAC_BITS{1'b0}} : (sg2_q ? -r_w : r_w);
 
     always @(posedge clk) begin
         if (rst) begin
-            tw_q    <= TW_RESET;
-            amp_q   <= {AMP_BITS{1'b1}};
-            en_q    <= 1'b1;
-            phase_q <= {PHASE_BITS{1'b0}};
             amp1_q  <= {AMP_BITS{1'b0}};
             en1_q   <= 1'b0;
             sg1_q   <= 1'b0;
@@ -104,29 +196,41 @@ module fmt_dds_chan #(
             sg2_q   <= 1'b0;
             pp_lo_q <= {PW{1'b0}};
             pp_hi_q <= {PW{1'b0}};
-            dac_o   <= {DAC_BITS{1'b0}};
-        end else begin
-            if (cfg_we_i) begin
-                case (cfg_sel_i)
-                    2'd0:    tw_q  <= cfg_data_i;
-                    2'd1:    amp_q <= cfg_data_i[AMP_BITS-1:0];
-                    2'd2:    en_q  <= cfg_data_i[0];
-                    default: ;
-                endcase
-            end
-            if (ce) begin
-                phase_q <= phase_q + tw_q;
-                amp1_q  <= amp_q;
-                en1_q   <= en_q;
-                sg1_q   <= tx_sign_i;
-                pp_lo_q <= pp_lo_d;
-                pp_hi_q <= pp_hi_d;
-                en2_q   <= en1_q;
-                sg2_q   <= sg1_q;
-                dac_o   <= !en2_q ? {DAC_BITS{1'b0}} : (sg2_q ? -r_w : r_w);
-            end
+        end else if (pe_i) begin
+            amp1_q  <= amp_s;
+            en1_q   <= proc_i & en_s;
+            sg1_q   <= sign_i;
+            pp_lo_q <= pp_lo_d;
+            pp_hi_q <= pp_hi_d;
+            en2_q   <= en1_q;
+            sg2_q   <= sg1_q;
         end
     end
+
+    // ---------------------------------------------------------------- outputs
+    generate
+        for (c = 0; c < ACTIVE; c = c + 1) begin : g_out
+            reg [DAC_BITS-1:0] dac_q;
+            if (c < SLOTS - 1) begin : g_stage
+                reg [DAC_BITS-1:0] stg_q;
+                always @(posedge clk) begin
+                    if (rst) begin
+                        stg_q <= {DAC_BITS{1'b0}};
+                        dac_q <= {DAC_BITS{1'b0}};
+                    end else begin
+                        if (stg_we_i[c]) stg_q <= res_w;
+                        if (ce_i)        dac_q <= stg_q;
+                    end
+                end
+            end else begin : g_last
+                always @(posedge clk) begin
+                    if (rst)       dac_q <= {DAC_BITS{1'b0}};
+                    else if (ce_i) dac_q <= res_w;
+                end
+            end
+            assign dac_o[c*DAC_BITS +: DAC_BITS] = dac_q;
+        end
+    endgenerate
 
     // Widths that would let -r overflow are a configuration error (see header).
     // synthesis translate_off
@@ -134,6 +238,10 @@ module fmt_dds_chan #(
         if (SH < 0 || !(HALF < ((1 << (SINE_BITS - 1)) + (1 << AMP_BITS) - 1))) begin
             $display("fmt_dds_chan: DAC_BITS %0d invalid for SINE_BITS %0d AMP_BITS %0d",
                      DAC_BITS, SINE_BITS, AMP_BITS);
+            $finish;
+        end
+        if (ACTIVE < 1 || ACTIVE > SLOTS) begin
+            $display("fmt_dds_chan: ACTIVE %0d must be 1..SLOTS (%0d)", ACTIVE, SLOTS);
             $finish;
         end
     end

@@ -8,9 +8,14 @@
 // dac_o when rx_delay_i = 3 + the channel delay in samples (DAC to despreader input).
 // PN off (pn_enable_i = 0) leaves the tones unmodulated; the LFSR keeps running.
 //
-// ce: fmt_pn_gen has no sample strobe (it steps on every clk), so this top is exact
-// only with ce = 1 (one sample per clock, as under test).  For CLK_PER_SAMPLE > 1 the
-// PN generator needs a ce input (requested from its owner); ce still gates the DDS.
+// ce: fmt_pn_gen has no sample strobe (it steps on every clk).  With ce = 1 (one
+// sample per clock, ROWS_PER_ENGINE = 1) the timing above holds as stated.  With
+// CLK_PER_SAMPLE = C > 1 (ce every C clk cycles; set ROWS_PER_ENGINE = C to share one
+// DDS engine between C rows, which needs exactly that ce spacing) program chip_len_i
+// and rx_delay_i in clk cycles (C x the values in samples): the DDS takes tx_sign_o as
+// it is at each ce edge, so DDS sample k carries the PN sign of clk cycle T_k - 1
+// (T_k = clk edge of ce edge k), i.e. PN chip floor((k - 1) / L) for chip length L
+// samples when the first ce edge is the first clk edge after reset (as in fmt_core).
 // Twin: sim/fmt/dds.py fmt_tx_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -30,6 +35,8 @@ module fmt_tx #(
     parameter SEED       = 1,                // LFSR reset state (non-zero)
     parameter CHIP_W     = 10,               // width of the chip-length setting
     parameter DELAY_W    = 6,                // width of the receive-delay setting
+    parameter ROWS_PER_ENGINE = 1,           // rows per DDS engine (fmt_dds_bank): 1, or
+                                             // CLK_PER_SAMPLE with ce every that many clk
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1  // width of cfg_row_i
 ) (
     input  wire                     clk,
@@ -75,6 +82,7 @@ module fmt_tx #(
         .SINE_BITS  (SINE_BITS),
         .AMP_BITS   (AMP_BITS),
         .DAC_BITS   (DAC_BITS),
+        .ROWS_PER_ENGINE (ROWS_PER_ENGINE),
         .ROW_W      (ROW_W)
     ) u_dds (
         .clk        (clk),

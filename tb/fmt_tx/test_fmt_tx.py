@@ -2,11 +2,13 @@
 sim/fmt/pn.py + sim/fmt/dds.py.
 
 Checks, under both simulators (MEDIUM; SMALL under Icarus, Verilator too with
-FMT_DDS_FULL=1): every DAC word bit-exact with the
-model for random PN settings (chip length, PN enable toggled at random times), random
-DDS settings written at random times, and a reset in the middle of a window; and the
-documented alignment: with rx_delay_i = 3, rx_sign_o is the PN sign of the words on
-dac_o at the same edge.  ce = 1 throughout (fmt_pn_gen has no sample strobe).
+FMT_DDS_FULL=1), for ROWS_PER_ENGINE R = 1 (ce = 1) and R = 3 (ce on clk cycles 0, 3,
+6, ... after reset, PN chip length and receive delay programmed in clk cycles, as
+fmt_core does): every DAC word bit-exact with the model for random PN settings (chip
+length, PN enable toggled at random clk cycles), random DDS settings written at random
+clk cycles, and a reset in the middle of a window; and, for R = 1, the documented
+alignment: with rx_delay_i = 3, rx_sign_o is the PN sign of the words on dac_o at the
+same edge.
 """
 from __future__ import annotations
 
@@ -35,32 +37,40 @@ class TB(BankTB):
         dut.chip_len_i.value = 1
         dut.rx_delay_i.value = ALIGN_DELAY
 
-    async def run_tx(self, n, rng, chip_len, p_toggle=0.01, p_write=0.05):
-        """n cycles after reset (ce = 1): random PN-enable toggles and DDS writes.
-        Returns settings per sample, PN enables per sample, words and rx signs per edge."""
+    async def run_tx(self, n, rng, p_toggle=0.01, p_write=0.05):
+        """Clk cycles after reset until n samples (ce edges; ce on cycles 0, R, 2R, ...)
+        have passed: random PN-enable toggles and DDS writes on any cycle.  Returns
+        settings per sample, PN enables and rx signs per clk cycle, words per ce edge."""
         dut = self.dut
         tws, amps, ens, pen, obs, rxs = [], [], [], [], [], []
         pn_en = 1
-        for t in range(n):
+        t = 0
+        while len(obs) < n:
             if t:
                 await self.writable()
+            ce = int(t % self.rpe == 0)
+            dut.ce.value = ce
             if rng.random() < p_toggle:
                 pn_en ^= 1
             dut.pn_enable_i.value = pn_en
             write = rng.random() < p_write
             dut.cfg_we_i.value = int(write)
-            tws.append(self.tw.copy())
-            amps.append(self.amp.copy())
-            ens.append(self.en.copy())
+            if ce:
+                tws.append(self.tw.copy())
+                amps.append(self.amp.copy())
+                ens.append(self.en.copy())
             pen.append(pn_en)
             if write:
                 self.random_write(rng)
             await RisingEdge(self.clk)
             await ReadOnly()
-            obs.append(self.words())
+            if ce:
+                obs.append(self.words())
             rxs.append(int(dut.rx_sign_o.value))
+            t += 1
         await self.writable()
         dut.cfg_we_i.value = 0
+        dut.ce.value = 1 if self.rpe == 1 else 0
         return (np.array(tws), np.array(amps), np.array(ens), np.array(pen),
                 np.array(obs), np.array(rxs))
 
@@ -75,40 +85,51 @@ def pn_tx(n, chip_len, pen, bits):
 @cocotb.test()
 async def bit_exact_pn_and_settings(dut):
     tb = TB(dut)
+    R = tb.rpe
     rng = random.Random(env_int("SEED", 5))
+    err0 = tb.ce_errors()
     for seg in range(3):
-        chip_len = [1, rng.randrange(2, 5), 0][seg]
+        chip_len = [1, rng.randrange(2, 5), 0][seg]        # samples per chip (0 = 1)
+        chip_clk = chip_len if R == 1 else max(1, chip_len) * R
         await tb.writable()
-        dut.chip_len_i.value = chip_len
+        dut.chip_len_i.value = chip_clk
+        dut.rx_delay_i.value = ALIGN_DELAY * R
+        dut.ce.value = 0 if R > 1 else 1
         await tb.reset()
         tb.defaults()
         n = 2 * tb.cfg.n_fft + 64   # the LFSR (seed 1) shows its first 1 at chip 14
-        tw, amp, en, pen, obs, rxs = await tb.run_tx(n, rng, chip_len, p_toggle=0.02 if seg else 0,
+        tw, amp, en, pen, obs, rxs = await tb.run_tx(n, rng, p_toggle=0.02 if seg else 0,
                                                      p_write=0.05 if seg else 0)
         if seg == 0:
             # reset comb, PN on: the transmit twin fmt_tx_fixed
             ref = dds.fmt_tx_fixed(n, cfg=tb.cfg, pn_enable=True, chip_len=chip_len)
             assert not obs[:LATENCY].any()
             assert np.array_equal(obs[LATENCY:], ref[:n - LATENCY]), "fmt_tx_fixed mismatch"
-        tx = pn_tx(n, chip_len, pen, tb.pn_bits)
-        sign = np.concatenate([[0], tx[:-1]])          # DDS sample k takes PN sample k-1
+        n_clk = len(pen)
+        tx = pn_tx(n_clk, chip_clk, pen, tb.pn_bits)       # tx_sign_o after clk edge i
+        # DDS sample k (ce edge at clk edge kR) takes tx_sign_o as it is before that edge
+        sign = np.concatenate([[0], tx[R * np.arange(1, n) - 1]])
         tb.check(tw, amp, en, sign, obs, what=f"segment {seg} chip_len {chip_len}")
-        # rx_sign_o (delay 3) after edge j = tx sign of PN sample j-3 = sign of dac word j
-        exp_rx = np.concatenate([np.zeros(ALIGN_DELAY, dtype=np.int64), tx[:-ALIGN_DELAY]])
-        assert np.array_equal(rxs, exp_rx), "rx_sign_o"
-        assert np.array_equal(rxs[LATENCY:], sign[:n - LATENCY]), "rx sign aligned with dac words"
         assert tx.any(), "PN active in this segment"
+        assert tb.ce_errors() == err0
+        if R == 1:
+            # rx_sign_o (delay 3) after edge j = tx sign of PN sample j-3 = sign of dac word j
+            exp_rx = np.concatenate([np.zeros(ALIGN_DELAY, dtype=np.int64), tx[:-ALIGN_DELAY]])
+            assert np.array_equal(rxs, exp_rx), "rx_sign_o"
+            assert np.array_equal(rxs[LATENCY:], sign[:n - LATENCY]), "rx sign aligned with dac words"
         # a reset in the middle of the next window comes with the next segment
         await tb.cycles(rng.randrange(1, tb.cfg.n_fft))
 
 
+@pytest.mark.parametrize("rpe", [1, 3], ids=lambda r: f"r{r}")
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
-def test_fmt_tx(sim, cfg):
+def test_fmt_tx(sim, cfg, rpe):
     skip_extra_verilator_build(sim, cfg is params.SMALL)
     p = cfg.verilog_params()
     parameters = {k: p[k] for k in ("ROWS", "LOG2_N", "BIN_LO", "BIN_STEP", "PHASE_BITS",
                                     "AMP_BITS", "SINE_BITS", "DAC_BITS", "PN_BITS")}
-    parameters.update(TAPS=MAXIMAL_TAPS[cfg.pn_bits], TABLE_ADDR=dds.TABLE_ADDR)
+    parameters.update(TAPS=MAXIMAL_TAPS[cfg.pn_bits], TABLE_ADDR=dds.TABLE_ADDR,
+                      ROWS_PER_ENGINE=rpe)
     run_cocotb(
         sim=sim,
         toplevel="fmt_tx",
@@ -116,6 +137,6 @@ def test_fmt_tx(sim, cfg):
         test_module="test_fmt_tx",
         test_dir=Path(__file__).parent,
         parameters=parameters,
-        extra_env={"CFG": cfg.name, "PN_BITS": cfg.pn_bits},
+        extra_env={"CFG": cfg.name, "PN_BITS": cfg.pn_bits, "RPE": rpe},
         build_args=build_args(sim),
     )
