@@ -25,6 +25,9 @@
 // With POST_CLK = 1 out_valid is a one-clk pulse, else it is held for the ce period.
 // Flags (sticky until reset): fft_ovf_o (FFT internal saturation), sat_o (a cell
 // clipped at 2^HM_W - 1).  The magnitude cannot overflow (fmt_magnitude).
+// Structure: fmt_rx_pair_front (despread, FFT, bookkeeping, split) + this pair's own
+// magnitude units and accumulator.  fmt_rx_array uses the front only and shares a few
+// magnitude units and one accumulator memory among all pairs.
 // Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (columns of one pair).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -64,81 +67,30 @@ module fmt_col_pair_rx #(
     localparam W    = FFT_OUT_W;
     localparam MW   = W + 1;                        // pair split / magnitude width
     localparam TAGW = ROW_W + 2 + SH_W;             // {row, first, last, shift}
-    localparam [M_LOG2_MAX:0] ONE = 1;
-    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
 
-    // ---- despread ----
-    wire signed [ADC_BITS:0] xa, xb;
-    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsa (
-        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_a_i), .sign_i(rx_sign_i), .y_o(xa));
-    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsb (
-        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_b_i), .sign_i(rx_sign_i), .y_o(xb));
-
-    // ---- FFT ----
-    // The despreaders add one ce cycle; the FFT is held in reset through the first ce
-    // after reset so that its window 0 is ADC samples 0 .. N-1 (counted from that ce).
-    reg fft_rst_q;
-    always @(posedge clk) begin
-        if (rst)      fft_rst_q <= 1'b1;
-        else if (ce)  fft_rst_q <= 1'b0;
-    end
-
-    wire                f_valid;
-    wire [LOG2_N-1:0]   f_slot, f_bin;
-    wire signed [W-1:0] f_re, f_im;
-    fmt_fft_r22sdf #(
-        .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W), .TW_DIR(TW_DIR)
-    ) u_fft (
-        .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re(xa), .in_im(xb),
-        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
-        .out_re(f_re), .out_im(f_im), .ovf_o(fft_ovf_o));
-
-    // ---- back-end pipeline enable ----
-    // The FFT's out_valid is 1 only on ce cycles: its outputs are taken on ce edges;
-    // the stages after the pair split's input register run on every clk (POST_CLK = 1)
-    // or on ce (POST_CLK = 0).
-    wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
-
-    // ---- window / frame bookkeeping (at the FFT output) ----
-    reg                  started_q;
-    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
-    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
-    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
-    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
-    wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}});
-    wire                 wrap    = !started_q || (wcnt_q == last_q);
-    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
-    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
-    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
-    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
-    wire                 w_last  = (w_cur == last_cur);
-
-    always @(posedge clk) begin
-        if (rst) begin
-            started_q <= 1'b0;
-            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
-            m_q       <= {SH_W{1'b0}};
-        end else if (ce && new_win) begin
-            started_q <= 1'b1;
-            wcnt_q    <= w_cur;
-            m_q       <= m_cur;
-        end
-    end
-
-    // ---- pair split ----
-    wire                ps_valid;
-    wire [ROW_W-1:0]    ps_row;
+    // ---- despread, FFT, frame bookkeeping, pair split (shared with fmt_rx_array) ----
+    wire                 ps_valid;
+    wire [ROW_W-1:0]     ps_row;
     wire signed [MW-1:0] ps_ar, ps_ai, ps_br, ps_bi;
-    wire [SH_W+1:0]     ps_tag;
-    fmt_pair_split #(
+    wire [SH_W+1:0]      ps_tag;
+    // the front's result memory serves shared magnitude units (fmt_rx_array); here the
+    // split outputs feed this pair's own units, so its read port is left unused
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [4*MW-1:0]      unused_rd;
+    /* verilator lint_on UNUSEDSIGNAL */
+    fmt_rx_pair_front #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
-    ) u_split (
-        .clk(clk), .rst(rst), .ce(post_ce),
-        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
-        .in_tag({m_cur, w_first, w_last}),
-        .out_valid(ps_valid), .out_row(ps_row),
-        .a_re(ps_ar), .a_im(ps_ai), .b_re(ps_br), .b_im(ps_bi), .out_tag(ps_tag));
+        .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W), .TW_DIR(TW_DIR),
+        .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
+    ) u_front (
+        .clk(clk), .rst(rst), .ce(ce), .adc_a_i(adc_a_i), .adc_b_i(adc_b_i),
+        .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+        .ps_valid_o(ps_valid), .ps_row_o(ps_row), .ps_tag_o(ps_tag),
+        .ps_ar_o(ps_ar), .ps_ai_o(ps_ai), .ps_br_o(ps_br), .ps_bi_o(ps_bi),
+        .rd_row_i({ROW_W{1'b0}}), .rd_data_o(unused_rd), .fft_ovf_o(fft_ovf_o));
+
+    // the stages after the split run on every clk (POST_CLK = 1) or on ce (POST_CLK = 0)
+    wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
 
     // ---- magnitudes ----
     wire             mg_valid;

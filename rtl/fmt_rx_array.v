@@ -1,21 +1,45 @@
-// fmt_rx_array -- the receive back end of all columns: COLS/2 fmt_col_pair_rx in
-// lockstep (column 2p is lane a, 2p+1 lane b of pair p; COLS must be even), one shared
-// receive PN sign, emitting the HEAT-MAP STREAM of docs/ARCHITECTURE.md:
-//   hm_valid  one whole row (all COLS cells) for one clk cycle, rows in the order their
-//             comb pair completes in the FFT's bit-reversed output, each row once per frame
-//   hm_row    row index, hm_frame frame number (wraps, FRAME_W bits, from 0 after reset)
-//   hm_data   column c at [c*HM_W +: HM_W], unsigned
-//   hm_eof    one clk cycle after the frame's last row (POST_CLK = 0: one ce period after);
-//             never with a row (rows are at least one ce period apart)
-// The stream registers run on clk; at most one beat per ce period.  Frame = M = 2^m_log2_i
-// windows (see fmt_col_pair_rx); a reset in the middle of a window drops it and the
-// stream restarts with the first full frame.
-// Latency: fmt_col_pair_rx + 1 clk (stream register): N = 256, ce = 1: the last row
-// 292 fs cycles after the window's last ADC sample, hm_eof 293; at 3 x fs (POST_CLK = 1)
-// 840 / 841 clk = 280.0 / 280.3 fs cycles (tb/fmt_rx_array measures it).
-// Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = OR
-// of the heat-map cell saturations; ovf_o = either (the magnitude cannot overflow).
-// Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed.
+// fmt_rx_array -- the receive back end of all columns, emitting the HEAT-MAP STREAM of
+// docs/ARCHITECTURE.md.  Per column pair p (column 2p = lane a, 2p+1 = lane b; COLS even)
+// a fmt_rx_pair_front (despread x2, FFT, pair split, result memory) runs in lockstep with
+// the others; MAG_UNITS magnitude units (fmt_magnitude) and ONE accumulator memory are
+// shared by all columns:
+//   queue   every pair completes a row's comb bins in the same slot (pair 0 stands for
+//           all); {row, log2 M, first, last} enter a FIFO (2^ROW_W entries, LUT RAM)
+//   engine  takes a row from the FIFO and reads the pairs' result memories at that row
+//           (one address for all pairs), feeding unit u with cell c = g*MAG_UNITS + u in
+//           step g = 0 .. P-1, P = ceil(COLS / MAG_UNITS): a row takes P steps
+//   accum   one memory of 2^(ROW_W+G_W) x MAG_UNITS*SUM_W bits, address {row, g}
+//           (synchronous read: block RAM), sum over the M windows, round, saturate
+//           (arithmetic exactly that of fmt_accum)
+//   stream  group g's cells go into the row register at [g*MAG_UNITS*HM_W]; after the
+//           last group hm_valid is high for one clk with the whole row
+// A "step" is a clk (POST_CLK = 1) or a ce cycle (POST_CLK = 0); rows complete at most
+// one per ce, in the FFT's bit-reversed order (bursts of two then >= 7 slots at N = 256;
+// sim/fmt/rx_fixed.py row_order).
+// MAG_UNITS rule: steps per FFT slot C = CLK_PER_SAMPLE (POST_CLK = 1) or 1 (POST_CLK =
+// 0); with rows arriving at step C * slot, the default is the smallest K for which no
+// row waits longer than P steps for the engine (a row waits at most for its burst
+// partner) and the engine is idle again before the next window: 30 x 40, N = 256:
+// K = 4 at C = 3, K = 10 at C = 1.  Elaboration fails (missing module
+// fmt_rx_array_MAG_UNITS_too_few) when K cannot finish a window's rows before the next
+// window's first row; at run time (ce faster than CLK_PER_SAMPLE says) a row arriving
+// with the queue full or while its previous window's copy is still queued or being fed
+// sets the sticky overrun bit, reported in ovf_o.  Twin: rx_fixed.rx_share_schedule.
+// Stream: hm_valid one clk per row, hm_row its index, hm_frame the frame number (wraps,
+// FRAME_W bits, from 0 after reset), hm_data column c at [c*HM_W +: HM_W] (valid with
+// hm_valid), hm_eof one step after the frame's last row, never with a row.  Frame =
+// M = 2^m_log2_i windows (fmt_rx_pair_front); a reset in the middle of a window drops it
+// and the stream restarts with the first full frame.
+// Latency (M = 1), from the ce edge that takes a window's last ADC sample: row r's pair
+// split output is registered LATENCY0 + slot_r + 1 ce cycles later (step a_r); the row is
+// queued at a_r + 1, loaded at L_r >= a_r + 2, and its beat is at step
+// L_r + P + MAG_ITER + 6 (P unit input steps, MAG_ITER + 3 magnitude stages, accumulator
+// read, sum, round, row register).  N = 256, 30 x 40: last row 298 ce cycles after the
+// window's last sample at ce = 1 (K = 10); at 3 x fs (K = 4) 852 clk = 284.0 fs cycles,
+// hm_eof 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
+// Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
+// heat-map cell saturated, ovf_o = either or a queue overrun (the magnitude cannot overflow).
+// Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (values), rx_row_beats (timing).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -30,9 +54,13 @@ module fmt_rx_array #(
     parameter FRAME_W    = 16,             // frame counter width
     parameter M_LOG2_MAX = 3,              // largest log2 M
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
-    parameter POST_CLK   = 1,              // back end after the FFT on every clk (see fmt_col_pair_rx)
+    parameter POST_CLK   = 1,              // 1: back end after the FFT on every clk, 0: on ce
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
-    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
+    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1, // width of m_log2_i
+    parameter CLK_PER_SAMPLE = (POST_CLK != 0) ? 3 : 1,   // smallest clk per ce period the
+                                           // shared units must keep up with (POST_CLK = 1)
+    parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
+    parameter MAG_UNITS  = 0               // shared magnitude units K; 0 = the default rule
 ) (
     input  wire                     clk,
     input  wire                     rst,       // synchronous, active high
@@ -43,83 +71,413 @@ module fmt_rx_array #(
     output reg                      hm_valid,  // heat-map row beat
     output reg  [ROW_W-1:0]         hm_row,    // row index
     output reg  [FRAME_W-1:0]       hm_frame,  // frame number
-    output reg  [COLS*HM_W-1:0]     hm_data,   // the row's cells
+    output wire [COLS*HM_W-1:0]     hm_data,   // the row's cells
     output reg                      hm_eof,    // end of frame marker
     output wire                     fft_ovf_o, // sticky: an FFT saturated
     output wire                     sat_o,     // sticky: a heat-map cell saturated
-    output wire                     ovf_o      // sticky: either of the above
+    output wire                     ovf_o      // sticky: either of the above or a queue overrun
 );
 
     localparam PAIRS = COLS / 2;
+    localparam N     = 1 << LOG2_N;
+    // FFT output scaling: as fmt_col_pair_rx (X * 2^-S, S = ADC_BITS + LOG2_N - 2 - HM_W)
+    localparam FFT_SHIFT = (ADC_BITS + LOG2_N - 2 > HM_W) ? ADC_BITS + LOG2_N - 2 - HM_W : 0;
+    localparam W     = ADC_BITS + LOG2_N + 2 - FFT_SHIFT;   // FFT output width
+    localparam MW    = W + 1;                                // split / magnitude width
+    localparam CW    = 2 * MW;                               // one cell {im, re}
+    localparam STEPC = (POST_CLK != 0) ? CLK_PER_SAMPLE : 1; // steps per FFT slot
 
-    wire [PAIRS-1:0]        p_valid, p_last, p_ovf, p_sat;
+    // ---- schedule of the shared units (elaboration-time; twin rx_fixed.rx_share_schedule)
+    function integer bitrev_f;
+        input integer v;
+        integer j;
+        begin
+            bitrev_f = 0;
+            for (j = 0; j < LOG2_N; j = j + 1)
+                if (((v >> j) & 1) != 0) bitrev_f = bitrev_f | (1 << (LOG2_N - 1 - j));
+        end
+    endfunction
+    // FFT slot at which row r's pair (k, N - k) is complete
+    function integer slot_f;
+        input integer r;
+        integer k, s1, s2;
+        begin
+            k  = BIN_LO + r * BIN_STEP;
+            s1 = bitrev_f(k);
+            s2 = bitrev_f(N - k);
+            slot_f = (s1 > s2) ? s1 : s2;
+        end
+    endfunction
+    // the row completing last (the frame's last row beat)
+    function integer last_row_f;
+        input integer dummy;
+        integer r, best;
+        begin
+            best = -1;
+            last_row_f = 0;
+            for (r = 0; r < ROWS; r = r + 1) begin
+                if (slot_f(r) > best) begin
+                    best = slot_f(r);
+                    last_row_f = r + 0 * dummy;
+                end
+            end
+        end
+    endfunction
+    // simulate one window with K units: mode 0 -> 1 if the engine is free before the next
+    // window's first row can load; mode 1 -> 1 if also no row waits more than P steps
+    function integer fits_f;
+        input integer k_units;
+        input integer mode;
+        integer p, i, r, prev, best, a, l, f, first, ok;
+        begin
+            p = (COLS + k_units - 1) / k_units;
+            prev = -1;
+            f = 0;
+            first = -1;
+            ok = 1;
+            for (i = 0; i < ROWS; i = i + 1) begin
+                best = 2 * N;
+                for (r = 0; r < ROWS; r = r + 1)
+                    if (slot_f(r) > prev && slot_f(r) < best) best = slot_f(r);
+                if (first < 0) first = best;
+                prev = best;
+                a = best * STEPC;
+                l = (a + 2 > f) ? a + 2 : f;
+                if (mode != 0 && l - (a + 2) > p) ok = 0;
+                f = l + p;
+            end
+            if (f > (first + N) * STEPC + 1) ok = 0;
+            fits_f = ok;
+        end
+    endfunction
+    function integer units_f;
+        input integer dummy;
+        integer k;
+        begin
+            units_f = COLS + 0 * dummy;
+            for (k = COLS; k >= 1; k = k - 1)
+                if (fits_f(k, 1) != 0) units_f = k;
+        end
+    endfunction
+
+    localparam K    = (MAG_UNITS > 0) ? MAG_UNITS : units_f(0);
+    localparam P    = (COLS + K - 1) / K;                    // steps (groups) per row
+    localparam G_W  = (P > 1) ? $clog2(P) : 1;               // group index width
+    localparam AW   = ROW_W + G_W;                           // accumulator address {row, g}
+    localparam SUM_W = MW + M_LOG2_MAX;                      // exact sum over M windows
+    localparam TS   = M_LOG2_MAX + 1;                        // largest shift (HM_SHIFT = 1)
+    localparam EW   = (SUM_W > HM_W) ? SUM_W + 1 : HM_W + 1; // width after the rounding half
+    localparam TAGW = ROW_W + G_W + SH_W + 2;                // {row, g, log2 M, first, last}
+    localparam QD   = 1 << ROW_W;                            // queue depth (>= ROWS)
+    localparam LAST_ROW = last_row_f(0);
+    localparam integer PM1 = P - 1;
+    localparam [G_W-1:0] G_LAST = PM1[G_W-1:0];
+
+    generate
+        if (fits_f(K, 0) == 0) begin : g_check
+            // MAG_UNITS too small for CLK_PER_SAMPLE: stop elaboration
+            fmt_rx_array_MAG_UNITS_too_few u_too_few ();
+        end
+    endgenerate
+
+    // ---- per pair: despread, FFT, pair split, result memory ----
+    wire [PAIRS-1:0]        p_valid, p_ovf;
     wire [PAIRS*ROW_W-1:0]  p_row;
-    wire [COLS*HM_W-1:0]    p_hm;
+    wire [PAIRS*(SH_W+2)-1:0] p_tag;
+    wire [P*K*CW-1:0]       cells;       // the engine's row: cell c = {im, re} at [c*CW +: CW]
+    reg  [ROW_W-1:0]        row_q;       // engine row (result memory read address)
+
+    // split outputs are used through the result memories only
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [PAIRS*4*MW-1:0]   p_split;
+    /* verilator lint_on UNUSEDSIGNAL */
 
     genvar p;
     generate
         for (p = 0; p < PAIRS; p = p + 1) begin : g_pair
-            fmt_col_pair_rx #(
+            fmt_rx_pair_front #(
                 .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-                .ADC_BITS(ADC_BITS), .HM_W(HM_W), .M_LOG2_MAX(M_LOG2_MAX),
+                .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
                 .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
-            ) u_pair (
+            ) u_front (
                 .clk(clk), .rst(rst), .ce(ce),
                 .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
                 .adc_b_i(adc_i[(2*p+1)*ADC_BITS +: ADC_BITS]),
                 .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
-                .out_valid(p_valid[p]), .out_row(p_row[p*ROW_W +: ROW_W]),
-                .out_hm(p_hm[2*p*HM_W +: 2*HM_W]), .out_last_row(p_last[p]),
-                .fft_ovf_o(p_ovf[p]), .sat_o(p_sat[p]));
+                .ps_valid_o(p_valid[p]), .ps_row_o(p_row[p*ROW_W +: ROW_W]),
+                .ps_tag_o(p_tag[p*(SH_W+2) +: SH_W+2]),
+                .ps_ar_o(p_split[(4*p)*MW +: MW]), .ps_ai_o(p_split[(4*p+1)*MW +: MW]),
+                .ps_br_o(p_split[(4*p+2)*MW +: MW]), .ps_bi_o(p_split[(4*p+3)*MW +: MW]),
+                .rd_row_i(row_q), .rd_data_o(cells[p*2*CW +: 2*CW]),   // {cell b, cell a}
+                .fft_ovf_o(p_ovf[p]));
+        end
+        if (P * K > COLS) begin : g_pad
+            assign cells[P*K*CW-1:COLS*CW] = {((P*K-COLS)*CW){1'b0}};
         end
     endgenerate
 
-    assign fft_ovf_o = |p_ovf;
-    assign sat_o     = |p_sat;
-    assign ovf_o     = fft_ovf_o | sat_o;
-
-    // the pairs run in lockstep: pair 0's valid, row and last-row mark stand for all
-    // (the others' are identical)
+    // the pairs run in lockstep: pair 0's valid, row and tag stand for all
     /* verilator lint_off UNUSEDSIGNAL */
-    wire [PAIRS-1:0]       unused_valid = p_valid;
-    wire [PAIRS*ROW_W-1:0] unused_row   = p_row;
-    wire [PAIRS-1:0]       unused_last  = p_last;
+    wire [PAIRS-1:0]          unused_valid = p_valid;
+    wire [PAIRS*ROW_W-1:0]    unused_row   = p_row;
+    wire [PAIRS*(SH_W+2)-1:0] unused_tag   = p_tag;
     /* verilator lint_on UNUSEDSIGNAL */
 
-    reg ce_q;          // the pair outputs were updated on the last edge (POST_CLK = 0)
-    reg eof_pend_q;    // the frame's last row has gone out, hm_eof follows
-    // POST_CLK = 1: the pair outputs are one-clk pulses; 0: held for a ce period, new
-    // on the clk after a ce edge
-    wire fresh = (POST_CLK != 0) ? 1'b1 : ce_q;
+    // the stages after the split advance on every clk (POST_CLK = 1) or on ce
+    wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
+
+    // ---- row queue: {row, log2 M, first, last} ----
+    reg [ROW_W+SH_W+1:0] q_mem [0:QD-1];
+    reg [ROW_W-1:0]      q_wr_q, q_rd_q;
+    reg [ROW_W:0]        q_cnt_q;
+    reg                  overrun_q;      // sticky: a row arrived with the queue full or
+                                         // before its previous copy was read
+    reg                  busy_q;         // the engine is feeding a row
+    reg [G_W-1:0]        g_q;            // group being fed
+    reg [SH_W+1:0]       etag_q;         // the row's {log2 M, first, last}
+
+    wire q_push = post_ce && p_valid[0];
+    wire q_full = (q_cnt_q == QD[ROW_W:0]);
+    wire load   = post_ce && (q_cnt_q != {(ROW_W+1){1'b0}}) && (!busy_q || g_q == G_LAST);
+    wire [ROW_W+SH_W+1:0] q_head = q_mem[q_rd_q];
+
+    always @(posedge clk) begin
+        if (q_push && !q_full) q_mem[q_wr_q] <= {p_row[ROW_W-1:0], p_tag[SH_W+1:0]};
+    end
 
     always @(posedge clk) begin
         if (rst) begin
-            ce_q       <= 1'b0;
+            q_wr_q    <= {ROW_W{1'b0}};
+            q_rd_q    <= {ROW_W{1'b0}};
+            q_cnt_q   <= {(ROW_W+1){1'b0}};
+            overrun_q <= 1'b0;
+            busy_q    <= 1'b0;
+            g_q       <= {G_W{1'b0}};
+        end else begin
+            if (q_push && !q_full) q_wr_q <= q_wr_q + 1'b1;
+            if ((q_push && q_full) || hazard) overrun_q <= 1'b1;
+            if (load)              q_rd_q <= q_rd_q + 1'b1;
+            case ({q_push && !q_full, load})
+                2'b10:   q_cnt_q <= q_cnt_q + 1'b1;
+                2'b01:   q_cnt_q <= q_cnt_q - 1'b1;
+                default: q_cnt_q <= q_cnt_q;
+            endcase
+            if (load) begin
+                busy_q <= 1'b1;
+                g_q    <= {G_W{1'b0}};
+            end else if (post_ce && busy_q) begin
+                if (g_q == G_LAST) busy_q <= 1'b0;
+                else               g_q    <= g_q + 1'b1;
+            end
+        end
+    end
+
+    // data hazard: a row completes again (its result memories are rewritten) while the
+    // previous window's copy is still queued or being fed
+    reg  [ROWS-1:0]  pend_q;             // row queued or being fed
+    wire [ROW_W-1:0] push_row = p_row[ROW_W-1:0];
+    wire             fed     = post_ce && busy_q && (g_q == G_LAST);   // row_q's last group read
+    wire             hazard  = q_push && pend_q[push_row] && !(fed && row_q == push_row);
+    always @(posedge clk) begin
+        if (rst) begin
+            pend_q <= {ROWS{1'b0}};
+        end else begin
+            if (fed)    pend_q[row_q]    <= 1'b0;
+            if (q_push) pend_q[push_row] <= 1'b1;
+        end
+    end
+
+    always @(posedge clk) begin
+        if (load) begin
+            row_q  <= q_head[ROW_W+SH_W+1 -: ROW_W];
+            etag_q <= q_head[SH_W+1:0];
+        end
+    end
+
+    // synthesis translate_off
+    always @(posedge clk) begin
+        if (!rst && ((q_push && q_full) || hazard))
+            $display("%m: ERROR: row queue overrun at %0t (MAG_UNITS %0d too few for this ce rate)", $time, K);
+    end
+    // synthesis translate_on
+
+    // ---- shared magnitude units: unit u takes cell g*K + u ----
+    wire [K*MW-1:0] mags;
+    wire            mg_valid;
+    wire [TAGW-1:0] mg_tag;
+    genvar u;
+    generate
+        for (u = 0; u < K; u = u + 1) begin : g_unit
+            reg [CW-1:0] sel;
+            integer g;
+            always @* begin
+                sel = cells[u*CW +: CW];
+                for (g = 1; g < P; g = g + 1)
+                    if (g_q == g[G_W-1:0]) sel = cells[(g*K+u)*CW +: CW];
+            end
+            if (u == 0) begin : g_lead
+                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag (
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid(busy_q),
+                    .in_re(sel[MW-1:0]), .in_im(sel[CW-1:MW]),
+                    .in_tag({row_q, g_q, etag_q}),
+                    .out_valid(mg_valid), .out_mag(mags[u*MW +: MW]), .out_tag(mg_tag));
+            end else begin : g_follow
+                // runs in lockstep with unit 0: its valid and tag are unit 0's
+                /* verilator lint_off UNUSEDSIGNAL */
+                wire unused_v, unused_t;
+                /* verilator lint_on UNUSEDSIGNAL */
+                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag (
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid(busy_q),
+                    .in_re(sel[MW-1:0]), .in_im(sel[CW-1:MW]), .in_tag(1'b0),
+                    .out_valid(unused_v), .out_mag(mags[u*MW +: MW]), .out_tag(unused_t));
+            end
+        end
+    endgenerate
+
+    // ---- accumulator: one memory for all cells, address {row, g} ----
+    // stage A: read the running sums (block RAM, synchronous read), hold the magnitudes
+    reg [K*SUM_W-1:0] acc_mem [0:(1<<AW)-1];
+    reg [K*SUM_W-1:0] acc_rd_q;
+    reg [K*MW-1:0]    a_mag_q;
+    reg [TAGW-1:0]    a_tag_q;
+    reg               a_valid_q;
+    wire [AW-1:0]     mg_addr = mg_tag[TAGW-1 -: AW];
+
+    always @(posedge clk) begin
+        if (post_ce) begin
+            acc_rd_q <= acc_mem[mg_addr];
+            a_mag_q  <= mags;
+            a_tag_q  <= mg_tag;
+        end
+    end
+
+    // stage B: sum = first ? mag : sum + mag (exact), written back; only the last
+    // window's sums go on
+    wire [AW-1:0]   a_addr  = a_tag_q[TAGW-1 -: AW];
+    wire            a_first = a_tag_q[1];
+    wire            a_last  = a_tag_q[0];
+    reg [K*SUM_W-1:0] sum_d;
+    integer l;
+    always @* begin
+        for (l = 0; l < K; l = l + 1)
+            sum_d[l*SUM_W +: SUM_W] = (a_first ? {SUM_W{1'b0}} : acc_rd_q[l*SUM_W +: SUM_W])
+                                    + {{M_LOG2_MAX{1'b0}}, a_mag_q[l*MW +: MW]};
+    end
+
+    always @(posedge clk) begin
+        if (post_ce && a_valid_q) acc_mem[a_addr] <= sum_d;
+    end
+
+    reg [K*SUM_W-1:0] b_sum_q;
+    // {first, last} are spent at stage B (b_valid_q carries "last")
+    /* verilator lint_off UNUSEDSIGNAL */
+    reg [TAGW-1:0]    b_tag_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg               b_valid_q;
+    always @(posedge clk) begin
+        if (post_ce) begin
+            b_sum_q <= sum_d;
+            b_tag_q <= a_tag_q;
+        end
+    end
+
+    // stage C: cell = (sum + 2^(s-1)) >> s, s = log2 M + 1 (round half up), saturated
+    wire [SH_W-1:0] b_shift   = b_tag_q[SH_W+1:2];
+    wire [TS:0]     shift_tot = {{(TS+1-SH_W){1'b0}}, b_shift} + 1'b1;
+    reg [K*HM_W-1:0] cell_d;
+    reg              clip_d;
+    reg [EW-1:0]     rnd, scaled;
+    always @* begin
+        clip_d = 1'b0;
+        for (l = 0; l < K; l = l + 1) begin
+            rnd    = {{(EW-SUM_W){1'b0}}, b_sum_q[l*SUM_W +: SUM_W]} + ({{(EW-1){1'b0}}, 1'b1} << shift_tot >> 1);
+            scaled = rnd >> shift_tot;
+            if (scaled > {{(EW-HM_W){1'b0}}, {HM_W{1'b1}}}) begin
+                cell_d[l*HM_W +: HM_W] = {HM_W{1'b1}};
+                clip_d = 1'b1;
+            end else begin
+                cell_d[l*HM_W +: HM_W] = scaled[HM_W-1:0];
+            end
+        end
+    end
+
+    reg [K*HM_W-1:0] c_cells_q;
+    reg [ROW_W-1:0]  c_row_q;
+    reg [G_W-1:0]    c_g_q;
+    reg              c_valid_q;
+    reg              sat_q;
+    always @(posedge clk) begin
+        if (post_ce) begin
+            c_cells_q <= cell_d;
+            c_row_q   <= b_tag_q[TAGW-1 -: ROW_W];
+            c_g_q     <= b_tag_q[TAGW-ROW_W-1 -: G_W];
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            a_valid_q <= 1'b0;
+            b_valid_q <= 1'b0;
+            c_valid_q <= 1'b0;
+            sat_q     <= 1'b0;
+        end else if (post_ce) begin
+            a_valid_q <= mg_valid;
+            b_valid_q <= a_valid_q && a_last;
+            c_valid_q <= b_valid_q;
+            if (b_valid_q && clip_d) sat_q <= 1'b1;
+        end
+    end
+
+    // stage D: the row register and the stream
+    reg [P*K*HM_W-1:0] row_q_data;
+    integer gg;
+    always @(posedge clk) begin
+        if (post_ce && c_valid_q) begin
+            for (gg = 0; gg < P; gg = gg + 1)
+                if (c_g_q == gg[G_W-1:0]) row_q_data[gg*K*HM_W +: K*HM_W] <= c_cells_q;
+        end
+    end
+    assign hm_data = row_q_data[COLS*HM_W-1:0];
+    generate
+        if (P * K > COLS) begin : g_pad_out
+            // the last group's cells beyond COLS are zero magnitudes of padding
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [(P*K-COLS)*HM_W-1:0] unused_pad = row_q_data[P*K*HM_W-1:COLS*HM_W];
+            /* verilator lint_on UNUSEDSIGNAL */
+        end
+    endgenerate
+
+    wire row_done = c_valid_q && (c_g_q == G_LAST);
+    reg  eof_pend_q;   // the frame's last row has gone out, hm_eof follows
+    always @(posedge clk) begin
+        if (rst) begin
             eof_pend_q <= 1'b0;
             hm_valid   <= 1'b0;
             hm_eof     <= 1'b0;
             hm_frame   <= {FRAME_W{1'b0}};
         end else begin
-            ce_q     <= ce;
             hm_valid <= 1'b0;
             hm_eof   <= 1'b0;
-            if (fresh && p_valid[0]) begin
-                hm_valid <= 1'b1;
-                if (p_last[0]) eof_pend_q <= 1'b1;
-            end else if (fresh && eof_pend_q) begin
-                hm_eof     <= 1'b1;
-                eof_pend_q <= 1'b0;
+            if (post_ce) begin
+                if (row_done) begin
+                    hm_valid <= 1'b1;
+                    if (c_row_q == LAST_ROW[ROW_W-1:0]) eof_pend_q <= 1'b1;
+                end else if (eof_pend_q) begin
+                    hm_eof     <= 1'b1;
+                    eof_pend_q <= 1'b0;
+                end
             end
             if (hm_eof) hm_frame <= hm_frame + 1'b1;
         end
     end
 
     always @(posedge clk) begin
-        if (fresh && p_valid[0]) begin
-            hm_row  <= p_row[ROW_W-1:0];
-            hm_data <= p_hm;
-        end
+        if (post_ce && row_done) hm_row <= c_row_q;
     end
+
+    assign fft_ovf_o = |p_ovf;
+    assign sat_o     = sat_q;
+    assign ovf_o     = fft_ovf_o | sat_q | overrun_q;
 
 endmodule
 

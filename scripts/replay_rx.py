@@ -56,7 +56,10 @@ def main(argv=None) -> int:
         test_dir=ROOT / "tb" / "fmt_rx_array",
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
                     "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
-                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"'},
+                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"',
+                    # the replay feeds a sample every clk: size the shared magnitude units
+                    # for ce = 1 (CLK_PER_SAMPLE 1)
+                    "CLK_PER_SAMPLE": 1},
         extra_env=env,
         build_args=VERILATOR_ARGS,
     )

@@ -212,3 +212,60 @@ def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, shift: float | None = 
 
 def get_cfg(name: str):
     return _params.get(name)
+
+
+# ---- timing of fmt_rx_array's shared magnitude units (no arithmetic) -----------------
+RX_SHARE_BACK = MAG_ITER + 6   # steps from a row's last unit input to its beat, minus P:
+#                                P unit input steps + MAG_ITER + 3 magnitude stages +
+#                                accumulator read, sum, round, row register
+
+
+def rx_share_schedule(cfg, units: int, step_per_slot: int):
+    """Twin of fmt_rx_array's row queue and engine over one window (engine idle at the
+    start).  Row r's split output is registered at step a_r = step_per_slot * slot_r (+ a
+    constant common to all rows, left out), it is queued at a_r + 1 and loaded at
+    L_r = max(a_r + 2, previous load + P).  Returns (P, dict row -> (a_r, L_r),
+    keeps_up, no_long_wait): keeps_up = the engine can load the next window's first row
+    on time (the elaboration check of the RTL), no_long_wait = also no row waits more than
+    P steps (the rule of the default MAG_UNITS)."""
+    slots = completion_slots(cfg)
+    p = -(-cfg.cols // units)
+    f, sched, wait_ok = 0, {}, True
+    order = row_order(cfg)
+    for r in order:
+        a = int(slots[r]) * step_per_slot
+        lo = max(a + 2, f)
+        wait_ok = wait_ok and (lo - (a + 2) <= p)
+        f = lo + p
+        sched[int(r)] = (a, lo)
+    keeps = f <= (int(slots[order[0]]) + cfg.n_fft) * step_per_slot + 1
+    return p, sched, keeps, keeps and wait_ok
+
+
+def rx_mag_units_default(cfg, step_per_slot: int) -> int:
+    """fmt_rx_array's default MAG_UNITS: the smallest K with no row waiting longer than P
+    steps (and the engine idle before the next window)."""
+    for k in range(1, cfg.cols + 1):
+        if rx_share_schedule(cfg, k, step_per_slot)[3]:
+            return k
+    return cfg.cols
+
+
+def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None,
+                 units=None):
+    """clk cycles from the ce edge that takes a window's last ADC sample to each row's
+    heat-map beat (M = 1), dict row -> clk.  every = clk per ce in the run; cps =
+    fmt_rx_array CLK_PER_SAMPLE (default: 3 if post_clk else 1); units = MAG_UNITS
+    (default: the rule).  latency0 = fft_fixed.latency0 of the receiver's FFT."""
+    if cps is None:
+        cps = 3 if post_clk else 1
+    steps_cfg = cps if post_clk else 1        # what the RTL sizes K for
+    if units is None:
+        units = rx_mag_units_default(cfg, steps_cfg)
+    steps_run = every if post_clk else 1       # steps per FFT slot in this run
+    step_clk = 1 if post_clk else every        # clk per step
+    p, sched, keeps, _ = rx_share_schedule(cfg, units, steps_run)
+    if not keeps:
+        raise ValueError(f"{units} magnitude units do not keep up at {steps_run} steps per slot")
+    base = (latency0 + 1) * every             # split of slot 0, clk (a ce edge)
+    return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}

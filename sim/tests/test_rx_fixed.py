@@ -144,3 +144,74 @@ def test_rx_fixed_vs_float(name):
     assert np.abs(e).max() <= 2.0
     assert np.sqrt(np.mean(e ** 2)) < 0.5
     assert abs(e.mean()) < 0.3
+
+
+# ---- timing of fmt_rx_array's shared magnitude units ---------------------------------
+def _step_sim(cfg, units, step_per_slot, windows=3):
+    """Independent cycle-by-cycle model of fmt_rx_array's queue and engine (registers
+    updated per step as in the RTL) over several windows; returns (load steps of the
+    first window's rows, overrun)."""
+    slots = R.completion_slots(cfg)
+    p = -(-cfg.cols // units)
+    arrive = {}                                    # step -> row (split output registered)
+    for w in range(windows):
+        for r, s in enumerate(slots):
+            arrive[(int(s) + w * cfg.n_fft) * step_per_slot] = (w, r)
+    end = (windows + 1) * cfg.n_fft * step_per_slot
+    fifo, busy, g, cur, loads, over, pend = [], False, 0, None, {}, False, set()
+    split = None                                   # split output visible this step
+    for t in range(end):
+        # edge at the end of step t: registers take their next values
+        push = split
+        load = bool(fifo) and (not busy or g == p - 1)
+        fed = busy and g == p - 1
+        if fed:
+            pend.discard(cur[1])
+        if push is not None:
+            if push[1] in pend or len(fifo) == 1 << max(1, (cfg.rows - 1).bit_length()):
+                over = True
+            pend.add(push[1])
+        if load:
+            cur = fifo.pop(0)
+            busy, g = True, 0
+            loads[cur] = t + 1
+        elif busy:
+            if g == p - 1:
+                busy = False
+            else:
+                g += 1
+        if push is not None:
+            fifo.append(push)
+        split = arrive.get(t + 1)
+    first = {r: loads[(0, r)] for r in range(cfg.rows)}
+    return first, over
+
+
+@pytest.mark.parametrize("name", ["default", "small", "medium"])
+@pytest.mark.parametrize("sps", [1, 3])
+def test_share_schedule_matches_step_sim(name, sps):
+    """rx_share_schedule's loads equal a step-by-step simulation of the queue and engine,
+    no overrun with the default units, and the default is minimal for its rule."""
+    cfg = params.get(name)
+    k = R.rx_mag_units_default(cfg, sps)
+    p, sched, keeps, rule = R.rx_share_schedule(cfg, k, sps)
+    assert keeps and rule
+    loads, over = _step_sim(cfg, k, sps)
+    assert not over
+    assert loads == {r: lo for r, (a, lo) in sched.items()}
+    if k > 1:
+        assert not R.rx_share_schedule(cfg, k - 1, sps)[3]
+
+
+def test_share_defaults_full_size():
+    """30 x 40: 4 units at 3 x fs, 10 at ce = 1; the loads follow row_order, a row
+    waits at most P steps; 3 x fs units at ce = 1 overrun (the RTL flags it)."""
+    cfg = params.DEFAULT
+    assert R.rx_mag_units_default(cfg, 3) == 4
+    assert R.rx_mag_units_default(cfg, 1) == 10
+    p, sched, _, _ = R.rx_share_schedule(cfg, 4, 3)
+    order = sorted(sched, key=lambda r: sched[r][1])
+    assert order == R.row_order(cfg).tolist()
+    assert max(lo - a - 2 for a, lo in sched.values()) <= p
+    assert _step_sim(cfg, 4, 1, windows=8)[1]
+    assert not _step_sim(cfg, 4, 3)[1]

@@ -36,7 +36,7 @@ FLOAT_BOUND_LSB = 2.0
 # the precompiled-header rule of split (parallel) C++ builds: build unsplit.  -O0: the
 # C++ compile dominates these short runs.
 VERILATOR_ARGS = ["--output-split", "0", "-CFLAGS", "-O0"]
-RTL_FILES = ["fmt_rx_array", "fmt_col_pair_rx", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
+RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
              "fmt_fft_delay", "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
 
 
@@ -44,6 +44,8 @@ class TB(ClockedTB):
     def __init__(self, dut):
         super().__init__(dut)
         self.cfg = params.get(env_str("CFG", "small"))
+        if env_int("COLS", 0):
+            self.cfg = self.cfg.replace(cols=env_int("COLS", 0))
         dut.ce.value = 0
         dut.adc_i.value = 0
         dut.rx_sign_i.value = 0
@@ -63,12 +65,14 @@ class TB(ClockedTB):
             v |= (int(x) & m) << (c * b)
         return v
 
-    async def run(self, adc, rx_sign, m_log2=0, ce_every=1, tail=None, stop_at=None):
+    async def run(self, adc, rx_sign, m_log2=0, ce_every=None, tail=None, stop_at=None):
         """Feed the samples (one per ce; ce on every ce_every-th clk), then ``tail`` more
         zero samples.  Returns (beats [(clk, row, frame, data)], eofs [(clk, frame)],
         clk cycle at which each sample was taken)."""
         dut, cfg = self.dut, self.cfg
         n = cfg.n_fft
+        if ce_every is None:
+            ce_every = env_int("CE_EVERY", 1)
         tail = n + 80 if tail is None else tail
         total = len(adc) + tail
         beats, eofs, taken = [], [], []
@@ -197,62 +201,85 @@ async def reset_mid_window(dut):
     check_exact(tb, adc, rx, 0, beats, eofs)
 
 
-POST_STAGES = 1 + (R.MAG_ITER + 3) + 2        # pair split, magnitude, accum
-
-
-def latency_formula(cfg, every=1, post_clk=1):
-    """clk cycles from the ce edge that takes a window's last ADC sample to the edge
-    that puts its last row on the heat-map stream (M = 1).  The pair split takes slot s
-    on the ce edge latency0 + s + 1 ce cycles later (latency0 counts from the FFT input
-    register, which the despread register feeds); the other POST_STAGES - 1 stages take
-    a clk each (POST_CLK = 1) or a ce period each (POST_CLK = 0); the stream register
-    adds 1 clk."""
+def row_beats_formula(cfg, every=1, post_clk=1, cps=None):
+    """clk cycles from the ce edge that takes a window's last ADC sample to the edge that
+    puts each row on the heat-map stream (M = 1), dict row -> clk: the pair split takes
+    slot s on the ce edge latency0 + s + 1 ce cycles later (latency0 counts from the FFT
+    input register, which the despread register feeds); then the shared units' queue and
+    engine (rx_fixed.rx_row_beats: queued 1 step later, loaded >= 1 step after that, P
+    unit input steps, MAG_ITER + 3 magnitude stages, accumulator read, sum, round, row
+    register; a step is a clk with POST_CLK = 1, a ce period with POST_CLK = 0)."""
     lat0 = fft_fixed.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
-    split = (lat0 + int(R.completion_slots(cfg).max()) + 1) * every
-    return split + (POST_STAGES - 1) * (1 if post_clk else every) + 1
+    return R.rx_row_beats(cfg, lat0, every, post_clk, cps)
 
 
 @cocotb.test()
 async def latency_and_slow_ce(dut):
-    """Latency at ce = 1 and at ce = 1 in 3 (3 x fs processing clock), M = 1."""
+    """Latency at ce = 1 and at ce = 1 in 3 (3 x fs processing clock), M = 1: every row's
+    beat time against the schedule of the shared units."""
     tb = TB(dut)
     cfg = tb.cfg
     n = cfg.n_fft
     rng = np.random.default_rng(8)
-    res = []
-    for every in (1, 3):
+    post_clk = env_int("POST_CLK", 1)
+    cps = env_int("CPS", 3 if post_clk else 1)
+    res = {}
+    for every in [int(x) for x in env_str("EVERY_LIST", "1,3").split(",")]:
         tx, rx, _ = rx_stim.pn(cfg, n, rng)
         adc = rx_stim.tones(cfg, n, rng, tx=tx)
         await tb.reset()
         beats, eofs, taken = await tb.run(adc, rx, 0, ce_every=every)
         check_exact(tb, adc, rx, 0, beats, eofs, float_check=False)
         last_in = taken[n - 1]                      # clk of the window's last sample
+        exp = row_beats_formula(cfg, every, post_clk, cps)
+        got = {b[1]: b[0] - last_in for b in beats[:cfg.rows]}
+        assert got == exp, f"ce every {every}: row beats (row: clk) {got}, schedule {exp}"
         lat_row = beats[cfg.rows - 1][0] - last_in  # clk cycles to the last row beat
         lat_eof = eofs[0][0] - last_in
-        # the stream register adds one clk after the ce cycle of the accumulator output
-        post_clk = env_int("POST_CLK", 1)
-        exp_row = latency_formula(cfg, every, post_clk)
-        assert lat_row == exp_row, f"ce every {every}: last row after {lat_row} clk, formula {exp_row}"
+        assert lat_row == max(exp.values())
         assert lat_eof == lat_row + (1 if post_clk else every), f"eof {lat_eof} clk after the last sample"
-        res.append((every, lat_row, lat_eof))
-    fs_row = res[0][1]
-    us = fs_row / (cfg.fs_hz / 1e6)
+        assert not int(dut.ovf_o.value), "queue overrun / overflow flag"
+        res[every] = (lat_row, lat_eof)
+    lines = [f"{cfg.name} (CLK_PER_SAMPLE {cps}, POST_CLK {post_clk}, MAG_UNITS "
+             f"{R.rx_mag_units_default(cfg, cps if post_clk else 1)}): "
+             f"last ADC sample of a window -> last heat-map row / hm_eof:"]
     budget = int(8e-6 * cfg.fs_hz)
-    text = (f"{cfg.name}: last ADC sample of a window -> last heat-map row: {fs_row} fs cycles "
-            f"({us:.3f} us), -> hm_eof: {res[0][2]} fs cycles; at 3 x fs: {res[1][1]} clk "
-            f"({res[1][1] / 3:.2f} fs cycles) / eof {res[1][2]} clk; "
-            f"8 us budget = {budget} fs cycles, left for touch processing: {budget - res[0][2]} fs cycles "
-            f"({(budget - res[0][2]) / (cfg.fs_hz / 1e6):.3f} us) at ce = 1, "
-            f"{budget - res[1][2] / 3:.1f} fs cycles = {3 * budget - res[1][2]} processing clk at 3 x fs\n")
-    out = ROOT / "build" / f"rx_latency_{cfg.name}_postclk{env_int('POST_CLK', 1)}.txt"
+    for every, (row, eof) in res.items():
+        lines.append(f"  clk = {every} x fs: {row} / {eof} clk = {row / every:.2f} / {eof / every:.2f} fs cycles "
+                     f"({row / every / (cfg.fs_hz / 1e6):.3f} us to the last row); 8 us budget = {budget} fs "
+                     f"cycles, left for touch processing: {budget - eof / every:.2f} fs cycles = "
+                     f"{every * budget - eof} clk")
+    text = "\n".join(lines) + "\n"
+    out = ROOT / "build" / f"rx_latency_{cfg.name}_postclk{post_clk}_cps{cps}.txt"
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)
     dut._log.info(text)
 
 
-def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1):
+@cocotb.test(skip=os.environ.get("OVERRUN", "0") in ("", "0"))
+async def overrun_flag(dut):
+    """Only with OVERRUN=1 (a build whose MAG_UNITS is too few for ce = 1): the sticky
+    overrun is clear at ce = 1 in 3 (exact heat maps) and set in ovf_o at ce = 1 (no
+    saturation or FFT flag)."""
+    tb = TB(dut)
+    cfg = tb.cfg
+    rng = np.random.default_rng(9)
+    adc = rx_stim.tones(cfg, 3 * cfg.n_fft, rng)
+    rx = np.zeros(len(adc), np.uint8)
+    await tb.reset()
+    beats, eofs, _ = await tb.run(adc, rx, 0, ce_every=3)
+    check_exact(tb, adc, rx, 0, beats, eofs, float_check=False)
+    assert not int(dut.ovf_o.value), "overrun flagged at the rate the units are sized for"
+    await tb.reset()
+    await tb.run(adc, rx, 0, ce_every=1)
+    assert int(dut.ovf_o.value) == 1, "queue overrun not flagged"
+    assert not int(dut.sat_o.value) and not int(dut.fft_ovf_o.value)
+
+
+def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1, cps=None, params_extra=None):
     cfg = params.get(cfg_name)
-    env = {"CFG": cfg_name, "POST_CLK": post_clk}
+    cps = (3 if post_clk else 1) if cps is None else cps
+    env = {"CFG": cfg_name, "POST_CLK": post_clk, "CPS": cps}
     env.update(extra or {})
     run_cocotb(
         sim=sim,
@@ -262,16 +289,32 @@ def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1):
         test_dir=Path(__file__).parent,
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
                     "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
-                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"', "POST_CLK": post_clk},
+                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"', "POST_CLK": post_clk,
+                    "CLK_PER_SAMPLE": cps, **(params_extra or {})},
         extra_env=env,
         testcase=testcase,
         build_args=VERILATOR_ARGS if sim == "verilator" else None,
     )
 
 
-@pytest.mark.parametrize("cfg_name", ["small", "medium"])
-def test_fmt_rx_array(sim, cfg_name):
-    _run(sim, cfg_name)
+@pytest.mark.parametrize("cfg_name,cps", [("small", 3), ("medium", 1)])
+def test_fmt_rx_array(sim, cfg_name, cps):
+    """All tests at ce = 1 (the latency test also at 1 in 3).  small: the default
+    CLK_PER_SAMPLE = 3 (MAG_UNITS 1, enough for ce = 1 too at 6 columns); medium:
+    CLK_PER_SAMPLE = 1 (MAG_UNITS 2)."""
+    _run(sim, cfg_name, cps=cps)
+
+
+def test_fmt_rx_array_medium_cps3(sim):
+    """medium at CLK_PER_SAMPLE = 3 (MAG_UNITS 1): every row's beat at 3 x fs."""
+    _run(sim, "medium", {"EVERY_LIST": "3"}, testcase="latency_and_slow_ce")
+
+
+def test_fmt_rx_array_overrun(sim):
+    """small rows and N with 30 columns and ONE magnitude unit (P = 30 steps a row: fits
+    3 x fs, not ce = 1): the sticky overrun flag."""
+    _run(sim, "small", {"OVERRUN": 1, "COLS": 30}, testcase="overrun_flag",
+         params_extra={"COLS": 30, "MAG_UNITS": 1})
 
 
 def test_fmt_rx_array_post_on_ce(sim):
@@ -281,8 +324,9 @@ def test_fmt_rx_array_post_on_ce(sim):
 
 @pytest.mark.verilator_only
 def test_fmt_rx_array_default(sim):
-    """Full 30 x 40, N = 256: bit-exact (M = 1, 2), latency, hard cases."""
-    _run(sim, "default", {"M_LIST": "0,1", "FRAMES": 1})
+    """Full 30 x 40, N = 256 at the real clocking: ce = 1 in 3, CLK_PER_SAMPLE = 3
+    (MAG_UNITS 4): bit-exact (M = 1, 2), latency, hard cases."""
+    _run(sim, "default", {"M_LIST": "0,1", "FRAMES": 1, "CE_EVERY": 3, "EVERY_LIST": "3"})
 
 
 

@@ -1,0 +1,137 @@
+// fmt_rx_pair_front -- front half of a column-pair receiver: despread (x2) ->
+// fmt_fft_r22sdf (z = a + j b) -> fmt_pair_split, with the window / frame bookkeeping,
+// plus a ROWS-entry result memory that keeps each row's (2A, 2B) until the row's next
+// completion one window later, so that magnitude units shared by many pairs can read it
+// at their own pace (fmt_rx_array).  fmt_col_pair_rx adds its own magnitude units and
+// accumulator to the split outputs (its result memory is then unused and trimmed).
+//
+// Frames: window k is ADC samples k*N .. k*N + N-1 counted from the first ce after reset
+// (the FFT is held in reset for that ce while the despreaders fill); a frame is
+// M = 2^m_log2_i consecutive windows (m_log2_i sampled at the first window of a frame,
+// values above M_LOG2_MAX clamped).  ps_tag = {log2 M, first window, last window}.
+// Timing: the pair split takes slot s of a window on the ce edge LATENCY0 + s + 1 ce
+// cycles after the ce edge that takes the window's last ADC sample (LATENCY0 of
+// fmt_fft_r22sdf, counted from its input register which the despread register feeds);
+// ps_* are registered by the split (on post_ce); the result memory is written on the
+// next post_ce edge (rd_data_o shows it from then on, asynchronous read: LUT RAM).
+// Formats: FFT output W = FFT_OUT_W bits = X * 2^-FFT_SHIFT (see fmt_col_pair_rx);
+// split outputs 2A, 2B exact, W + 1 bits signed.  Flag: fft_ovf_o sticky.
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_rx_pair_front #(
+    parameter LOG2_N     = `FMT_LOG2_N,    // FFT size N = 2^LOG2_N
+    parameter ROWS       = `FMT_ROWS,      // comb bins (rows)
+    parameter BIN_LO     = `FMT_BIN_LO,    // bin of row 0
+    parameter BIN_STEP   = `FMT_BIN_STEP,  // bins between rows
+    parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
+    parameter M_LOG2_MAX = 3,              // largest log2 M
+    parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
+    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter POST_CLK   = 1,              // 1: split and result memory on every clk, 0: on ce
+    parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
+    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
+) (
+    input  wire                       clk,
+    input  wire                       rst,        // synchronous, active high
+    input  wire                       ce,         // sample strobe
+    input  wire signed [ADC_BITS-1:0] adc_a_i,    // column a ADC sample (even column)
+    input  wire signed [ADC_BITS-1:0] adc_b_i,    // column b ADC sample (odd column)
+    input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
+    input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
+    output wire                       ps_valid_o, // a row's pair completed (split output valid)
+    output wire [ROW_W-1:0]           ps_row_o,   // its row index
+    output wire [SH_W+1:0]            ps_tag_o,   // {log2 M, first window, last window}
+    output wire signed [FFT_OUT_W:0]  ps_ar_o,    // 2 Re A (column a)
+    output wire signed [FFT_OUT_W:0]  ps_ai_o,    // 2 Im A
+    output wire signed [FFT_OUT_W:0]  ps_br_o,    // 2 Re B (column b)
+    output wire signed [FFT_OUT_W:0]  ps_bi_o,    // 2 Im B
+    input  wire [ROW_W-1:0]           rd_row_i,   // result memory read address (row)
+    output wire [4*FFT_OUT_W+3:0]     rd_data_o,  // {2 Im B, 2 Re B, 2 Im A, 2 Re A} of that row
+    output wire                       fft_ovf_o   // sticky FFT saturation
+);
+
+    localparam W  = FFT_OUT_W;
+    localparam MW = W + 1;
+    localparam [M_LOG2_MAX:0] ONE  = 1;
+    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
+
+    // ---- despread ----
+    wire signed [ADC_BITS:0] xa, xb;
+    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsa (
+        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_a_i), .sign_i(rx_sign_i), .y_o(xa));
+    fmt_despread #(.ADC_BITS(ADC_BITS)) u_dsb (
+        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_b_i), .sign_i(rx_sign_i), .y_o(xb));
+
+    // ---- FFT ----
+    // The despreaders add one ce cycle; the FFT is held in reset through the first ce
+    // after reset so that its window 0 is ADC samples 0 .. N-1 (counted from that ce).
+    reg fft_rst_q;
+    always @(posedge clk) begin
+        if (rst)      fft_rst_q <= 1'b1;
+        else if (ce)  fft_rst_q <= 1'b0;
+    end
+
+    wire                f_valid;
+    wire [LOG2_N-1:0]   f_slot, f_bin;
+    wire signed [W-1:0] f_re, f_im;
+    fmt_fft_r22sdf #(
+        .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W), .TW_DIR(TW_DIR)
+    ) u_fft (
+        .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re(xa), .in_im(xb),
+        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
+        .out_re(f_re), .out_im(f_im), .ovf_o(fft_ovf_o));
+
+    // The FFT's out_valid is 1 only on ce cycles: its outputs are taken on ce edges; the
+    // split registers and the result memory run on every clk (POST_CLK = 1) or on ce.
+    wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
+
+    // ---- window / frame bookkeeping (at the FFT output) ----
+    reg                  started_q;
+    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
+    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
+    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
+    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
+    wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}});
+    wire                 wrap    = !started_q || (wcnt_q == last_q);
+    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
+    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
+    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
+    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
+    wire                 w_last  = (w_cur == last_cur);
+
+    always @(posedge clk) begin
+        if (rst) begin
+            started_q <= 1'b0;
+            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
+            m_q       <= {SH_W{1'b0}};
+        end else if (ce && new_win) begin
+            started_q <= 1'b1;
+            wcnt_q    <= w_cur;
+            m_q       <= m_cur;
+        end
+    end
+
+    // ---- pair split ----
+    fmt_pair_split #(
+        .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
+        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
+    ) u_split (
+        .clk(clk), .rst(rst), .ce(post_ce),
+        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
+        .in_tag({m_cur, w_first, w_last}),
+        .out_valid(ps_valid_o), .out_row(ps_row_o),
+        .a_re(ps_ar_o), .a_im(ps_ai_o), .b_re(ps_br_o), .b_im(ps_bi_o), .out_tag(ps_tag_o));
+
+    // ---- result memory: row r's (2A, 2B), written when the row completes ----
+    reg [4*MW-1:0] res_mem [0:ROWS-1];
+    always @(posedge clk) begin
+        if (post_ce && ps_valid_o) begin
+            res_mem[ps_row_o] <= {ps_bi_o, ps_br_o, ps_ai_o, ps_ar_o};
+        end
+    end
+    assign rd_data_o = res_mem[rd_row_i];
+
+endmodule
+
+`default_nettype wire
