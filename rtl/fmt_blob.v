@@ -77,13 +77,14 @@ module fmt_blob #(
     parameter ROW_IDX_W = (ROWS > 1) ? $clog2(ROWS) : 1,    // row index width
     parameter COL_IDX_W = (COLS > 1) ? $clog2(COLS) : 1,    // column index width
     parameter AREA_W    = $clog2(ROWS * COLS + 1),          // area / min-cells / found width
-    parameter CNT_W     = $clog2(MAX_BLOBS + 1)             // blob count width
+    parameter CNT_W     = $clog2(MAX_BLOBS + 1),            // blob count width
+    parameter MINC_W    = 16                                // blob_min_cells_i width
 ) (
     input  wire                   clk,
     input  wire                   rst,               // synchronous, active high
     // settings
     input  wire [HM_W-1:0]        blob_threshold_i,  // cell is "on" when z >= threshold (>= 1)
-    input  wire [AREA_W-1:0]      blob_min_cells_i,  // region of >= this many cells is a blob
+    input  wire [MINC_W-1:0]      blob_min_cells_i,  // region of >= this many cells is a blob
     // heat-map stream in
     input  wire                   hm_valid_i,        // one row this cycle
     input  wire [ROW_IDX_W-1:0]   hm_row_i,          // row index
@@ -475,7 +476,9 @@ module fmt_blob #(
     reg [LBL_W-1:0]     cl_lbl_q;
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
-    wire              cl_blob = cl_v_q && (cl_area >= blob_min_cells_i);
+    localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
+    wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
+    wire              cl_blob = cl_v_q && cl_isblob;
 
     reg [MB-1:0]  l_v_q;
     reg [E_W-1:0] l_e_q [0:MB-1];
@@ -571,7 +574,7 @@ module fmt_blob #(
             localparam [LBL_W-1:0] LBL = gl;
             reg cf_mem [0:ROWS-1];
             always @(posedge clk) begin
-                if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= (cl_area >= blob_min_cells_i);
+                if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= cl_isblob;
             end
             assign cfr[gl] = cf_mem[cf_row];
         end

@@ -340,7 +340,7 @@ async def shapes(dut):
     # min-cells exactly at a region's area, and one above
     z = bitmap_hm(nrng, maps["U"], 1000)
     area = int((z >= 1000).sum())
-    for minc in (area, area + 1):
+    for minc in (area, area + 1, 0, 65535):          # 0 acts as 1; 65535: no blob
         tb.set(1000, minc)
         await tb.run_frames(rng, [z], frame)
         frame += 1
