@@ -403,10 +403,12 @@ def latency_histogram(first, last, onset, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6, 3.5))
+    allv = list(first) + list(last) + list(onset) + [8.0]
+    bins = np.linspace(min(allv) - 0.1, max(allv) + 0.1, 80)     # shared bins
     for v, lab in ((first, "window end -> first event"), (last, "window end -> last event"),
                    (onset, "onset -> new-contact event")):
         if v:
-            ax.hist(v, bins=40, alpha=0.6, label=lab)
+            ax.hist(v, bins=bins, alpha=0.6, label=lab)
     ax.axvline(8.0, color="k", ls="--", lw=1, label="8 us")
     ax.set_xlabel("latency (us)")
     ax.set_ylabel("count")
