@@ -27,10 +27,13 @@
 // of the engine change together, at ce edges only.
 //
 // Amplitude product, LUT only (no DSP48E): p = s * amp with s the SINE_BITS-bit signed
-// table word and amp the AMP_BITS-bit unsigned amplitude, formed as the shift-add of
-// the partial products s << i for the set bits of amp, in two halves (low and high
-// amplitude bits) registered at edge E+1 and added after it.  No `*` operator appears,
-// so neither XST nor Yosys can map it to a DSP48E.
+// table word and amp the AMP_BITS-bit unsigned amplitude, by radix-4 Booth recoding of
+// amp (ND = AMP_BITS/2 + 1 digits d_j = a[2j] + a[2j-1] - 2 a[2j+1] in -2..2, a[-1] =
+// 0, zero above the MSB): p = sum_j d_j s 4^j; a negative digit contributes ~m 4^j
+// plus a 1 at bit 2j, placed in a free low bit of digit j+1's shifted term (the last
+// digit is never negative).  The terms are summed in two halves registered at edge
+// E+1 and added after it (exact: two's complement modulo 2^PW, and |p| < 2^(PW-1)).
+// No `*` operator appears, so neither XST nor Yosys can map it to a DSP48E.
 // Rounding: r = (p + 2^(SH-1)) >> SH, SH = SINE_BITS + AMP_BITS - DAC_BITS
 // (round half up; the 2^(SH-1) is folded into the low half).  The sign is applied
 // after rounding, so the words of +1 and -1 are exact negatives.
@@ -81,7 +84,8 @@ module fmt_dds_chan #(
     localparam SH   = PW - DAC_BITS;                // rounding shift
     localparam SHM1 = (SH > 0) ? SH - 1 : 0;
     localparam [PW-1:0] HALF = (SH > 0) ? ({{(PW - 1){1'b0}}, 1'b1} << SHM1) : {PW{1'b0}};
-    localparam LO_BITS = AMP_BITS / 2;              // amplitude bits summed in the low half
+    localparam ND   = AMP_BITS / 2 + 1;             // radix-4 Booth digits of the unsigned amplitude
+    localparam LO_D = (ND + 1) / 2;                 // digits summed in the low half
 
     // ---------------------------------------------------------------- settings
     wire [SLOTS*PHASE_BITS-1:0] tw_all;
@@ -167,16 +171,35 @@ module fmt_dds_chan #(
     reg signed [PW-1:0]  pp_lo_d, pp_hi_d;
 
     wire signed [PW-1:0] s_ext = {{AMP_BITS{sine_i[SINE_BITS-1]}}, sine_i};
+    wire [2*ND:0]        ax    = {{(2*ND - AMP_BITS){1'b0}}, amp1_q, 1'b0};  // {0.., amp, 0}
 
-    integer i;
+    // Booth partial product of digit bits b = {a[2j+1], a[2j], a[2j-1]} without its
+    // +1: neg ? ~m : m, m = s (b = 001, 010, 101, 110), 2s (011, 100) or 0
+    function [PW-1:0] booth_pp;
+        input [PW-1:0] s;
+        input [2:0]    b;
+        reg   [PW-1:0] m;
+        begin
+            case (b)
+                3'b001, 3'b010, 3'b101, 3'b110: m = s;
+                3'b011, 3'b100:                 m = {s[PW-2:0], 1'b0};
+                default:                        m = {PW{1'b0}};
+            endcase
+            booth_pp = b[2] ? ~m : m;
+        end
+    endfunction
+
+    integer j;
+    reg [PW-1:0] op;
     always @* begin
         pp_lo_d = HALF;
         pp_hi_d = {PW{1'b0}};
-        for (i = 0; i < AMP_BITS; i = i + 1) begin
-            if (amp1_q[i]) begin
-                if (i < LO_BITS) pp_lo_d = pp_lo_d + (s_ext <<< i);
-                else             pp_hi_d = pp_hi_d + (s_ext <<< i);
-            end
+        for (j = 0; j < ND; j = j + 1) begin
+            op = booth_pp(s_ext, ax[2*j +: 3]) << (2 * j);
+            // the +1 of digit j-1 (a[2j-1] = ax[2j]) in a free low bit (bit 2j-2)
+            if (j > 0) op = op | ({{(PW - 1){1'b0}}, ax[2*j]} << (2 * j - 2));
+            if (j < LO_D) pp_lo_d = pp_lo_d + op;
+            else          pp_hi_d = pp_hi_d + op;
         end
     end
 

@@ -18,6 +18,11 @@ DAC_BITS > AMP_BITS): the negation by the PN sign can never overflow and no satu
 is needed (checked by :func:`check_widths`).  The sign is applied after rounding, so
 the +1 and -1 words are exact negatives of each other.
 
+The RTL bank time-multiplexes its channel engines (``ROWS_PER_ENGINE`` = R rows per
+engine, ce every R clk cycles); R changes the schedule, not the arithmetic: the words
+above are those of every R (tb/fmt_dds_bank checks R = 1 and 3 against
+:func:`dds_bank_fixed`).
+
 Exact-bin tones: bin k has tuning word k << (P - log2 N); with 2**A >= N entries the
 address has no truncated phase bits, so every N-sample window of a row is identical.
 
