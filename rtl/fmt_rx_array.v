@@ -17,12 +17,12 @@
 // one per ce, in the FFT's bit-reversed order (bursts of two then >= 7 slots at N = 256;
 // sim/fmt/rx_fixed.py row_order).
 // MAG_UNITS rule: steps per FFT slot C = CLK_PER_SAMPLE (POST_CLK = 1) or 1 (POST_CLK =
-// 0); with rows arriving at step C * slot, the default is the smallest K for which no
-// row waits longer than P steps for the engine (a row waits at most for its burst
-// partner) and the engine is idle again before the next window: 30 x 40, N = 256:
-// K = 4 at C = 3, K = 10 at C = 1.  Elaboration fails (missing module
-// fmt_rx_array_MAG_UNITS_too_few) when K cannot finish a window's rows before the next
-// window's first row; at run time (ce faster than CLK_PER_SAMPLE says) a row arriving
+// 0).  The comb's rows complete at most two in any 8 consecutive slots, so with
+// P <= 4 C (default K = ceil(COLS / (4 C))) a row waits at most for its burst partner:
+// 30 x 40, N = 256: K = 4 at C = 3, K = 10 at C = 1 (rx_fixed.rx_share_schedule checks
+// the schedule for the sensor configs).  Elaboration fails (missing module
+// fmt_rx_array_MAG_UNITS_too_few) when ROWS * P > N * C (a window's rows cannot be
+// processed in a window); at run time (ce faster than CLK_PER_SAMPLE says) a row arriving
 // with the queue full or while its previous window's copy is still queued or being fed
 // sets the sticky overrun bit, reported in ovf_o.  Twin: rx_fixed.rx_share_schedule.
 // Stream: hm_valid one clk per row, hm_row its index, hm_frame the frame number (wraps,
@@ -87,7 +87,7 @@ module fmt_rx_array #(
     localparam CW    = 2 * MW;                               // one cell {im, re}
     localparam STEPC = (POST_CLK != 0) ? CLK_PER_SAMPLE : 1; // steps per FFT slot
 
-    // ---- schedule of the shared units (elaboration-time; twin rx_fixed.rx_share_schedule)
+    // ---- the frame's last row (the row whose pair completes last in bit-reversed order)
     function integer bitrev_f;
         input integer v;
         integer j;
@@ -97,70 +97,28 @@ module fmt_rx_array #(
                 if (((v >> j) & 1) != 0) bitrev_f = bitrev_f | (1 << (LOG2_N - 1 - j));
         end
     endfunction
-    // FFT slot at which row r's pair (k, N - k) is complete
-    function integer slot_f;
-        input integer r;
-        integer k, s1, s2;
-        begin
-            k  = BIN_LO + r * BIN_STEP;
-            s1 = bitrev_f(k);
-            s2 = bitrev_f(N - k);
-            slot_f = (s1 > s2) ? s1 : s2;
-        end
-    endfunction
-    // the row completing last (the frame's last row beat)
     function integer last_row_f;
         input integer dummy;
-        integer r, best;
+        integer r, k, s, best;
         begin
             best = -1;
             last_row_f = 0;
             for (r = 0; r < ROWS; r = r + 1) begin
-                if (slot_f(r) > best) begin
-                    best = slot_f(r);
+                k = BIN_LO + r * BIN_STEP;
+                s = (bitrev_f(k) > bitrev_f(N - k)) ? bitrev_f(k) : bitrev_f(N - k);
+                if (s > best) begin
+                    best = s;
                     last_row_f = r + 0 * dummy;
                 end
             end
         end
     endfunction
-    // simulate one window with K units: mode 0 -> 1 if the engine is free before the next
-    // window's first row can load; mode 1 -> 1 if also no row waits more than P steps
-    function integer fits_f;
-        input integer k_units;
-        input integer mode;
-        integer p, i, r, prev, best, a, l, f, first, ok;
-        begin
-            p = (COLS + k_units - 1) / k_units;
-            prev = -1;
-            f = 0;
-            first = -1;
-            ok = 1;
-            for (i = 0; i < ROWS; i = i + 1) begin
-                best = 2 * N;
-                for (r = 0; r < ROWS; r = r + 1)
-                    if (slot_f(r) > prev && slot_f(r) < best) best = slot_f(r);
-                if (first < 0) first = best;
-                prev = best;
-                a = best * STEPC;
-                l = (a + 2 > f) ? a + 2 : f;
-                if (mode != 0 && l - (a + 2) > p) ok = 0;
-                f = l + p;
-            end
-            if (f > (first + N) * STEPC + 1) ok = 0;
-            fits_f = ok;
-        end
-    endfunction
-    function integer units_f;
-        input integer dummy;
-        integer k;
-        begin
-            units_f = COLS + 0 * dummy;
-            for (k = COLS; k >= 1; k = k - 1)
-                if (fits_f(k, 1) != 0) units_f = k;
-        end
-    endfunction
 
-    localparam K    = (MAG_UNITS > 0) ? MAG_UNITS : units_f(0);
+    // MAG_UNITS = 0: K = ceil(COLS / (4 * STEPC)), a row in at most 4 steps per FFT slot:
+    // the comb's rows complete at most two in any 8 consecutive slots (bit-reversed order;
+    // rx_fixed checks it and the resulting schedule for the sensor configs)
+    localparam K    = (MAG_UNITS > 0) ? MAG_UNITS :
+                      ((COLS + 4 * STEPC - 1) / (4 * STEPC) > 0 ? (COLS + 4 * STEPC - 1) / (4 * STEPC) : 1);
     localparam P    = (COLS + K - 1) / K;                    // steps (groups) per row
     localparam G_W  = (P > 1) ? $clog2(P) : 1;               // group index width
     localparam AW   = ROW_W + G_W;                           // accumulator address {row, g}
@@ -174,8 +132,8 @@ module fmt_rx_array #(
     localparam [G_W-1:0] G_LAST = PM1[G_W-1:0];
 
     generate
-        if (fits_f(K, 0) == 0) begin : g_check
-            // MAG_UNITS too small for CLK_PER_SAMPLE: stop elaboration
+        if (ROWS * P > N * STEPC) begin : g_check
+            // MAG_UNITS too few to process a window's rows in a window: stop elaboration
             fmt_rx_array_MAG_UNITS_too_few u_too_few ();
         end
     endgenerate

@@ -243,12 +243,25 @@ def rx_share_schedule(cfg, units: int, step_per_slot: int):
 
 
 def rx_mag_units_default(cfg, step_per_slot: int) -> int:
-    """fmt_rx_array's default MAG_UNITS: the smallest K with no row waiting longer than P
-    steps (and the engine idle before the next window)."""
+    """fmt_rx_array's default MAG_UNITS: K = ceil(COLS / (4 C)), C = steps per FFT slot
+    (a row in at most 4 C steps: the comb's rows complete at most two in any 8
+    consecutive slots; tests check the resulting schedule with rx_share_schedule)."""
+    return max(1, -(-cfg.cols // (4 * step_per_slot)))
+
+
+def rx_mag_units_min(cfg, step_per_slot: int) -> int:
+    """The smallest K whose schedule has no row waiting longer than P steps (for
+    comparison with the default rule)."""
     for k in range(1, cfg.cols + 1):
         if rx_share_schedule(cfg, k, step_per_slot)[3]:
             return k
     return cfg.cols
+
+
+def max_completions_in(cfg, slots: int = 8) -> int:
+    """Most rows completing in any ``slots`` consecutive FFT slots."""
+    s = np.sort(completion_slots(cfg))
+    return int(max(np.searchsorted(s, v + slots) - i for i, v in enumerate(s)))
 
 
 def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None,

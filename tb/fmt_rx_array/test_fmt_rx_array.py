@@ -301,7 +301,7 @@ def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1, cps=None, params_
 def test_fmt_rx_array(sim, cfg_name, cps):
     """All tests at ce = 1 (the latency test also at 1 in 3).  small: the default
     CLK_PER_SAMPLE = 3 (MAG_UNITS 1, enough for ce = 1 too at 6 columns); medium:
-    CLK_PER_SAMPLE = 1 (MAG_UNITS 2)."""
+    CLK_PER_SAMPLE = 1 (MAG_UNITS 3)."""
     _run(sim, cfg_name, cps=cps)
 
 
