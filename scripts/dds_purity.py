@@ -11,7 +11,7 @@ Table-width rows use DAC_BITS = SINE_BITS + AMP_BITS (the table's own purity: th
 amplitude product is exact); the last row is the default build (16-bit table, 12-bit
 DAC words), where the DAC word's rounding dominates.
 
-    python scripts/dds_purity.py [--cfg default] [--sim icarus] [--bits 10 12 14 16]
+    python scripts/dds_purity.py [--cfg default] [--sim icarus] [--bits 10 12 14 16] [--rpe 3]
 """
 from __future__ import annotations
 
@@ -28,13 +28,14 @@ from fmt import dds, params  # noqa: E402
 from fmt_dds_bank.test_fmt_dds_bank import _run  # noqa: E402
 
 
-def measure(sim: str, cfg, sine_bits: int, dac_bits: int) -> dict:
+def measure(sim: str, cfg, sine_bits: int, dac_bits: int, rpe: int = 1) -> dict:
     with tempfile.TemporaryDirectory() as d:
         out = Path(d) / "purity.json"
         import os
         os.environ["DDS_PURITY_OUT"] = str(out)
         try:
-            _run(sim, cfg, sine_bits=sine_bits, dac_bits=dac_bits, testcase="exact_comb_and_purity")
+            _run(sim, cfg, sine_bits=sine_bits, dac_bits=dac_bits, testcase="exact_comb_and_purity",
+                 rpe=rpe)
         finally:
             del os.environ["DDS_PURITY_OUT"]
         return json.loads(out.read_text())
@@ -45,6 +46,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cfg", default="default", help="sensor config (default, medium, small)")
     ap.add_argument("--sim", default="icarus", choices=["icarus", "verilator"])
     ap.add_argument("--bits", type=int, nargs="*", default=[10, 12, 14, 16])
+    ap.add_argument("--rpe", type=int, default=1,
+                    help="ROWS_PER_ENGINE of the simulated bank (ce every RPE clk; same words)")
     a = ap.parse_args(argv)
     cfg = params.get(a.cfg)
     runs = [(b, b + cfg.amp_bits) for b in a.bits] + [(cfg.sine_bits, cfg.dac_bits)]
@@ -53,7 +56,7 @@ def main(argv=None) -> int:
         if (dds.TABLE_ADDR, s_bits) not in dds.HEX_TABLES:
             print(f"no committed table for SINE_BITS {s_bits}; skipped", file=sys.stderr)
             continue
-        rows.append(measure(a.sim, cfg, s_bits, d_bits))
+        rows.append(measure(a.sim, cfg, s_bits, d_bits, a.rpe))
     print(f"\nDDS purity from the RTL ({a.sim}), sensor '{cfg.name}': {cfg.rows} rows, N = {cfg.n_fft}, "
           f"bins {cfg.bin_lo}..{cfg.bin_hi}, table 2^{dds.TABLE_ADDR} entries, full amplitude, PN off")
     print("| SINE_BITS | DAC_BITS | worst row spur (dBc) | bound -6B | comb: worst non-comb bin (dBc) "
