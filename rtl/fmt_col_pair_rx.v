@@ -74,14 +74,14 @@ module fmt_col_pair_rx #(
     wire signed [MW-1:0] ps_ar, ps_ai, ps_br, ps_bi;
     wire [SH_W+1:0]      ps_tag;
     // the front's result memory serves shared magnitude units (fmt_rx_array); here the
-    // split outputs feed this pair's own units, so its read port is left unused
+    // split outputs feed this pair's own units: no result memory (RES_MEM = 0)
     /* verilator lint_off UNUSEDSIGNAL */
     wire [4*MW-1:0]      unused_rd;
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_rx_pair_front #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W), .TW_DIR(TW_DIR),
-        .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
+        .POST_CLK(POST_CLK), .RES_MEM(0), .ROW_W(ROW_W), .SH_W(SH_W)
     ) u_front (
         .clk(clk), .rst(rst), .ce(ce), .adc_a_i(adc_a_i), .adc_b_i(adc_b_i),
         .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),

@@ -29,6 +29,7 @@ module fmt_rx_pair_front #(
     parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter POST_CLK   = 1,              // 1: split and result memory on every clk, 0: on ce
+    parameter RES_MEM    = 1,              // 1: result memory and read port, 0: none (rd_data_o = 0)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
     parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
 ) (
@@ -124,13 +125,23 @@ module fmt_rx_pair_front #(
         .a_re(ps_ar_o), .a_im(ps_ai_o), .b_re(ps_br_o), .b_im(ps_bi_o), .out_tag(ps_tag_o));
 
     // ---- result memory: row r's (2A, 2B), written when the row completes ----
-    reg [4*MW-1:0] res_mem [0:ROWS-1];
-    always @(posedge clk) begin
-        if (post_ce && ps_valid_o) begin
-            res_mem[ps_row_o] <= {ps_bi_o, ps_br_o, ps_ai_o, ps_ar_o};
+    generate
+        if (RES_MEM != 0) begin : g_res
+            reg [4*MW-1:0] res_mem [0:ROWS-1];
+            always @(posedge clk) begin
+                if (post_ce && ps_valid_o) begin
+                    res_mem[ps_row_o] <= {ps_bi_o, ps_br_o, ps_ai_o, ps_ar_o};
+                end
+            end
+            assign rd_data_o = res_mem[rd_row_i];
+        end else begin : g_nores
+            // the split outputs are used directly (fmt_col_pair_rx)
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [ROW_W-1:0] unused_rd_row = rd_row_i;
+            /* verilator lint_on UNUSEDSIGNAL */
+            assign rd_data_o = {(4*MW){1'b0}};
         end
-    end
-    assign rd_data_o = res_mem[rd_row_i];
+    endgenerate
 
 endmodule
 

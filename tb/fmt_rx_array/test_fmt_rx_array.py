@@ -9,8 +9,10 @@ split and magnitude, mean over M) within 2 LSB; the hard cases (palm = saturated
 DC offset, impulse, tone between bins, all rows in phase, full-scale random, full-scale
 tone: sticky saturation flag exactly when the model saturates); a reset in the middle of
 a window (the stream restarts cleanly with the next full frame); ce = 1 in 3
-(CLK_PER_SAMPLE = 3); and the LATENCY from a window's last ADC sample to its last row and
-to hm_eof, asserted against the formula and written to build/rx_latency_<cfg>.txt.
+(CLK_PER_SAMPLE = 3); every row's beat time (the schedule of the shared magnitude units,
+rx_fixed.rx_row_beats) and the LATENCY from a window's last ADC sample to its last row and
+to hm_eof, written to build/rx_latency_<cfg>_postclk<p>_cps<c>.txt; the sticky queue
+overrun (ovf_o) when ce comes faster than the units were sized for.
 """
 from __future__ import annotations
 
