@@ -14,7 +14,9 @@
 // cycles 0, C, 2C, ... the signs seen at ce edges are exactly those of a PN generator
 // at fs (the DDS sample k carries PN chip floor((k-1)/L), the receiver sample j the
 // chip floor((j-1-d)/L), d = PN_RX_DELAY) -- tb/fmt_core checks it bit for bit against
-// the models for C = 1 and 3.
+// the models for C = 1 and 3.  The DDS bank shares one engine between C rows
+// (ROWS_PER_ENGINE = C: ce is exactly every C clk cycles) and the receivers size their
+// shared magnitude units for C clk per sample (fmt_rx_array CLK_PER_SAMPLE).
 //
 // Latency (fmt_latency): the frame end is the ce edge that takes the last ADC sample of
 // a frame (M = 2^m windows, m = floor(log2 WINDOWS_M) clamped to M_LOG2_MAX, latched at
@@ -212,7 +214,8 @@ module fmt_core #(
     fmt_tx #(
         .ROWS(ROWS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .PHASE_BITS(PHASE_BITS), .SINE_BITS(SINE_BITS), .AMP_BITS(AMP_BITS),
-        .DAC_BITS(DAC_BITS), .PN_BITS(PN_BITS), .CHIP_W(CHIP_W), .DELAY_W(DLY_W), .ROW_W(ROW_W)
+        .DAC_BITS(DAC_BITS), .PN_BITS(PN_BITS), .CHIP_W(CHIP_W), .DELAY_W(DLY_W),
+        .ROWS_PER_ENGINE(CPS), .ROW_W(ROW_W)
     ) u_tx (
         .clk(clk), .rst(rst), .ce(ce),
         .pn_enable_i(r_pn_en), .chip_len_i(chip_clk), .rx_delay_i(dly_clk),
@@ -238,7 +241,8 @@ module fmt_core #(
     fmt_rx_array #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .ADC_BITS(ADC_BITS), .HM_W(HM_W), .FRAME_W(16), .M_LOG2_MAX(M_LOG2_MAX),
-        .TW_DIR(TW_DIR), .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .SH_W(SH_W)
+        .TW_DIR(TW_DIR), .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .SH_W(SH_W),
+        .CLK_PER_SAMPLE(CPS)
     ) u_rx (
         .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_i), .rx_sign_i(rx_sign), .m_log2_i(m_log2),
         .hm_valid(hm_valid), .hm_row(hm_row), .hm_frame(hm_frame), .hm_data(hm_data),
