@@ -127,7 +127,10 @@ module fmt_ctrl_tb_top #(
         .lat_last_count_i(LL_COUNT),
         .lat_trig_last_i(LT_LAST), .lat_trig_min_i(LT_MIN), .lat_trig_max_i(LT_MAX),
         .lat_trig_count_i(LT_COUNT), .lat_trig_armed_i(1'b1),
-        .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o());
+        .lat_clear_we_o(lat_clear_o), .lat_clear_wdata_o(),
+        // snapshot control: this top's block RAM always holds a whole frame, so
+        // SNAP_STATUS reads "complete" (bit 31) at once
+        .snap_req_we_o(), .snap_req_wdata_o(), .snap_status_i(32'h8000_0000));
     /* verilator lint_on PINCONNECTEMPTY */
 
     wire unused_ok = &{1'b0, tone_tw_re, tone_amp_re, cal_off_re, cal_gain_re, cal_row[4:3], cal_col[5:3]};
