@@ -56,7 +56,7 @@ Latency
 window end -> event = receive chain (last ADC sample of the frame's last window -> last
 heat-map row beat: ``rx_clk`` processing-clock cycles at 3 x fs, the figure measured and
 asserted by tb/fmt_rx_array ``latency_and_slow_ce``; computed here from its formula and
-compared with ``build/rx_latency_default.txt`` when that file exists) + touch processing
+compared with ``build/rx_latency_default_postclk1_cps3.txt`` when that file exists) + touch processing
 (last row beat -> last event on the event port: ``--touch-clk``, default 120 cycles = the
 bound tb/fmt_touch asserts on scene heat maps (``BUDGET``); the header of rtl/fmt_touch.v
 gives the per-stage figures 4 + (6 + n) + 23 + (events + 5) + 3).  Plus (M - 1) N / fs.
@@ -168,14 +168,15 @@ def quantise(cells: np.ndarray, m: int, hm_w: int, cells_w: int = 16):
 # ---- latency --------------------------------------------------------------------------------
 def rx_latency_clk(cfg) -> dict:
     """Last ADC sample of a window -> last heat-map row beat, processing clocks at 3 x fs
-    (the formula tb/fmt_rx_array asserts), cross-checked with its written figure."""
+    (the schedule tb/fmt_rx_array asserts row by row: ``rx_fixed.rx_row_beats`` with the
+    shared magnitude units of the core's configuration), cross-checked with the figure the
+    test writes when it has run."""
     lat0 = _fft.latency0(cfg.log2_n, cfg.adc_bits + 1, _rx.fft_out_w(cfg))
-    ce = lat0 + int(_rx.completion_slots(cfg).max()) + 1 + (_rx.MAG_ITER + 3) + 2
-    clk = ce * CLK_PER_SAMPLE + 1
-    out = {"rx_clk": clk, "source": "formula of tb/fmt_rx_array (latency_formula x 3 + 1)"}
-    f = ROOT / "build" / f"rx_latency_{cfg.name}.txt"
+    clk = int(max(_rx.rx_row_beats(cfg, lat0, every=CLK_PER_SAMPLE, post_clk=1).values()))
+    out = {"rx_clk": clk, "source": "rx_fixed.rx_row_beats (the schedule tb/fmt_rx_array asserts)"}
+    f = ROOT / "build" / f"rx_latency_{cfg.name}_postclk1_cps{CLK_PER_SAMPLE}.txt"
     if f.exists():
-        mt = re.search(r"at 3 x fs: (\d+) clk", f.read_text())
+        mt = re.search(r"clk = 3 x fs: (\d+) /", f.read_text())
         if mt:
             out["measured_clk"] = int(mt.group(1))
             agree = "agrees" if int(mt.group(1)) == clk else "DIFFERS: stale file or changed RTL"
