@@ -1,5 +1,5 @@
 # Fast Multi-Touch (FMT) controller -- top-level commands.
-#   make sim     the main job: the default scene (or SCENE=path) through the chain
+#   make sim     the main job: the default scene (or SCENE=path) through the RTL core
 #   make test    the whole suite (model tests + cocotb under Icarus and Verilator)
 #   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
@@ -52,7 +52,13 @@ $(STAMP): requirements.txt
 setup: iverilog ccache $(STAMP)
 
 # ---- main job ------------------------------------------------------------------
+# The scene through the RTL (fmt_core under Verilator, the fixed-point model in lockstep).
+# The first full-size Verilator build takes 10-17 minutes; later runs reuse it.
 sim: setup
+	$(VPY) -m fmt.run_sim_rtl --scene $(SCENE)
+
+# The scene through the floating-point model only (seconds).
+sim-model: setup
 	$(VPY) -m fmt.run_sim --scene $(SCENE)
 
 # ---- tests ---------------------------------------------------------------------
