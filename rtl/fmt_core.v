@@ -79,7 +79,7 @@ module fmt_core #(
 ) (
     input  wire                     clk,            // processing clock, CLK_PER_SAMPLE x fs
     input  wire                     rst,            // synchronous, active high
-    output wire                     ce_o,           // sample strobe (DAC/ADC interface timing)
+    output wire                     ce_o,           // sample strobe (DAC/ADC word timing)
     // analogue front end
     output wire [ROWS*DAC_BITS-1:0] dac_o,          // row r DAC word at [r*DAC_BITS +: DAC_BITS], signed
     input  wire [COLS*ADC_BITS-1:0] adc_i,          // column c ADC word at [c*ADC_BITS +: ADC_BITS], signed

@@ -13,7 +13,7 @@
 // i.e. the exact round-half-up of (a c - b s) / 2^SH up to +-2^-GUARD output LSB from the
 // truncation (the two floors' biases cancel).  The result keeps its low OW bits; if the
 // value did not fit, ovf_o (sticky) is set: the FFT's growth plan makes that impossible,
-// so no saturation logic is spent on it, but it is never silent.
+// so no saturation hardware is spent on it, but it is never silent.
 // Latency: 4 ce-steps (ROM/data register, products, difference/sum, rounded output).
 `default_nettype none
 `include "fmt_defaults.vh"
