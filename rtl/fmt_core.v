@@ -31,7 +31,8 @@
 // ({enable, amplitude}) write the DDS bank through its settings port and read back a shadow copy (reset
 // values = the DDS reset plan).  CAL_OFFSET / CAL_GAIN write fmt_touch's calibration
 // memory and read a copy refreshed through its read-back port (see below).
-// BLOB_THRESHOLD / BLOB_MIN_CELLS are not used (fmt_touch has no blob detection).
+// BLOB_THRESHOLD / BLOB_MIN_CELLS drive fmt_touch's blob detector, but the register map
+// has no blob enable bit: blob_en is tied to 0 here (blobs off), so they have no effect yet.
 //
 // Block-read space (BLKREAD): HEATMAP words 0 .. ROWS*COLS-1 = the snapshot (cell (r,c)
 // at r*COLS + c, raw heat map before flattening); LAT_HIST words 0x8000 .. 0x801F = the
@@ -325,6 +326,8 @@ module fmt_core #(
         .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .hold_jump_i(r_hold_jump),
         .hold_off_i(r_hold_off), .vel_shift_i(r_vel_shift), .max_speed_i(r_max_speed),
         .delay_i(r_lat_dial), .report_period_i(r_report_period),
+        .blob_en_i(1'b0), .blob_threshold_i(r_blob_thr[HM_W-1:0]),
+        .blob_min_cells_i({4'd0, r_blob_min}),
         .cal_we_i(cal_wr), .cal_sel_i(cal_sel),
         .cal_row_i(r_cal_row[ROW_W-1:0]), .cal_col_i(r_cal_col[COL_W-1:0]),
         .cal_data_i({{(CAL_W - 16){1'b0}}, cal_gain_we ? cal_gain_wdata : cal_off_wdata}),
@@ -497,7 +500,7 @@ module fmt_core #(
     /* verilator lint_on PINCONNECTEMPTY */
 
     // settings the core does not use (documented in the header)
-    wire unused_ok = &{1'b0, r_scratch, r_blob_thr, r_blob_min, tone_tw_re, tone_amp_re,
+    wire unused_ok = &{1'b0, r_scratch, r_blob_thr, tone_tw_re, tone_amp_re,
                        cal_off_re, cal_gain_re, r_threshold, r_cal_row, r_cal_col, r_limit,
                        tone_tw_wdata, tone_amp_wdata, stream_en, now, rx_fft_ovf, rx_sat,
                        r_tone_sel, blk_addr, r_max_speed};

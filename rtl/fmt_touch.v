@@ -1,6 +1,28 @@
 // fmt_touch -- the touch-processing top: heat-map stream in, touch-event stream out.
 //
-//   fmt_flatten -> fmt_localmax -> fmt_interp -> fmt_tracker -> fmt_event_port
+//   fmt_flatten -> fmt_localmax -> fmt_interp -> [finger removal] -> fmt_tracker
+//               -> fmt_blob ----------------------------------------> [blob events]
+//                                                             -> fmt_event_port
+//
+// Blobs (blob_en_i = 1; twin process_frames(blobs=True)): fmt_blob sees the flattened
+// stream beside fmt_localmax.  The frame's fine touches (fmt_interp keeps the order of
+// the candidates, so the candidate cells are kept in a buffer of MAX_TOUCHES entries
+// beside the touch beats) are held until the blob mask of the frame is written
+// (mask_ready), then replayed one per cycle: the cell's mask row is read, one cycle
+// later the touch goes to the tracker unless its candidate cell lies in a blob (all
+// blobs, also beyond the 8 reported); tp_eof follows on the next cycle.  Up to 8 blob
+// records are buffered and emitted after the tracker's events of the frame (when the
+// tracker is idle again) as type 3: id 0xFF, x/y = centroid (Q8.8), strength = peak,
+// axes/angle/flags 0, ev_last on the last blob.  blob_threshold_i must be >= 1.
+// With blob_en_i = 0 the blob path is bypassed combinationally: the events and their
+// timing are those of the chain without blobs.  The blob path handles one frame at a
+// time (the frame's events must be out before the next frame's touches: true at the
+// frame period, ~100 cycles against >= 384).  The event port reserves room for
+// 2 * MAX_TOUCHES + 8 events per frame.
+// Extra latency with blobs on: the wait for the mask (~56..61 cycles after the last
+// row beat at 30 x 40), n + 2 cycles of replay, then one cycle per blob event.
+// Measured (tb/fmt_touch, 8 x 10, test blobs): last row beat -> last event 56..65 cycles
+// on palm scenes (1..4 events), worst 93 on random maps with many blobs.
 //
 // Twin: sim/fmt/touch.py process_frames(fixed=True, blobs=False): per frame the same
 // events in the same order (time stamps excepted).  The run-time settings are input
@@ -46,6 +68,9 @@ module fmt_touch #(
     input  wire [V_W-2:0]        max_speed_i,        // velocity clamp
     input  wire [TIME_W-1:0]     delay_i,            // dial-a-latency (cycles)
     input  wire [TIME_W-1:0]     report_period_i,    // min cycles between reported frames
+    input  wire                  blob_en_i,          // 1: blob detection, finger removal, blob events
+    input  wire [HM_W-1:0]       blob_threshold_i,   // blob cell when z >= this (must be >= 1)
+    input  wire [15:0]           blob_min_cells_i,   // a region of >= this many cells is a blob
     // calibration write port (fmt_flatten)
     input  wire                  cal_we_i,           // write one cell's offset or gain
     input  wire                  cal_sel_i,          // 0 offset, 1 gain (Q2.14)
@@ -68,7 +93,7 @@ module fmt_touch #(
     output wire [FRAME_W-1:0]    ev_frame_o,         // frame number
     output wire [TIME_W-1:0]     ev_time_o,          // time stamp (cycles since reset)
     output wire [ID_W-1:0]       ev_id_o,            // contact ID
-    output wire [1:0]            ev_type_o,          // 0 new, 1 move, 2 lift
+    output wire [1:0]            ev_type_o,          // 0 new, 1 move, 2 lift, 3 blob
     output wire [15:0]           ev_x_o,             // Q8.8 column coordinate
     output wire [15:0]           ev_y_o,             // Q8.8 row coordinate
     output wire [HM_W-1:0]       ev_strength_o,      // peak (flattened) cell
@@ -163,6 +188,127 @@ module fmt_touch #(
         .tp_angle(t_angle), .tp_flags(t_flags), .tp_eof(t_eof), .tp_count(t_count),
         .tp_overflow(t_overflow));
 
+    // ---- blobs (beside the local maxima) ------------------------------------------
+    localparam MAX_BLOBS = 8;                          // blob records per frame
+    localparam BAREA_W   = $clog2(ROWS * COLS + 1);
+    localparam BCNT_W    = $clog2(MAX_BLOBS + 1);
+    localparam TI_W      = $clog2(MAX_TOUCHES + 1);    // touch index / count width
+    localparam TPD_W     = FRAME_W + 4 * 16 + HM_W + 16; // held touch beat
+    localparam BRD_W     = 32 + HM_W;                  // held blob record (cx, cy, peak)
+
+    wire                   b_valid, b_eof, m_ready;
+    wire [FRAME_W-1:0]     b_frame;
+    wire [15:0]            b_cx, b_cy;
+    wire [HM_W-1:0]        b_peak;
+    wire [COLS-1:0]        m_data;
+    /* verilator lint_off UNUSEDSIGNAL */   // blob fields and monitors not used by the events
+    wire [FRAME_W-1:0]     m_frame;
+    wire [BAREA_W-1:0]     b_area, b_found;
+    wire [ROW_IDX_W-1:0]   b_rmin, b_rmax, b_prow;
+    wire [COL_IDX_W-1:0]   b_cmin, b_cmax, b_pcol;
+    wire [BCNT_W-1:0]      b_count;
+    wire                   b_ovf, b_inc, b_ovf_flag, b_overrun;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [ROW_IDX_W-1:0]   m_rd_row;
+
+    fmt_blob #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_BLOBS(MAX_BLOBS),
+               .FRAME_W(FRAME_W), .ROW_IDX_W(ROW_IDX_W), .COL_IDX_W(COL_IDX_W),
+               .MINC_W(16)) u_blob (
+        .clk(clk), .rst(rst),
+        .blob_threshold_i(blob_threshold_i), .blob_min_cells_i(blob_min_cells_i),
+        .hm_valid_i(f_valid), .hm_row_i(f_row), .hm_frame_i(f_frame), .hm_data_i(f_data),
+        .hm_eof_i(f_eof),
+        .blob_valid_o(b_valid), .blob_frame_o(b_frame), .blob_area_o(b_area),
+        .blob_cx_o(b_cx), .blob_cy_o(b_cy), .blob_rmin_o(b_rmin), .blob_cmin_o(b_cmin),
+        .blob_rmax_o(b_rmax), .blob_cmax_o(b_cmax), .blob_peak_o(b_peak),
+        .blob_peak_row_o(b_prow), .blob_peak_col_o(b_pcol), .blob_eof_o(b_eof),
+        .blob_count_o(b_count), .blob_found_o(b_found), .blob_overflow_o(b_ovf),
+        .blob_incomplete_o(b_inc),
+        .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_rd_row_i(m_rd_row),
+        .mask_rd_data_o(m_data),
+        .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
+
+    // ---- finger removal: hold the touch beats until the mask is written --------------
+    reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index
+    reg  [COL_IDX_W-1:0]   cc_mem [0:(1<<TI_W)-1];
+    reg  [TPD_W-1:0]       tp_mem [0:(1<<TI_W)-1];   // touch beats of the frame
+    reg  [TI_W-1:0]        ci_q, ti_q, tn_q, rj_q, s1_idx_q;
+    reg                    have_tp_q, have_mask_q, have_blob_q, rp_q, s1_valid_q, s1_eof_q;
+
+    always @(posedge clk) begin
+        if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) begin
+            cr_mem[ci_q] <= c_row;
+            cc_mem[ci_q] <= c_col;
+        end
+        if (t_valid && blob_en_i && ti_q < MAX_TOUCHES)
+            tp_mem[ti_q] <= {t_frame, t_x, t_y, t_major, t_minor, t_strength,
+                                       t_angle, t_flags};
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            ci_q <= {TI_W{1'b0}};
+            ti_q <= {TI_W{1'b0}};
+            tn_q <= {TI_W{1'b0}};
+            rj_q <= {TI_W{1'b0}};
+            s1_idx_q <= {TI_W{1'b0}};
+            have_tp_q <= 1'b0;
+            have_mask_q <= 1'b0;
+            have_blob_q <= 1'b0;
+            rp_q <= 1'b0;
+            s1_valid_q <= 1'b0;
+            s1_eof_q <= 1'b0;
+        end else begin
+            s1_valid_q <= 1'b0;
+            s1_eof_q   <= 1'b0;
+            if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
+            if (c_eof) ci_q <= {TI_W{1'b0}};
+            if (t_valid && blob_en_i && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
+            if (t_eof && blob_en_i) begin
+                tn_q      <= ti_q + {{(TI_W-1){1'b0}}, t_valid};
+                ti_q      <= {TI_W{1'b0}};
+                have_tp_q <= 1'b1;
+            end else if (t_eof) begin
+                ti_q <= {TI_W{1'b0}};
+            end
+            if (m_ready && blob_en_i) have_mask_q <= 1'b1;
+            if (b_eof && blob_en_i) have_blob_q <= 1'b1;
+            if (!rp_q && have_tp_q && have_mask_q && have_blob_q) begin
+                rp_q        <= 1'b1;                  // replay the frame's touches
+                rj_q        <= {TI_W{1'b0}};
+                have_tp_q   <= 1'b0;
+                have_mask_q <= 1'b0;
+                have_blob_q <= 1'b0;
+            end
+            if (rp_q) begin
+                if (rj_q < tn_q) begin
+                    s1_valid_q <= 1'b1;               // mask row read this cycle
+                    s1_idx_q   <= rj_q;
+                    rj_q       <= rj_q + 1'b1;
+                end else begin
+                    s1_eof_q <= 1'b1;
+                    rp_q     <= 1'b0;
+                end
+            end
+        end
+    end
+
+    assign m_rd_row = cr_mem[rj_q];
+    wire [COL_IDX_W-1:0] s1_col  = cc_mem[s1_idx_q];
+    wire [TPD_W-1:0]     s1_beat = tp_mem[s1_idx_q];
+    wire                 s1_keep = s1_valid_q && !m_data[s1_col];
+
+    // tracker input: the chain (blobs off) or the replayed touches (blobs on)
+    wire                   g_valid = blob_en_i ? s1_keep  : t_valid;
+    wire                   g_eof   = blob_en_i ? s1_eof_q : t_eof;
+    wire [FRAME_W-1:0]     g_frame;
+    wire [15:0]            g_x, g_y, g_major, g_minor;
+    wire [HM_W-1:0]        g_strength;
+    wire [7:0]             g_angle, g_flags;
+    assign {g_frame, g_x, g_y, g_major, g_minor, g_strength, g_angle, g_flags} =
+        blob_en_i ? (s1_eof_q ? {t_frame, {(TPD_W-FRAME_W){1'b0}}} : s1_beat)
+                  : {t_frame, t_x, t_y, t_major, t_minor, t_strength, t_angle, t_flags};
+
     // ---- frame matching -------------------------------------------------------------
     wire                   k_valid, k_last;
     wire [FRAME_W-1:0]     k_frame;
@@ -171,18 +317,16 @@ module fmt_touch #(
     wire [15:0]            k_x, k_y, k_major, k_minor;
     wire [HM_W-1:0]        k_strength;
     wire [7:0]             k_angle, k_flags;
-    /* verilator lint_off UNUSEDSIGNAL */   // busy: status only
     wire                   k_busy;
-    /* verilator lint_on UNUSEDSIGNAL */
 
     fmt_tracker #(.MAX_TOUCHES(MAX_TOUCHES), .HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W),
                   .VF(VF), .V_W(V_W), .HOLD_W(HOLD_W)) u_tracker (
         .clk(clk), .rst(rst),
         .max_jump_i(max_jump_i), .hold_jump_i(hold_jump_i), .hold_off_i(hold_off_i),
         .vel_shift_i(vel_shift_i), .max_speed_i(max_speed_i),
-        .tp_valid_i(t_valid), .tp_frame_i(t_frame), .tp_x_i(t_x), .tp_y_i(t_y),
-        .tp_strength_i(t_strength), .tp_axis_major_i(t_major), .tp_axis_minor_i(t_minor),
-        .tp_angle_i(t_angle), .tp_flags_i(t_flags), .tp_eof_i(t_eof),
+        .tp_valid_i(g_valid), .tp_frame_i(g_frame), .tp_x_i(g_x), .tp_y_i(g_y),
+        .tp_strength_i(g_strength), .tp_axis_major_i(g_major), .tp_axis_minor_i(g_minor),
+        .tp_angle_i(g_angle), .tp_flags_i(g_flags), .tp_eof_i(g_eof),
         .ev_valid_o(k_valid), .ev_frame_o(k_frame), .ev_id_o(k_id), .ev_type_o(k_type),
         .ev_x_o(k_x), .ev_y_o(k_y), .ev_strength_o(k_strength), .ev_axis_major_o(k_major),
         .ev_axis_minor_o(k_minor), .ev_angle_o(k_angle), .ev_flags_o(k_flags),
@@ -190,15 +334,72 @@ module fmt_touch #(
         .drop_flag_o(trk_drop_o), .noslot_flag_o(trk_noslot_o),
         .overrun_flag_o(trk_overrun_o), .busy_o(k_busy));
 
+    // ---- blob events after the tracker's events of the frame -------------------------
+    reg  [BRD_W-1:0]       br_mem [0:(1<<BCNT_W)-1];    // cx, cy, peak
+    reg  [BCNT_W-1:0]      bc_q, bn_q, bi_q;
+    reg  [FRAME_W-1:0]     bf_q;
+    reg                    wt_q, em_q;
+
+    always @(posedge clk) begin
+        if (b_valid && blob_en_i && bc_q < MAX_BLOBS)
+            br_mem[bc_q] <= {b_cx, b_cy, b_peak};
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            bc_q <= {BCNT_W{1'b0}};
+            bn_q <= {BCNT_W{1'b0}};
+            bi_q <= {BCNT_W{1'b0}};
+            bf_q <= {FRAME_W{1'b0}};
+            wt_q <= 1'b0;
+            em_q <= 1'b0;
+        end else begin
+            if (b_valid && blob_en_i && bc_q < MAX_BLOBS) bc_q <= bc_q + 1'b1;
+            if (b_eof) begin
+                bc_q <= {BCNT_W{1'b0}};
+                if (blob_en_i) begin
+                    bn_q <= bc_q;
+                    bf_q <= b_frame;
+                end
+            end
+            if (blob_en_i && s1_eof_q) wt_q <= 1'b1;  // tracker busy from the next cycle
+            if (wt_q && !k_busy) begin                // its last event is out now
+                wt_q <= 1'b0;
+                em_q <= (bn_q != {BCNT_W{1'b0}});
+                bi_q <= {BCNT_W{1'b0}};
+            end
+            if (em_q) begin
+                bi_q <= bi_q + 1'b1;
+                if (bi_q + 1'b1 == bn_q) em_q <= 1'b0;
+            end
+        end
+    end
+
+    wire [BRD_W-1:0] br_cur = br_mem[bi_q];
+    // event port input: the tracker's events, then (blobs on) the frame's blob events
+    wire               p_valid    = (blob_en_i && em_q) ? 1'b1      : k_valid;
+    wire [FRAME_W-1:0] p_frame    = (blob_en_i && em_q) ? bf_q      : k_frame;
+    wire [ID_W-1:0]    p_id       = (blob_en_i && em_q) ? {ID_W{1'b1}} : k_id;
+    wire [1:0]         p_type     = (blob_en_i && em_q) ? 2'd3      : k_type;
+    wire [15:0]        p_x        = (blob_en_i && em_q) ? br_cur[BRD_W-1 -: 16] : k_x;
+    wire [15:0]        p_y        = (blob_en_i && em_q) ? br_cur[HM_W +: 16]    : k_y;
+    wire [HM_W-1:0]    p_strength = (blob_en_i && em_q) ? br_cur[HM_W-1:0]      : k_strength;
+    wire [15:0]        p_major    = (blob_en_i && em_q) ? 16'd0     : k_major;
+    wire [15:0]        p_minor    = (blob_en_i && em_q) ? 16'd0     : k_minor;
+    wire [7:0]         p_angle    = (blob_en_i && em_q) ? 8'd0      : k_angle;
+    wire [7:0]         p_flags    = (blob_en_i && em_q) ? 8'd0      : k_flags;
+    wire               p_last     = (blob_en_i && em_q) ? (bi_q + 1'b1 == bn_q)
+                                  : (k_last && !(blob_en_i && bn_q != {BCNT_W{1'b0}}));
+
     // ---- event port -----------------------------------------------------------------
     fmt_event_port #(.HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W), .TIME_W(TIME_W),
-                     .DEPTH(EV_DEPTH), .MAX_EV(2 * MAX_TOUCHES), .CNT_W(CNT_W)) u_port (
+                     .DEPTH(EV_DEPTH), .MAX_EV(2 * MAX_TOUCHES + MAX_BLOBS), .CNT_W(CNT_W)) u_port (
         .clk(clk), .rst(rst),
         .delay_i(delay_i), .report_period_i(report_period_i),
-        .in_valid_i(k_valid), .in_frame_i(k_frame), .in_id_i(k_id), .in_type_i(k_type),
-        .in_x_i(k_x), .in_y_i(k_y), .in_strength_i(k_strength),
-        .in_axis_major_i(k_major), .in_axis_minor_i(k_minor), .in_angle_i(k_angle),
-        .in_flags_i(k_flags), .in_last_i(k_last),
+        .in_valid_i(p_valid), .in_frame_i(p_frame), .in_id_i(p_id), .in_type_i(p_type),
+        .in_x_i(p_x), .in_y_i(p_y), .in_strength_i(p_strength),
+        .in_axis_major_i(p_major), .in_axis_minor_i(p_minor), .in_angle_i(p_angle),
+        .in_flags_i(p_flags), .in_last_i(p_last),
         .ev_valid_o(ev_valid_o), .ev_ready_i(ev_ready_i), .ev_frame_o(ev_frame_o),
         .ev_time_o(ev_time_o), .ev_id_o(ev_id_o), .ev_type_o(ev_type_o), .ev_x_o(ev_x_o),
         .ev_y_o(ev_y_o), .ev_strength_o(ev_strength_o), .ev_axis_major_o(ev_axis_major_o),

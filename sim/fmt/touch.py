@@ -1,7 +1,7 @@
 """The touch-processing pipeline: heat maps -> touch events (twin of ``rtl/fmt_touch.v``).
 
     flatten (fmt.flatten) -> 3x3 local maxima above the threshold (fmt.localmax)
-    [-> blobs (fmt.blobs), model only, off by default] -> paraboloid fits (fmt.interp)
+    [-> blobs (fmt.blobs), off by default] -> paraboloid fits (fmt.interp)
     -> frame matching (fmt.tracking)
 
 ``fixed=True`` runs the bit-exact twins of the RTL blocks (integer heat maps); the
@@ -22,6 +22,8 @@ from . import localmax as _localmax
 from .params import SensorConfig
 from .settings import TouchSettings
 from .tracking import Touch, TouchEvent, Tracker, TrackParams
+
+MAX_BLOBS = 8          # blob events per frame (rtl/fmt_touch.v: fmt_blob MAX_BLOBS)
 
 
 def _touch_from_fixed(tp) -> Touch:
@@ -73,7 +75,10 @@ class TouchPipeline:
         blobs = []
         if self.blobs:
             from . import blobs as _blobs
+            # finger removal after the contact limit, by every blob (also those beyond
+            # the MAX_BLOBS reported); events for the first MAX_BLOBS blobs only
             cands, blobs = _blobs.split_touches(zi, cands, s.blob_threshold, s.blob_min_cells)
+            blobs = blobs[:MAX_BLOBS]
         if self.fixed:
             tps = _interp.interp_frame_fixed(cands, self.cfg, self.moore, s.bias_correction, frame)
             return [_touch_from_fixed(t) for t in tps], blobs
@@ -98,7 +103,7 @@ class TouchPipeline:
             fr = (first_frame + k) & 0xFFFF
             ts, blobs = self.touches(flat[k], fr)
             evs = self.tracker.step(fr, ts)
-            for b in blobs:                    # model only: one 'blob' event per blob
+            for b in blobs:                    # one 'blob' event per reported blob
                 evs.append(TouchEvent(fr, 0xFF, "blob", b.cx_q, b.cy_q, b.peak))
             out.append(evs)
         return out
@@ -111,10 +116,12 @@ def process_frames(heatmaps, cfg: SensorConfig, settings: TouchSettings | None =
 
     ``flatten_cal`` = (offset, gain) arrays (default: identity).  ``frame_period_s``
     converts the tracking settings (default one window, M = 1).  ``blobs=True`` adds the
-    blob stage (model only, no RTL twin): maxima inside a blob are not fingers, each
-    blob gives a 'blob' event (id 0xFF, x/y = centroid, strength = peak) after the
-    tracker's events.  With ``fixed=True, blobs=False`` the events are bit-exact with
-    ``rtl/fmt_touch.v`` (per frame, in the RTL's order)."""
+    blob stage: maxima (after the contact limit) inside any blob are not fingers, and
+    the first MAX_BLOBS = 8 blobs (largest first, ``blobs.blob_stream_fixed`` order)
+    give 'blob' events (type 3, id 0xFF, x/y = centroid Q8.8, strength = peak, other
+    fields 0) after the tracker's events.  With ``fixed=True`` the events are
+    bit-exact with ``rtl/fmt_touch.v`` (per frame, in the RTL's order; blob_en_i =
+    blobs, blob_threshold >= 1)."""
     hm = np.asarray(heatmaps)
     if hm.ndim == 2:
         hm = hm[None]

@@ -8,6 +8,12 @@ frame's events (all fields, in order, ev_last) must equal the model's.  The late
 from the frame's last row beat to its last event on the output (dial 0, consumer
 ready) is measured per frame and checked against the budget (~120 processing-clock
 cycles); the numbers are logged (pytest -s, or the cocotb log).
+
+Blobs (blob_en_i = 1, test ``blobs``): palm scenes (a large ellipse and fingers next to
+it, some fingers landing on the palm) and random maps, bit-exact with
+process_frames(blobs=True) (finger removal by the blob mask, type-3 blob events after
+the tracker's); the latency last row -> last event with blobs on is logged and
+checked against BLOB_BUDGET.  The other tests run with blob_en_i = 0.
 """
 from __future__ import annotations
 
@@ -29,8 +35,10 @@ from fmt.tracking import TrackParams
 
 MODULES = ["fmt_touch", "fmt_flatten", "fmt_localmax", "fmt_interp", "fmt_interp_dly",
            "fmt_interp_cordic", "fmt_div", "fmt_interp_lg", "fmt_interp_exp",
-           "fmt_interp_bias_rom", "fmt_tracker", "fmt_tracker_vel", "fmt_event_port"]
+           "fmt_interp_bias_rom", "fmt_tracker", "fmt_tracker_vel", "fmt_event_port",
+           "fmt_blob"]
 BUDGET = 120
+BLOB_BUDGET = 200              # blobs on: + the wait for the blob mask and the replay
 FRAME_PERIOD_S = 1e-3          # scaled timeline for the tracking settings
 
 
@@ -57,6 +65,9 @@ class TB(ClockedTB):
         d.ev_ready_i.value = 1
         d.delay_i.value = 0
         d.report_period_i.value = 0
+        d.blob_en_i.value = 0
+        d.blob_threshold_i.value = 1
+        d.blob_min_cells_i.value = 0
         cocotb.start_soon(self._monitor())
 
     def settings(self, st: TouchSettings):
@@ -71,6 +82,8 @@ class TB(ClockedTB):
         d.hold_off_i.value = tp.hold_off_frames
         d.vel_shift_i.value = tp.vel_shift
         d.max_speed_i.value = tp.max_speed_v
+        d.blob_threshold_i.value = st.blob_threshold
+        d.blob_min_cells_i.value = st.blob_min_cells
 
     async def _monitor(self):
         d = self.dut
@@ -172,9 +185,10 @@ def group(events):
     return fr
 
 
-async def run_case(tb, maps, st, cal, rng, period):
+async def run_case(tb, maps, st, cal, rng, period, blobs=False):
     cfg = tb.cfg
     tb.settings(st)
+    tb.dut.blob_en_i.value = int(blobs)
     await tb.reset()
     # the calibration RAM is not cleared by reset: always load one
     await tb.calibrate(*(cal if cal is not None else flatten.identity(cfg)))
@@ -183,7 +197,8 @@ async def run_case(tb, maps, st, cal, rng, period):
     await tb.send(maps, rng, period)
     for _ in range(200):
         await RisingEdge(tb.clk)
-    exp = process_frames(maps, cfg, st, fixed=True, flatten_cal=cal, frame_period_s=FRAME_PERIOD_S)
+    exp = process_frames(maps, cfg, st, fixed=True, flatten_cal=cal, frame_period_s=FRAME_PERIOD_S,
+                         blobs=blobs)
     got = {fr[0][1][0]: fr for fr in group(tb.events)}
     lat = []
     for k, evs in enumerate(exp):
@@ -269,6 +284,59 @@ async def many_fingers(dut):
     dut._log.info(f"{len(grid)} fingers: latency last row -> last event (events, cycles): "
                   f"worst {worst}, all {sorted(set(lat))}")
     assert worst <= BUDGET
+
+
+def palm_maps(cfg, n, top, rng):
+    """A palm (large ellipse, drifting) with fingers next to it; every 4th frame one
+    finger sits on the palm's edge (removed as part of the blob), some frames without
+    the palm (fingers only), some with two small blobs."""
+    out = np.zeros((n, cfg.rows, cfg.cols), dtype=np.int64)
+    w, h = cfg.width_mm, cfg.height_mm
+    for k in range(n):
+        px, py = (0.35 + 0.01 * k) * w, (0.45 + 0.005 * k) * h
+        cts = []
+        if k % 7 != 6:
+            cts.append((px, py, 0.5 * h, 1.0, 0.35 * w, 0.3 + 0.05 * k))
+        cts.append((0.85 * w, (0.2 + 0.01 * k) * h, 8.0, 1.0, 8.0, 0.0))
+        cts.append((0.88 * w, 0.8 * h, 7.0, 0.8, 7.0, 0.0))
+        if k % 4 == 3:
+            cts.append((px + 0.3 * w, py, 7.0, 1.0, 7.0, 0.0))
+        if k % 5 == 4:
+            cts.append((0.1 * w, 0.1 * h, 9.0, 1.0, 9.0, 0.0))
+        m = sensor.contact_map(cfg, cts) * 25000 + rng.normal(200, 40, (cfg.rows, cfg.cols))
+        out[k] = np.clip(np.rint(m), 0, top)
+    return out
+
+
+@cocotb.test()
+async def blobs(dut):
+    """blob_en_i = 1: palm scenes and random maps (many small regions: more than 8
+    blobs, fingers removed by blobs beyond the reported 8), bit-exact with
+    process_frames(blobs=True); latency with blobs on."""
+    tb = TB(dut)
+    cfg = tb.cfg
+    top = (1 << cfg.hm_width) - 1
+    rng = np.random.default_rng(11)
+    period = 3 * cfg.n_fft
+    maps = palm_maps(cfg, 24, top, rng)
+    st = TouchSettings(threshold=3000, hold_off_us=3000, max_speed_mm_s=1000,
+                       blob_threshold=4000, blob_min_cells=6)
+    lat = await run_case(tb, maps, st, None, random.Random(11), period, blobs=True)
+    exp = process_frames(maps, cfg, st, fixed=True, frame_period_s=FRAME_PERIOD_S, blobs=True)
+    assert sum(e.type == "blob" for f in exp for e in f) >= 12, "palm scenes give blobs"
+    worst = max(l for _, l in lat)
+    dut._log.info(f"blobs on, palm scenes: latency last row -> last event (events, cycles): "
+                  f"worst {worst}, all {sorted(set(lat))}")
+    assert worst <= BLOB_BUDGET
+    rmaps = random_maps(cfg, rng, 16, top)
+    st2 = TouchSettings(threshold=2500, hold_off_us=3000, blob_threshold=2000,
+                        blob_min_cells=1)
+    exp = process_frames(rmaps, cfg, st2, fixed=True, frame_period_s=FRAME_PERIOD_S, blobs=True)
+    # single cells count: frames with more than 8 blobs (the list is full)
+    assert max(sum(e.type == "blob" for e in f) for f in exp) == 8
+    lat2 = await run_case(tb, rmaps, st2, None, random.Random(12), period, blobs=True)
+    dut._log.info(f"blobs on, random maps: latency (events, cycles): worst "
+                  f"{max(l for _, l in lat2)}")
 
 
 # ---- pytest entry ------------------------------------------------------------------
