@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
+from common.hm_stream import drive_hm_schedule
 from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
@@ -105,27 +106,9 @@ class TB(ClockedTB):
         return sched
 
     async def drive(self, sched):
-        """Drive the schedule; returns the monitor cycle numbers of the last row beat and
-        of hm_eof of each frame."""
-        d = self.dut
-        marks, last_row = [], None
-        for item in sched:
-            await self.writable()
-            d.hm_valid_i.value = 0
-            d.hm_eof_i.value = 0
-            if item is not None and item[0] == "row":
-                d.hm_valid_i.value = 1
-                d.hm_row_i.value = item[1]
-                d.hm_data_i.value = self.pack(item[2])
-                last_row = self.cycle + 1
-            elif item is not None:
-                d.hm_eof_i.value = 1
-                d.hm_frame_i.value = item[1]
-                marks.append((last_row, self.cycle + 1))
-        await self.writable()
-        d.hm_valid_i.value = 0
-        d.hm_eof_i.value = 0
-        return marks
+        """Drive the schedule (tb/common/hm_stream.py); returns (last row beat, hm_eof)
+        monitor cycles per frame."""
+        return await drive_hm_schedule(self, sched)
 
     async def drain(self, n_frames, timeout=2000):
         for _ in range(timeout):
