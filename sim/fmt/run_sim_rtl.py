@@ -230,7 +230,8 @@ def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
         ("PN_RX_DELAY", PN_RX_DELAY), ("PN_ENABLE", int(enable)), ("PN_CHIP_LEN", chip_len),
         ("WINDOWS_M", scene.m),
         ("TOUCH_THRESHOLD", settings.threshold),
-        ("TOUCH_MODE", int(settings.neighbourhood == "moore") | (2 if settings.bias_correction else 0)),
+        ("TOUCH_MODE", int(settings.neighbourhood == "moore") | (2 if settings.bias_correction else 0)
+         | (4 if settings.blobs else 0)),
         ("CONTACT_LIMIT", settings.max_touches if settings.max_touches is not None else cfg.max_touches),
         ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_HOLD_JUMP", tp.hold_jump_q),
         ("TRACK_HOLD_OFF", tp.hold_off_frames), ("TRACK_VEL_SHIFT", tp.vel_shift),

@@ -55,14 +55,14 @@ class TouchPipeline:
 
     def __init__(self, cfg: SensorConfig, settings: TouchSettings | None = None,
                  fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
-                 track_params: TrackParams | None = None, blobs: bool = False):
+                 track_params: TrackParams | None = None, blobs: bool | None = None):
         self.cfg = cfg
         self.s = settings or TouchSettings()
         self.fixed = fixed
         self.offset, self.gain = flatten_cal if flatten_cal is not None else _flatten.identity(cfg)
         self.tp = track_params or TrackParams.from_settings(cfg, self.s, frame_period_s)
         self.tracker = Tracker(self.tp)
-        self.blobs = blobs
+        self.blobs = self.s.blobs if blobs is None else blobs
         self.max_touches = self.s.max_touches if self.s.max_touches is not None else cfg.max_touches
         self.moore = self.s.neighbourhood == "moore"
 
@@ -111,12 +111,12 @@ class TouchPipeline:
 
 def process_frames(heatmaps, cfg: SensorConfig, settings: TouchSettings | None = None,
                    fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
-                   first_frame: int = 0, blobs: bool = False) -> list[list[TouchEvent]]:
+                   first_frame: int = 0, blobs: bool | None = None) -> list[list[TouchEvent]]:
     """Heat maps (frames, rows, cols) -> list (per frame) of TouchEvent lists.
 
     ``flatten_cal`` = (offset, gain) arrays (default: identity).  ``frame_period_s``
-    converts the tracking settings (default one window, M = 1).  ``blobs=True`` adds the
-    blob stage: maxima (after the contact limit) inside any blob are not fingers, and
+    converts the tracking settings (default one window, M = 1).  ``blobs=True`` (default:
+    ``settings.blobs``) adds the blob stage: maxima (after the contact limit) inside any blob are not fingers, and
     the first MAX_BLOBS = 8 blobs (largest first, ``blobs.blob_stream_fixed`` order)
     give 'blob' events (type 3, id 0xFF, x/y = centroid Q8.8, strength = peak, other
     fields 0) after the tracker's events.  With ``fixed=True`` the events are
