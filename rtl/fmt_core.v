@@ -31,8 +31,8 @@
 // ({enable, amplitude}) write the DDS bank through its settings port and read back a shadow copy (reset
 // values = the DDS reset plan).  CAL_OFFSET / CAL_GAIN write fmt_touch's calibration
 // memory and read a copy refreshed through its read-back port (see below).
-// BLOB_THRESHOLD / BLOB_MIN_CELLS drive fmt_touch's blob detector, but the register map
-// has no blob enable bit: blob_en is tied to 0 here (blobs off), so they have no effect yet.
+// TOUCH_MODE bit 2 turns fmt_touch's blob detector on (blob_en_i; BLOB_THRESHOLD and
+// BLOB_MIN_CELLS set it): fingers inside blobs are dropped and blobs leave as type-3 events.
 //
 // Block-read space (BLKREAD): HEATMAP words 0 .. ROWS*COLS-1 = the snapshot (cell (r,c)
 // at r*COLS + c, raw heat map before flattening); LAT_HIST words 0x8000 .. 0x801F = the
@@ -49,7 +49,8 @@
 //
 // Status: STATUS bits (w1c) are set by the blocks' sticky flags (bit 0 flattening
 // saturation, 1 receiver FFT/cell overflow, 2 event-port drop, 3 latency saturation,
-// 4 control-port error, 5 localmax overflow/overrun, 6 tracker drop/no slot/overrun);
+// 4 control-port error, 5 localmax overflow/overrun, 6 tracker drop/no slot/overrun,
+// 7 blob overflow/overrun);
 // status_o mirrors them for LEDs.  FRAME_COUNT counts heat-map frames (hm_eof).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -159,7 +160,7 @@ module fmt_core #(
     wire [31:0] tone_tw_wdata;
     wire [8:0]  tone_amp_wdata;
     wire [15:0] r_threshold, r_max_jump, r_hold_jump, r_blob_thr;
-    wire [1:0]  r_mode;
+    wire [2:0]  r_mode;
     wire [11:0] r_hold_off, r_blob_min;
     wire [3:0]  r_vel_shift;
     wire [20:0] r_max_speed;
@@ -286,6 +287,7 @@ module fmt_core #(
     wire             ev_last;
     wire [31:0]      now;
     wire             flat_sat, lm_ovf, lm_overrun, trk_drop, trk_noslot, trk_overrun, ev_ovf;
+    wire             blob_flag;
     wire [15:0]      flat_sat_cnt, lm_drop_cnt, ev_drop_cnt, ev_skip_cnt;
     wire [LIM_W-1:0] limit = ({27'd0, r_limit} > MAX_TOUCHES) ? MAX_TOUCHES[LIM_W-1:0] : r_limit[LIM_W-1:0];
 
@@ -326,7 +328,7 @@ module fmt_core #(
         .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .hold_jump_i(r_hold_jump),
         .hold_off_i(r_hold_off), .vel_shift_i(r_vel_shift), .max_speed_i(r_max_speed),
         .delay_i(r_lat_dial), .report_period_i(r_report_period),
-        .blob_en_i(1'b0), .blob_threshold_i(r_blob_thr[HM_W-1:0]),
+        .blob_en_i(r_mode[2]), .blob_threshold_i(r_blob_thr[HM_W-1:0]),
         .blob_min_cells_i({4'd0, r_blob_min}),
         .cal_we_i(cal_wr), .cal_sel_i(cal_sel),
         .cal_row_i(r_cal_row[ROW_W-1:0]), .cal_col_i(r_cal_col[COL_W-1:0]),
@@ -343,7 +345,8 @@ module fmt_core #(
         .now_o(now), .sat_flag_o(flat_sat), .sat_count_o(flat_sat_cnt),
         .lm_overflow_o(lm_ovf), .lm_drop_count_o(lm_drop_cnt), .lm_overrun_o(lm_overrun),
         .trk_drop_o(trk_drop), .trk_noslot_o(trk_noslot), .trk_overrun_o(trk_overrun),
-        .ev_drop_count_o(ev_drop_cnt), .ev_skip_count_o(ev_skip_cnt), .ev_overflow_o(ev_ovf));
+        .ev_drop_count_o(ev_drop_cnt), .ev_skip_count_o(ev_skip_cnt), .ev_overflow_o(ev_ovf),
+        .blob_flag_o(blob_flag));
     assign ev_valid_o = ev_valid;
     assign ev_frame_o = ev_frame;
     assign ev_type_o  = ev_type;
@@ -440,7 +443,7 @@ module fmt_core #(
         else if (hm_eof) frames_q <= frames_q + 1'b1;
     end
     assign frame_count_o = frame_count_q;
-    wire [7:0] status_set = {1'b0, trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
+    wire [7:0] status_set = {blob_flag, trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
                              err_pulse, lat_sat, ev_ovf, rx_ovf, flat_sat};
     assign status_o = r_status;
 
@@ -500,7 +503,7 @@ module fmt_core #(
     /* verilator lint_on PINCONNECTEMPTY */
 
     // settings the core does not use (documented in the header)
-    wire unused_ok = &{1'b0, r_scratch, r_blob_thr, tone_tw_re, tone_amp_re,
+    wire unused_ok = &{1'b0, r_scratch, tone_tw_re, tone_amp_re,
                        cal_off_re, cal_gain_re, r_threshold, r_cal_row, r_cal_col, r_limit,
                        tone_tw_wdata, tone_amp_wdata, stream_en, now, rx_fft_ovf, rx_sat,
                        r_tone_sel, blk_addr, r_max_speed};

@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0x02D9.
+// Register map id 0x5A15.
 `default_nettype none
 
 module fmt_regfile (
@@ -33,7 +33,7 @@ module fmt_regfile (
     output wire tone_amp_re_o,                      // TONE_AMP: read strobe
     input  wire [8:0] tone_amp_rdata_i,             // TONE_AMP: read data (valid while selected)
     output reg  [15:0] touch_threshold_o,           // TOUCH_THRESHOLD (rw): Coarse-touch threshold on the flattened heat map (counts); fmt_touch threshold_i
-    output reg  [1:0] touch_mode_o,                 // TOUCH_MODE (rw): Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i)
+    output reg  [2:0] touch_mode_o,                 // TOUCH_MODE (rw): Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i); bit 2: blob detection on (blob_en_i: fingers inside blobs dropped, type-3 blob events)
     output reg  [4:0] contact_limit_o,              // CONTACT_LIMIT (rw): Contact limit per frame, <= MAX_TOUCHES (limit_i)
     output reg  [15:0] track_max_jump_o,            // TRACK_MAX_JUMP (rw): Tracker L1 gate of a contact seen last frame, cells Q8
     output reg  [15:0] track_hold_jump_o,           // TRACK_HOLD_JUMP (rw): Tracker L1 gate of a contact in hold-off, cells Q8
@@ -56,7 +56,7 @@ module fmt_regfile (
     output reg  [31:0] report_period_o,             // REPORT_PERIOD (rw): Minimum processing cycles between reported frames (report_period_i; 0 = every frame; default 250 Hz)
     input  wire [31:0] frame_count_i,               // FRAME_COUNT (ro): Frames processed since reset
     input  wire [7:0] status_set_i,                 // STATUS: bits to set
-    output reg  [7:0] status_o,                     // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun
+    output reg  [7:0] status_o,                     // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, bit 7 blob overflow (more than 8 blobs in a frame)/overrun
     input  wire [15:0] ctrl_errors_i,               // CTRL_ERRORS (ro): Control-port error count, saturating (every ERROR reply and junk burst)
     input  wire [7:0] ctrl_last_err_i,              // CTRL_LAST_ERR (ro): Control-port code of the last error (docs/PROTOCOL
     input  wire [15:0] ev_drop_count_i,             // EV_DROP_COUNT (ro): Event port: frames dropped for lack of room
@@ -198,7 +198,7 @@ module fmt_regfile (
             windows_m_o <= 8'h01;
             tone_sel_o <= 5'h00;
             touch_threshold_o <= 16'h07D0;
-            touch_mode_o <= 2'h3;
+            touch_mode_o <= 3'h3;
             contact_limit_o <= 5'h10;
             track_max_jump_o <= 16'h0300;
             track_hold_jump_o <= 16'h00C0;
@@ -221,7 +221,7 @@ module fmt_regfile (
             if (wr_windows_m) windows_m_o <= reg_wdata_i[7:0];
             if (wr_tone_sel) tone_sel_o <= reg_wdata_i[4:0];
             if (wr_touch_threshold) touch_threshold_o <= reg_wdata_i[15:0];
-            if (wr_touch_mode) touch_mode_o <= reg_wdata_i[1:0];
+            if (wr_touch_mode) touch_mode_o <= reg_wdata_i[2:0];
             if (wr_contact_limit) contact_limit_o <= reg_wdata_i[4:0];
             if (wr_track_max_jump) track_max_jump_o <= reg_wdata_i[15:0];
             if (wr_track_hold_jump) track_hold_jump_o <= reg_wdata_i[15:0];
@@ -256,7 +256,7 @@ module fmt_regfile (
                 A_TONE_TW: reg_rdata_o <= tone_tw_rdata_i;
                 A_TONE_AMP: reg_rdata_o <= {23'h0, tone_amp_rdata_i};
                 A_TOUCH_THRESHOLD: reg_rdata_o <= {16'h0, touch_threshold_o};
-                A_TOUCH_MODE: reg_rdata_o <= {30'h0, touch_mode_o};
+                A_TOUCH_MODE: reg_rdata_o <= {29'h0, touch_mode_o};
                 A_CONTACT_LIMIT: reg_rdata_o <= {27'h0, contact_limit_o};
                 A_TRACK_MAX_JUMP: reg_rdata_o <= {16'h0, track_max_jump_o};
                 A_TRACK_HOLD_JUMP: reg_rdata_o <= {16'h0, track_hold_jump_o};

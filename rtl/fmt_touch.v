@@ -114,7 +114,8 @@ module fmt_touch #(
     output wire                  trk_overrun_o,      // tracker: touches while busy (sticky)
     output wire [CNT_W-1:0]      ev_drop_count_o,    // event port: frames dropped (no room)
     output wire [CNT_W-1:0]      ev_skip_count_o,    // event port: frames skipped (report rate)
-    output wire                  ev_overflow_o       // event port: a frame was dropped (sticky)
+    output wire                  ev_overflow_o,      // event port: a frame was dropped (sticky)
+    output wire                  blob_flag_o         // blobs: > MAX_BLOBS in a frame or overrun (sticky)
 );
 
     // ---- flatten ------------------------------------------------------------------
@@ -227,6 +228,7 @@ module fmt_touch #(
         .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_rd_row_i(m_rd_row),
         .mask_rd_data_o(m_data),
         .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
+    assign blob_flag_o = b_ovf_flag | b_overrun;
 
     // ---- finger removal: hold the touch beats until the mask is written --------------
     reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index

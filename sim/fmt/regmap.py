@@ -106,9 +106,11 @@ REGISTERS: list[Reg] = [
     # ---- touch processing (fmt_touch run-time inputs) ---------------------------------------
     R("TOUCH_THRESHOLD", 0x020, CFG.hm_width, "rw", SETTINGS.threshold,
       "Coarse-touch threshold on the flattened heat map (counts); fmt_touch threshold_i."),
-    R("TOUCH_MODE", 0x021, 2, "rw",
-      (1 if SETTINGS.neighbourhood == "moore" else 0) | (2 if SETTINGS.bias_correction else 0),
-      "Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i)."),
+    R("TOUCH_MODE", 0x021, 3, "rw",
+      (1 if SETTINGS.neighbourhood == "moore" else 0) | (2 if SETTINGS.bias_correction else 0)
+      | (4 if SETTINGS.blobs else 0),
+      "Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on "
+      "(bias_en_i); bit 2: blob detection on (blob_en_i: fingers inside blobs dropped, type-3 blob events)."),
     R("CONTACT_LIMIT", 0x022, _LIM_W, "rw",
       SETTINGS.max_touches if SETTINGS.max_touches is not None else CFG.max_touches,
       "Contact limit per frame, <= MAX_TOUCHES (limit_i)."),
@@ -142,7 +144,8 @@ REGISTERS: list[Reg] = [
     R("STATUS", 0x081, 8, "w1c", 0,
       "Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT "
       "overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 "
-      "control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun."),
+      "control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, "
+      "bit 7 blob overflow (more than 8 blobs in a frame)/overrun."),
     R("CTRL_ERRORS", 0x082, 16, "ro", 0, "Control-port error count, saturating (every ERROR reply and junk burst)."),
     R("CTRL_LAST_ERR", 0x083, 8, "ro", 0, "Control-port code of the last error (docs/PROTOCOL.md)."),
     R("EV_DROP_COUNT", 0x084, 16, "ro", 0, "Event port: frames dropped for lack of room."),

@@ -236,6 +236,7 @@ def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
         ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_HOLD_JUMP", tp.hold_jump_q),
         ("TRACK_HOLD_OFF", tp.hold_off_frames), ("TRACK_VEL_SHIFT", tp.vel_shift),
         ("TRACK_MAX_SPEED", tp.max_speed_v),
+        ("BLOB_THRESHOLD", settings.blob_threshold), ("BLOB_MIN_CELLS", settings.blob_min_cells),
         ("LATENCY_DIAL", 0), ("REPORT_PERIOD", 0),
     ]
 

@@ -312,6 +312,40 @@ def test_fmt_core(sim, cps):
     assert u["snap"] == exp
 
 
+def small_palm_scene(frames: int) -> _scene.Scene:
+    """The small scene's still finger plus a 14 mm palm that lands inside window 4."""
+    sc = _scene.small_scene()
+    cfg = sc.cfg
+    n, fs = cfg.n_fft, cfg.fs_hz
+    palm = _scene.Contact(name="palm", diameter_mm=14.0, path=[[0.0, 22.0, 12.0]],
+                          active=[[4 * n / fs + 30 / fs, None]])
+    return sc.replace(frames=frames, contacts=[sc.contacts[0], palm])
+
+
+def test_fmt_core_blobs(sim):
+    """TOUCH_MODE bit 2 (blobs on) through the register file: the palm's maximum is
+    dropped and blob events follow the tracker's, bit-exact with process_frames(blobs)."""
+    frames = 12
+    # threshold and size between the finger (3 cells above 3500) and the palm (8 cells)
+    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0, blobs=True,
+                       blob_threshold=3500, blob_min_cells=5)
+    scene = small_palm_scene(frames)
+    d, ref, res, rep = _run(sim, scene, 3, False, st)
+    assert rep["frames_dropped"] == 0, rep
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+    per_frame = [sorted(e.type for e in evs) for evs in ref.events]
+    n_blob = sum(t.count("blob") for t in per_frame)
+    assert n_blob >= frames - 6, f"the palm must be a blob in the later frames: {per_frame}"
+    assert all(t.count("blob") <= 1 for t in per_frame), per_frame
+    # in a frame with a blob, the palm's maximum is not a finger: only the still finger
+    # (the first ID) moves or is new there (the palm may be a finger while it lands)
+    still = ref.events[0][0].id
+    for evs in ref.events:
+        if any(e.type == "blob" for e in evs):
+            assert {e.id for e in evs if e.type in ("new", "move")} == {still}, evs
+    assert res["status"]["STATUS"] >> 7 & 1 == 0          # no blob overflow/overrun
+
+
 @pytest.mark.verilator_only
 @pytest.mark.skipif(not os.environ.get("FMT_CORE_DEFAULT"), reason="FMT_CORE_DEFAULT=1 runs it")
 def test_fmt_core_default(sim):
