@@ -96,7 +96,9 @@ REGISTERS: list[Reg] = [
     R("PN_ENABLE", 0x011, 1, "rw", 1, "1 = PN stir/unstir on (fmt_pn_gen enable_i)."),
     R("PN_CHIP_LEN", 0x012, 10, "rw", 1, "Samples per PN chip (fmt_pn_gen chip_len_i; 0 is taken as 1)."),
     R("PN_RX_DELAY", 0x013, 6, "rw", 0, "Receive PN delay in samples (fmt_pn_gen rx_delay_i)."),
-    R("WINDOWS_M", 0x014, 8, "rw", WINDOWS_M, "FFT windows accumulated per frame (M >= 1)."),
+    R("WINDOWS_M", 0x014, 8, "rw", WINDOWS_M,
+      "FFT windows accumulated per frame. The RTL takes M = the largest power of two <= this "
+      "value and <= 2^M_LOG2_MAX (8 in the default build); 0 is taken as 1."),
     R("TONE_SEL", 0x018, _ROW_W, "rw", 0, "Row selector of the tone-plan windows TONE_TW and TONE_AMP."),
     R("TONE_TW", 0x019, CFG.phase_bits, "window", 0,
       "Tuning word of row TONE_SEL (DDS phase increment; default bin k -> k << (PHASE_BITS - LOG2_N))."),
