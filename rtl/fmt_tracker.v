@@ -1,41 +1,58 @@
 // fmt_tracker -- frame matching: stable contact IDs, new / move / lift events.
 //
-// Twin: sim/fmt/tracking.py (Tracker.step), bit-exact (same events, same order).
+// Twin: sim/fmt/tracking.py (Tracker.step), bit-exact (same events, same order); the
+// cycle count of the match is modelled by tracking.lazy_greedy (see MATCH below).
 //
-// Contact table: MAX_TOUCHES slots, each with active flag, generation counter,
-// predicted position p (signed, Q.(8+VF): Q8.8 cells with VF extra fraction bits),
-// velocity v (signed V_W bits, 2^-(8+VF) cells/frame), miss counter (frames since
-// last seen) and last measured position (for the lift event).
+// Contact table: MAX_TOUCHES slots.  In flip-flops (read by all slots in parallel):
+// active flag, miss counter (frames since last seen) and the rounded prediction,
+// saturated to PR_W = 18 bits signed per axis (exact for the gate test: a prediction
+// outside [-2^16, 2^17) is more than 65535 from any x in [0, 65535], so never a
+// candidate, saturated or not) and generation counter.  In a LUT RAM (one word per
+// slot, one slot per cycle; written by NEW before it is read, so not reset): predicted
+// position p (signed, Q.(8+VF): Q8.8 cells with VF extra fraction bits), velocity v
+// (signed V_W bits, 2^-(8+VF) cells/frame) and last measured position (lift event).
 //
 // Per frame:
 //   COLLECT  touches arrive (tp_valid, any cycles).  In the cycle a touch arrives its
-//            L1 distance to the (rounded) prediction of every slot is computed in
-//            parallel, D = |x - (px + 2^(VF-1) >> VF)| + |y - ...|, and stored with a
-//            candidate bit = slot active and D <= gate (max_jump_i for a contact seen
-//            last frame, hold_jump_i for one in hold-off).  Touches beyond MAX_TOUCHES
-//            are dropped (sticky drop_flag_o).
-//   MATCH    (after tp_eof) one greedy step per 2 cycles: a min tree over the
-//            MAX_TOUCHES^2 candidate matrix (unassigned touches and slots), pipelined
-//            in two stages (per-touch minima over the slots, registered; then the
-//            minimum over the touches), picks the smallest D, ties to the smallest
-//            index t * 2^SB + s; the pair is assigned; in the next cycle a move event
-//            is issued and the slot's velocity/prediction updated:
+//            record goes to a LUT RAM and its L1 distance to the prediction of every
+//            slot is computed in parallel, D = |x - pred_x| + |y - pred_y| with
+//            pred = (p + 2^(VF-1)) >>> VF, and stored (one LUT-RAM row per touch) with
+//            a candidate bit = slot active and D <= gate (max_jump_i for a contact
+//            seen last frame, hold_jump_i for one in hold-off).  The next cycle the row
+//            is read back and one shared min tree over the slots (ties to the lower
+//            slot) caches the touch's best key (D, s) in a register.  Touches beyond
+//            MAX_TOUCHES are dropped (sticky drop_flag_o).
+//   MATCH    (after tp_eof) greedy nearest pairs, smallest (D, t, s) first -- ties to
+//            the smallest index t * 2^SB + s -- with lazily refreshed per-touch minima:
+//            a second min tree picks the smallest cached key (D_t, t) of the
+//            unassigned touches.  Cached keys only grow as slots are taken, so each is
+//            a lower bound of that touch's current key: if the picked touch's cached
+//            slot is still free the pair IS the global greedy choice and is assigned
+//            (1 cycle); otherwise (stale) the touch's row is re-read and its minimum
+//            over the free slots recomputed (1 more cycle), and the pick repeats.  The
+//            cycle after an assignment a move event is issued and the slot's
+//            velocity/prediction updated:
 //              e = (x << VF) - p;  v = clamp(v + (e >>> vel_shift_i), +-max_speed_i);
 //              p = (x << VF) + v.
-//            No candidate left -> LIFT.
+//            No candidate left -> LIFT.  Stale picks: none when every touch's nearest
+//            slot is its own; at most one per remaining touch per assignment, i.e.
+//            <= MT(MT-1)/2 = 120 at 16 slots (all touches ranking the slots alike).
 //   LIFT     one lift per cycle, lowest slot first, for each active unmatched slot
 //            with miss + 1 >= hold_off_i (the slot becomes free).
 //   NEW      one per cycle, unassigned touches in arrival order: the first free slot
 //            at or after the round-robin pointer; generation + 1; id = {gen, slot};
-//            no free slot -> the touch is dropped (sticky noslot_flag_o).
-//   UPDATE   one cycle: every active slot neither matched nor new: miss + 1, p += v.
+//            no free slot -> the touch is dropped (sticky noslot_flag_o).  The cycle
+//            that finds no touch left marks the frame's last event.
+//   UPDATE   MAX_TOUCHES cycles after the last event, one slot per cycle: every
+//            active slot neither matched nor new: miss + 1, p += v.  busy_o stays high.
 // Events leave through a one-event holding register (to mark ev_last_o).  With m
-// matches, l lifts, n news and d new touches without a free slot, the frame's last
-// event is on the output 2m + l + n + d + 6 cycles after the tp_eof cycle (tp_eof ->
-// MATCH 1, the empty MATCH step 2, empty LIFT/NEW steps 2, UPDATE and hold 1).
-// A frame with no events emits nothing.  Touches of the next frame must not arrive
-// before the tracker is idle again (overrun_flag_o; they are dropped).
-// tp_frame_i is sampled with every touch and with tp_eof (the event frame number).
+// matches, k stale picks, l lifts, n news and d new touches without a free slot, the
+// frame's last event is on the output m + 2k + l + n + d + 4 cycles after the tp_eof
+// cycle (MATCH m + 2k + 1, LIFT l + 1, NEW n + d + 1, holding register 1); one more
+// when the last touch arrives in the tp_eof cycle.  busy_o falls MAX_TOUCHES cycles
+// after the last event.  A frame with no events emits nothing.  Touches of the next
+// frame must not arrive before the tracker is idle again (overrun_flag_o; they are
+// dropped).  tp_frame_i is sampled with every touch and with tp_eof (event frame).
 //
 // Fixed-point formats: x, y, axes unsigned Q8.8 cells; gates Q8.8 (L1); p signed
 // P_W = 16 + VF + 8 bits; e >>> vel_shift is an arithmetic shift (floor); velocity
@@ -89,173 +106,167 @@ module fmt_tracker #(
     output reg                   drop_flag_o,      // a frame had more than MAX_TOUCHES touches
     output reg                   noslot_flag_o,    // a new touch found no free slot
     output reg                   overrun_flag_o,   // input while busy (dropped)
-    output wire                  busy_o            // not idle (matching / emitting)
+    output wire                  busy_o            // not idle (matching / emitting / updating)
 );
 
     // ---- sizes ----------------------------------------------------------------------
     localparam MT    = MAX_TOUCHES;
-    localparam MTP   = 1 << SB;              // slots padded to a power of two
-    localparam NL    = MTP * MTP;            // leaves of the min tree
-    localparam LW    = 2 * SB;               // leaf index width
+    localparam MTP   = 1 << SB;              // slots padded to a power of two (tree leaves)
     localparam TCW   = $clog2(MT + 1);       // touch counter width
     localparam GEN_W = ID_W - SB;            // generation bits
     localparam P_W   = 16 + VF + 8;          // prediction width (signed)
     localparam PI_W  = P_W - VF;             // integer (Q8.8) part of a prediction
+    localparam PR_W  = 18;                   // saturated rounded prediction (signed)
     localparam DW    = 16;                   // stored distance (candidates are <= 16 bits)
     localparam KW    = DW + 1;               // tree key {invalid, D}
+    localparam RW    = MT * KW;              // distance-RAM row: {cand, D} per slot
     localparam TD_W  = 16 + 16 + HM_W + 16 + 16 + 8 + 8;  // touch record width
+    localparam SD_W  = 2 * P_W + 2 * V_W + 32;            // slot record {px,py,vx,vy,lx,ly}
 
     localparam [2:0] S_IDLE = 3'd0, S_MATCH = 3'd1, S_LIFT = 3'd2, S_NEW = 3'd3, S_UPD = 3'd4;
     localparam [1:0] T_NEW = 2'd0, T_MOVE = 2'd1, T_LIFT = 2'd2;
 
     // ---- state ------------------------------------------------------------------------
-    reg [2:0]          state_q;
-    reg [FRAME_W-1:0]  frame_q;
-    reg [TCW-1:0]      tcnt_q;                    // touches stored this frame
-    reg [MT*TD_W-1:0]  touch_q;                   // touch records {x,y,str,maj,min,ang,flg}
-    reg [NL*DW-1:0]    dist_q;                    // D of leaf t*MTP+s
-    reg [NL-1:0]       cand_q;                    // candidate bit of leaf t*MTP+s
-    reg [MT-1:0]       tused_q;                   // touch assigned (matched / new / dropped)
-    reg [MT-1:0]       sused_q;                   // slot matched or newly allocated
-    reg [MT-1:0]       act_q;                     // slot active
-    reg [MT*GEN_W-1:0] gen_q;
-    reg [MT*P_W-1:0]   px_q, py_q;
-    reg [MT*V_W-1:0]   vx_q, vy_q;
-    reg [MT*HOLD_W-1:0] miss_q;
-    reg [MT*16-1:0]    lx_q, ly_q;
-    reg [SB-1:0]       next_slot_q;               // round-robin allocation pointer
-    reg                mph_q;                     // MATCH phase: 0 tree stage A, 1 stage B
+    reg [2:0]           state_q;
+    reg [FRAME_W-1:0]   frame_q;
+    reg [TCW-1:0]       tcnt_q;                   // touches stored this frame
+    reg                 st_v_q;                   // a row written last cycle: reduce it now
+    reg [SB-1:0]        st_t_q;                   // its touch index
+    reg [MT-1:0]        kv_q;                     // cached key: touch has a candidate
+    reg [MT*DW-1:0]     kd_q;                     // cached key: best D
+    reg [MT*SB-1:0]     ks_q;                     // cached key: its slot
+    reg                 rc_q;                     // recompute the row of rc_t_q this cycle
+    reg [SB-1:0]        rc_t_q;
+    reg [MT-1:0]        tused_q;                  // touch assigned (matched / new / dropped)
+    reg [MT-1:0]        sused_q;                  // slot matched or newly allocated
+    reg [MT-1:0]        act_q;                    // slot active
+    reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
+    reg [MT*PR_W-1:0]   prx_q, pry_q;             // rounded, saturated predictions
+    reg [MT*GEN_W-1:0]  gen_q;                    // generation counters
+    reg [SB-1:0]        next_slot_q;              // round-robin allocation pointer
+    reg [SB-1:0]        u_q;                      // UPDATE: slot of this cycle
+    reg                 mv_q;                     // the pair assigned last cycle: move now
+    reg [SB-1:0]        mv_s_q, mv_t_q;
     // event holding register
-    reg                pend_q;
-    reg [ID_W-1:0]     pid_q;
-    reg [1:0]          ptype_q;
-    reg [TD_W-1:0]     pdata_q;
+    reg                 pend_q;
+    reg [ID_W-1:0]      pid_q;
+    reg [1:0]           ptype_q;
+    reg [TD_W-1:0]      pdata_q;
 
     assign busy_o = (state_q != S_IDLE);
 
-    // ---- predictions and gates (combinational from the slot state) -------------------
-    reg [MT*PI_W-1:0] predx, predy;
-    reg [MT*16-1:0]   gate;
+    // ---- LUT RAMs (asynchronous read, no reset: a word is written before it is read) --
+    reg [RW-1:0]    dmem [0:MTP-1];      // distance rows, written on arrival
+    reg [TD_W-1:0]  tmem [0:MTP-1];      // touch records, written on arrival
+    reg [SD_W-1:0]  smem [0:MTP-1];      // slot records
+
+    wire            arrive = (state_q == S_IDLE) && tp_valid_i && (tcnt_q < MT);
+    wire [SB-1:0]   wa_t   = tcnt_q[SB-1:0];      // < MT when arrive
+
+    // ---- gates and distances of the arriving touch to every slot ------------------
+    reg [RW-1:0]       drow;           // {cand, D} per slot
+    reg [15:0]         gate;
+    reg signed [PR_W:0] ddx, ddy;
+    reg [PR_W:0]       dsum;
     integer s_i;
     always @* begin
         for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-            predx[s_i*PI_W +: PI_W] = pred_of(px_q[s_i*P_W +: P_W]);
-            predy[s_i*PI_W +: PI_W] = pred_of(py_q[s_i*P_W +: P_W]);
-            gate[s_i*16 +: 16] = (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}}) ? max_jump_i
-                                                                               : hold_jump_i;
+            gate = (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}}) ? max_jump_i : hold_jump_i;
+            ddx = $signed({{(PR_W-15){1'b0}}, tp_x_i}) -
+                  $signed({prx_q[s_i*PR_W+PR_W-1], prx_q[s_i*PR_W +: PR_W]});
+            ddy = $signed({{(PR_W-15){1'b0}}, tp_y_i}) -
+                  $signed({pry_q[s_i*PR_W+PR_W-1], pry_q[s_i*PR_W +: PR_W]});
+            // |ddx|, |ddy| < 2^PR_W: the sum fits PR_W + 1 bits
+            dsum = {1'b0, ddx[PR_W-1:0] ^ {PR_W{ddx[PR_W]}}} + {{PR_W{1'b0}}, ddx[PR_W]} +
+                   {1'b0, ddy[PR_W-1:0] ^ {PR_W{ddy[PR_W]}}} + {{PR_W{1'b0}}, ddy[PR_W]};
+            drow[s_i*KW +: KW] = {act_q[s_i] && (dsum <= {{(PR_W+1-16){1'b0}}, gate}),
+                                  dsum[DW-1:0]};
         end
     end
 
-    // round half up: (p + 2^(VF-1)) >>> VF
-    function [PI_W-1:0] pred_of;
-        input [P_W-1:0] p;
-        /* verilator lint_off UNUSEDSIGNAL */   // the low VF bits are the dropped fraction
-        reg   [P_W-1:0] r;
-        /* verilator lint_on UNUSEDSIGNAL */
-        begin
-            r = p + ({{(P_W-1){1'b0}}, 1'b1} << (VF - 1));
-            pred_of = r[P_W-1:VF];
-        end
-    endfunction
-
-    // ---- distances of the arriving touch to every slot ---------------------------
-    reg [MT*DW-1:0] dnew;       // saturated D per slot
-    reg [MT-1:0]    cnew;       // candidate per slot
-    reg signed [PI_W:0] ddx, ddy;
-    reg [PI_W+1:0]  dsum;
-    always @* begin
-        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-            ddx = $signed({{(PI_W-15){1'b0}}, tp_x_i}) - $signed({predx[s_i*PI_W+PI_W-1], predx[s_i*PI_W +: PI_W]});
-            ddy = $signed({{(PI_W-15){1'b0}}, tp_y_i}) - $signed({predy[s_i*PI_W+PI_W-1], predy[s_i*PI_W +: PI_W]});
-            dsum = {1'b0, (ddx < 0) ? -ddx : ddx} + {1'b0, (ddy < 0) ? -ddy : ddy};
-            cnew[s_i] = act_q[s_i] && (dsum <= {{(PI_W+2-16){1'b0}}, gate[s_i*16 +: 16]});
-            dnew[s_i*DW +: DW] = dsum[DW-1:0];
+    always @(posedge clk) begin
+        if (arrive) begin
+            dmem[wa_t] <= drow;
+            tmem[wa_t] <= {tp_x_i, tp_y_i, tp_strength_i, tp_axis_major_i, tp_axis_minor_i,
+                           tp_angle_i, tp_flags_i};
         end
     end
 
-    // ---- min tree over the candidate matrix, two pipeline stages ----------------------
-    // Leaf t*MTP+s = {invalid, D}.  Stage A (MATCH phase 0): the first SB levels reduce
-    // over s for each touch t -> per-touch minima, registered.  Stage B (MATCH phase
-    // 1): the last SB levels reduce over t.  Ties always go to the lower index, so the
-    // result is the smallest (D, t, s) -- the same as one flat tree.
-    reg [NL*KW-1:0]  tk;        // stage A keys, reduced in place
-    reg [NL*LW-1:0]  ti;        // stage A leaf indices
-    reg [MTP*KW-1:0] rk_q;      // registered per-touch minima
-    reg [MTP*LW-1:0] ri_q;
-    reg [MTP*KW-1:0] bk;        // stage B keys, reduced in place
-    reg [MTP*LW-1:0] bi;
-    reg              m_found;
-    reg [SB-1:0]     m_s;
-    reg [SB-1:0]     m_t;
+    // ---- row min tree: one touch's best free slot ---------------------------------
+    // Leaves s = {invalid, D}; node <- min(left, right), ties to the left (lower slot).
+    wire [SB-1:0]  rr_t   = st_v_q ? st_t_q : rc_t_q;   // row being reduced
+    wire [RW-1:0]  rrow   = dmem[rr_t];
+    reg [MTP*KW-1:0] rk;
+    reg [MTP*SB-1:0] ri;
+    reg              r_found;
+    reg [DW-1:0]     r_d;
+    reg [SB-1:0]     r_s;
     integer l_i, n_i, t_i;
     always @* begin
-        for (t_i = 0; t_i < MTP; t_i = t_i + 1) begin
-            for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
-                if (t_i < MT && s_i < MT) begin
-                    tk[(t_i*MTP+s_i)*KW +: KW] = {~(cand_q[t_i*MTP+s_i] & ~tused_q[t_i] & ~sused_q[s_i]),
-                                                  dist_q[(t_i*MTP+s_i)*DW +: DW]};
-                end else begin
-                    tk[(t_i*MTP+s_i)*KW +: KW] = {KW{1'b1}};
-                end
-                ti[(t_i*MTP+s_i)*LW +: LW] = {t_i[SB-1:0], s_i[SB-1:0]};
-            end
+        for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
+            if (s_i < MT)
+                rk[s_i*KW +: KW] = {~(rrow[s_i*KW+DW] & ~sused_q[s_i]), rrow[s_i*KW +: DW]};
+            else
+                rk[s_i*KW +: KW] = {KW{1'b1}};
+            ri[s_i*SB +: SB] = s_i[SB-1:0];
         end
-        // level by level: node i <- min(node 2i, node 2i+1), ties to the left (lower index)
-        for (n_i = NL / 2; n_i >= MTP; n_i = n_i / 2) begin
+        for (n_i = MTP / 2; n_i >= 1; n_i = n_i / 2) begin
             for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
-                if (tk[(2*l_i+1)*KW +: KW] < tk[(2*l_i)*KW +: KW]) begin
-                    tk[l_i*KW +: KW] = tk[(2*l_i+1)*KW +: KW];
-                    ti[l_i*LW +: LW] = ti[(2*l_i+1)*LW +: LW];
+                if (rk[(2*l_i+1)*KW +: KW] < rk[(2*l_i)*KW +: KW]) begin
+                    rk[l_i*KW +: KW] = rk[(2*l_i+1)*KW +: KW];
+                    ri[l_i*SB +: SB] = ri[(2*l_i+1)*SB +: SB];
                 end else begin
-                    tk[l_i*KW +: KW] = tk[(2*l_i)*KW +: KW];
-                    ti[l_i*LW +: LW] = ti[(2*l_i)*LW +: LW];
+                    rk[l_i*KW +: KW] = rk[(2*l_i)*KW +: KW];
+                    ri[l_i*SB +: SB] = ri[(2*l_i)*SB +: SB];
                 end
             end
         end
+        r_found = ~rk[KW-1];
+        r_d = rk[DW-1:0];
+        r_s = ri[SB-1:0];
     end
+
+    // ---- touch min tree: smallest cached key (D_t, t) of the unassigned touches -------
+    reg [MTP*KW-1:0] bk;
+    reg [MTP*SB-1:0] bi;             // touch index
+    reg [MTP*SB-1:0] bs;             // its cached slot
+    reg              m_found;
+    reg [SB-1:0]     m_t, m_s;
     always @* begin
-        bk = rk_q;
-        bi = ri_q;
+        for (t_i = 0; t_i < MTP; t_i = t_i + 1) begin
+            if (t_i < MT) begin
+                bk[t_i*KW +: KW] = {~(kv_q[t_i] & ~tused_q[t_i]), kd_q[t_i*DW +: DW]};
+                bs[t_i*SB +: SB] = ks_q[t_i*SB +: SB];
+            end else begin
+                bk[t_i*KW +: KW] = {KW{1'b1}};
+                bs[t_i*SB +: SB] = {SB{1'b0}};
+            end
+            bi[t_i*SB +: SB] = t_i[SB-1:0];
+        end
         for (n_i = MTP / 2; n_i >= 1; n_i = n_i / 2) begin
             for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
                 if (bk[(2*l_i+1)*KW +: KW] < bk[(2*l_i)*KW +: KW]) begin
                     bk[l_i*KW +: KW] = bk[(2*l_i+1)*KW +: KW];
-                    bi[l_i*LW +: LW] = bi[(2*l_i+1)*LW +: LW];
+                    bi[l_i*SB +: SB] = bi[(2*l_i+1)*SB +: SB];
+                    bs[l_i*SB +: SB] = bs[(2*l_i+1)*SB +: SB];
                 end else begin
                     bk[l_i*KW +: KW] = bk[(2*l_i)*KW +: KW];
-                    bi[l_i*LW +: LW] = bi[(2*l_i)*LW +: LW];
+                    bi[l_i*SB +: SB] = bi[(2*l_i)*SB +: SB];
+                    bs[l_i*SB +: SB] = bs[(2*l_i)*SB +: SB];
                 end
             end
         end
         m_found = ~bk[KW-1];
-        m_t = bi[LW-1:SB];
-        m_s = bi[SB-1:0];
+        m_t = bi[SB-1:0];
+        m_s = bs[SB-1:0];
     end
-
-    // ---- the matched pair's update (one shared datapath) ------------------------
-    // registered pair: the slot update and the move event happen the cycle after the
-    // tree's stage B (a MATCH phase-0 cycle), off the tree's critical path
-    reg               mv_q;
-    reg [SB-1:0]      mv_s_q, mv_t_q;
-    // Variable-index reads are written as AND-OR selects over constant slices (and the
-    // writes below as per-entry enables): a part-select at a computed offset would
-    // synthesize to a barrel shifter over the whole vector.
-    reg [TD_W-1:0]    m_touch, n_touch;
-    reg [P_W-1:0]     m_px, m_py;
-    reg [V_W-1:0]     m_vx, m_vy;
-    reg [GEN_W-1:0]   m_gen, l_gen, f_gen_old;
-    reg [15:0]        l_lx, l_ly;
-    wire [15:0]       m_x     = m_touch[TD_W-1 -: 16];
-    wire [15:0]       m_y     = m_touch[TD_W-17 -: 16];
-    wire [V_W-1:0]    m_vx_new, m_vy_new;
-    wire [P_W-1:0]    m_px_new, m_py_new;
-
-    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_velx (
-        .meas_i(m_x), .p_i(m_px), .v_i(m_vx),
-        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vx_new), .p_o(m_px_new));
-    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_vely (
-        .meas_i(m_y), .p_i(m_py), .v_i(m_vy),
-        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vy_new), .p_o(m_py_new));
+    // the picked touch's cached slot is still free (one-hot select: no barrel shifter)
+    reg m_fresh;
+    always @* begin
+        m_fresh = 1'b0;
+        for (s_i = 0; s_i < MT; s_i = s_i + 1)
+            m_fresh = m_fresh | (~sused_q[s_i] & (m_s == s_i[SB-1:0]));
+    end
 
     // ---- lifts: lowest active unmatched slot whose hold-off expires --------------
     reg [MT-1:0] lift_mask;
@@ -295,98 +306,153 @@ module fmt_tracker #(
             end
         end
     end
-    // selects of the registered pair, the lifted slot, the new touch and its slot
-    integer q_i;
+    wire [SB-1:0] f_next = ({1'b0, f_s} == MT - 1) ? {SB{1'b0}} : f_s + 1'b1;
+
+    // ---- slot RAM port (read and write at one address) and touch RAM read ------------
+    reg  [SB-1:0]    sa;             // slot of this cycle
     always @* begin
-        m_touch = {TD_W{1'b0}};
-        n_touch = {TD_W{1'b0}};
-        m_px = {P_W{1'b0}};
-        m_py = {P_W{1'b0}};
-        m_vx = {V_W{1'b0}};
-        m_vy = {V_W{1'b0}};
-        m_gen = {GEN_W{1'b0}};
-        l_gen = {GEN_W{1'b0}};
-        f_gen_old = {GEN_W{1'b0}};
-        l_lx = 16'd0;
-        l_ly = 16'd0;
-        for (q_i = 0; q_i < MT; q_i = q_i + 1) begin
-            m_touch = m_touch | (touch_q[q_i*TD_W +: TD_W] & {TD_W{mv_t_q == q_i[SB-1:0]}});
-            n_touch = n_touch | (touch_q[q_i*TD_W +: TD_W] & {TD_W{n_t == q_i[SB-1:0]}});
-            m_px  = m_px  | (px_q[q_i*P_W +: P_W] & {P_W{mv_s_q == q_i[SB-1:0]}});
-            m_py  = m_py  | (py_q[q_i*P_W +: P_W] & {P_W{mv_s_q == q_i[SB-1:0]}});
-            m_vx  = m_vx  | (vx_q[q_i*V_W +: V_W] & {V_W{mv_s_q == q_i[SB-1:0]}});
-            m_vy  = m_vy  | (vy_q[q_i*V_W +: V_W] & {V_W{mv_s_q == q_i[SB-1:0]}});
-            m_gen = m_gen | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{mv_s_q == q_i[SB-1:0]}});
-            l_gen = l_gen | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{l_s == q_i[SB-1:0]}});
-            f_gen_old = f_gen_old | (gen_q[q_i*GEN_W +: GEN_W] & {GEN_W{f_s == q_i[SB-1:0]}});
-            l_lx  = l_lx  | (lx_q[q_i*16 +: 16] & {16{l_s == q_i[SB-1:0]}});
-            l_ly  = l_ly  | (ly_q[q_i*16 +: 16] & {16{l_s == q_i[SB-1:0]}});
+        case (state_q)
+            S_MATCH: sa = mv_s_q;
+            S_LIFT:  sa = l_s;
+            S_NEW:   sa = f_s;
+            S_UPD:   sa = u_q;
+            default: sa = mv_s_q;
+        endcase
+    end
+    wire [SD_W-1:0]  srec  = smem[sa];
+    wire [P_W-1:0]   s_px  = srec[SD_W-1 -: P_W];
+    wire [P_W-1:0]   s_py  = srec[SD_W-P_W-1 -: P_W];
+    wire [V_W-1:0]   s_vx  = srec[SD_W-2*P_W-1 -: V_W];
+    wire [V_W-1:0]   s_vy  = srec[SD_W-2*P_W-V_W-1 -: V_W];
+    wire [15:0]      s_lx  = srec[31:16];
+    wire [15:0]      s_ly  = srec[15:0];
+    reg  [GEN_W-1:0] s_gen;          // generation of slot sa (one-hot select)
+    always @* begin
+        s_gen = {GEN_W{1'b0}};
+        for (s_i = 0; s_i < MT; s_i = s_i + 1)
+            s_gen = s_gen | (gen_q[s_i*GEN_W +: GEN_W] & {GEN_W{sa == s_i[SB-1:0]}});
+    end
+    wire [GEN_W-1:0] f_gen = s_gen + 1'b1;
+
+    wire [SB-1:0]    ta    = (state_q == S_NEW) ? n_t : mv_t_q;
+    wire [TD_W-1:0]  trec  = tmem[ta];
+    wire [15:0]      t_x   = trec[TD_W-1 -: 16];
+    wire [15:0]      t_y   = trec[TD_W-17 -: 16];
+
+    // matched pair: velocity / prediction update
+    wire [V_W-1:0]   m_vx_new, m_vy_new;
+    wire [P_W-1:0]   m_px_new, m_py_new;
+    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_velx (
+        .meas_i(t_x), .p_i(s_px), .v_i(s_vx),
+        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vx_new), .p_o(m_px_new));
+    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_vely (
+        .meas_i(t_y), .p_i(s_py), .v_i(s_vy),
+        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vy_new), .p_o(m_py_new));
+    // unmatched slot in hold-off: p + v
+    wire [P_W-1:0]   u_px  = s_px + {{(P_W-V_W){s_vx[V_W-1]}}, s_vx};
+    wire [P_W-1:0]   u_py  = s_py + {{(P_W-V_W){s_vy[V_W-1]}}, s_vy};
+    wire             u_en  = (state_q == S_UPD) && act_q[u_q] && !sused_q[u_q];
+    wire             n_en  = (state_q == S_NEW) && n_found && f_found;
+
+    // slot write: move (mv_q, in MATCH), new, update
+    reg              s_we;
+    reg [SD_W-1:0]   s_wd;
+    reg [P_W-1:0]    w_px, w_py;     // the written p: rounded into the prediction registers
+    always @* begin
+        s_we = 1'b0;
+        w_px = u_px;
+        w_py = u_py;
+        s_wd = {u_px, u_py, s_vx, s_vy, s_lx, s_ly};
+        if (state_q == S_MATCH) begin
+            s_we = mv_q;
+            w_px = m_px_new;
+            w_py = m_py_new;
+            s_wd = {m_px_new, m_py_new, m_vx_new, m_vy_new, t_x, t_y};
+        end else if (state_q == S_NEW) begin
+            s_we = n_en;
+            w_px = {{(P_W-16-VF){1'b0}}, t_x, {VF{1'b0}}};
+            w_py = {{(P_W-16-VF){1'b0}}, t_y, {VF{1'b0}}};
+            s_wd = {w_px, w_py, {(2*V_W){1'b0}}, t_x, t_y};
+        end else if (state_q == S_UPD) begin
+            s_we = u_en;
         end
     end
-    wire [GEN_W-1:0] f_gen   = f_gen_old + 1'b1;
-    wire [SB-1:0]    f_next  = ({1'b0, f_s} == MT - 1) ? {SB{1'b0}} : f_s + 1'b1;
+    always @(posedge clk) begin
+        if (s_we) smem[sa] <= s_wd;
+    end
 
-    // ---- the sequencer ------------------------------------------------------------
+    // round half up, (p + 2^(VF-1)) >>> VF, then saturate to PR_W bits
+    function [PR_W-1:0] pred_of;
+        input [P_W-1:0] p;
+        /* verilator lint_off UNUSEDSIGNAL */   // the low VF bits are the dropped fraction
+        reg   [P_W-1:0] r;
+        /* verilator lint_on UNUSEDSIGNAL */
+        begin
+            r = p + ({{(P_W-1){1'b0}}, 1'b1} << (VF - 1));
+            if (r[P_W-1:VF+PR_W-1] == {(PI_W-PR_W+1){1'b0}} ||
+                r[P_W-1:VF+PR_W-1] == {(PI_W-PR_W+1){1'b1}})
+                pred_of = r[VF+PR_W-1:VF];
+            else if (r[P_W-1])
+                pred_of = {1'b1, {(PR_W-1){1'b0}}};
+            else
+                pred_of = {1'b0, {(PR_W-1){1'b1}}};
+        end
+    endfunction
+    wire [PR_W-1:0]  w_prx = pred_of(w_px);
+    wire [PR_W-1:0]  w_pry = pred_of(w_py);
+    // the slot's miss counter: 0 on move / new, + 1 on update (shared incrementer)
+    reg [HOLD_W-1:0] u_miss;
+    always @* begin
+        u_miss = {HOLD_W{1'b0}};
+        for (s_i = 0; s_i < MT; s_i = s_i + 1)
+            u_miss = u_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{u_q == s_i[SB-1:0]}});
+    end
+    wire [HOLD_W-1:0] w_miss = (state_q == S_UPD) ? u_miss + 1'b1 : {HOLD_W{1'b0}};
+
+    // ---- events ---------------------------------------------------------------------
     reg              gen_ev;           // an event is formed this cycle
-    reg [ID_W-1:0]   gen_id;
     reg [1:0]        gen_type;
-    reg [TD_W-1:0]   gen_data;
     always @* begin
         gen_ev = 1'b0;
-        gen_id = {ID_W{1'b0}};
         gen_type = T_MOVE;
-        gen_data = {TD_W{1'b0}};
         case (state_q)
-            S_MATCH: if (mv_q) begin
-                gen_ev = 1'b1;
-                gen_id = {m_gen, mv_s_q};
-                gen_type = T_MOVE;
-                gen_data = m_touch;
-            end
-            S_LIFT: if (l_found) begin
-                gen_ev = 1'b1;
-                gen_id = {l_gen, l_s};
-                gen_type = T_LIFT;
-                gen_data = {l_lx, l_ly, {(TD_W-32){1'b0}}};
-            end
-            S_NEW: if (n_found && f_found) begin
-                gen_ev = 1'b1;
-                gen_id = {f_gen, f_s};
-                gen_type = T_NEW;
-                gen_data = n_touch;
-            end
+            S_MATCH: gen_ev = mv_q;
+            S_LIFT:  begin gen_ev = l_found;  gen_type = T_LIFT; end
+            S_NEW:   begin gen_ev = n_en;     gen_type = T_NEW;  end
             default: ;
         endcase
     end
+    wire [ID_W-1:0] gen_id   = {(state_q == S_NEW) ? f_gen : s_gen, sa};
+    wire [TD_W-1:0] gen_data = (state_q == S_LIFT) ? {s_lx, s_ly, {(TD_W-32){1'b0}}} : trec;
+    wire            frame_done = (state_q == S_NEW) && !n_found;
 
-    wire frame_done = (state_q == S_UPD);
+    // the cached key written this cycle: the row read on arrival or recomputed
+    wire k_we = st_v_q | rc_q;
 
     always @(posedge clk) begin
         if (rst) begin
             state_q        <= S_IDLE;
             frame_q        <= {FRAME_W{1'b0}};
             tcnt_q         <= {TCW{1'b0}};
-            touch_q        <= {(MT*TD_W){1'b0}};
-            dist_q         <= {(NL*DW){1'b0}};
-            cand_q         <= {NL{1'b0}};
+            st_v_q         <= 1'b0;
+            st_t_q         <= {SB{1'b0}};
+            kv_q           <= {MT{1'b0}};
+            kd_q           <= {(MT*DW){1'b0}};
+            ks_q           <= {(MT*SB){1'b0}};
+            rc_q           <= 1'b0;
+            rc_t_q         <= {SB{1'b0}};
             tused_q        <= {MT{1'b0}};
             sused_q        <= {MT{1'b0}};
             act_q          <= {MT{1'b0}};
-            gen_q          <= {(MT*GEN_W){1'b0}};
-            px_q           <= {(MT*P_W){1'b0}};
-            py_q           <= {(MT*P_W){1'b0}};
-            vx_q           <= {(MT*V_W){1'b0}};
-            vy_q           <= {(MT*V_W){1'b0}};
             miss_q         <= {(MT*HOLD_W){1'b0}};
-            lx_q           <= {(MT*16){1'b0}};
-            ly_q           <= {(MT*16){1'b0}};
+            prx_q          <= {(MT*PR_W){1'b0}};
+            pry_q          <= {(MT*PR_W){1'b0}};
+            gen_q          <= {(MT*GEN_W){1'b0}};
             next_slot_q    <= {SB{1'b0}};
-            mph_q          <= 1'b0;
+            u_q            <= {SB{1'b0}};
             mv_q           <= 1'b0;
             mv_s_q         <= {SB{1'b0}};
             mv_t_q         <= {SB{1'b0}};
-            rk_q           <= {(MTP*KW){1'b1}};
-            ri_q           <= {(MTP*LW){1'b0}};
             pend_q         <= 1'b0;
             pid_q          <= {ID_W{1'b0}};
             ptype_q        <= 2'd0;
@@ -408,24 +474,13 @@ module fmt_tracker #(
             overrun_flag_o <= 1'b0;
         end else begin
             // ---- input side --------------------------------------------------------
+            st_v_q <= arrive;
+            st_t_q <= wa_t;
             if (state_q == S_IDLE) begin
                 if (tp_valid_i) begin
                     frame_q <= tp_frame_i;
-                    if (tcnt_q < MT) begin
-                        for (t_i = 0; t_i < MT; t_i = t_i + 1) begin
-                            if (tcnt_q == t_i[TCW-1:0]) begin
-                                touch_q[t_i*TD_W +: TD_W] <= {tp_x_i, tp_y_i, tp_strength_i,
-                                    tp_axis_major_i, tp_axis_minor_i, tp_angle_i, tp_flags_i};
-                                for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                                    dist_q[(t_i*MTP+s_i)*DW +: DW] <= dnew[s_i*DW +: DW];
-                                    cand_q[t_i*MTP+s_i] <= cnew[s_i];
-                                end
-                            end
-                        end
-                        tcnt_q <= tcnt_q + 1'b1;
-                    end else begin
-                        drop_flag_o <= 1'b1;
-                    end
+                    if (tcnt_q < MT) tcnt_q <= tcnt_q + 1'b1;
+                    else             drop_flag_o <= 1'b1;
                 end
                 if (tp_eof_i) begin
                     frame_q <= tp_frame_i;
@@ -435,35 +490,42 @@ module fmt_tracker #(
                 overrun_flag_o <= 1'b1;
             end
 
-            // ---- the matched pair's slot update (one cycle after stage B) --------------
-            mv_q <= 1'b0;
+            // ---- cached per-touch minima -------------------------------------------
+            for (t_i = 0; t_i < MT; t_i = t_i + 1) begin
+                if (k_we && rr_t == t_i[SB-1:0]) begin
+                    kv_q[t_i] <= r_found;
+                    kd_q[t_i*DW +: DW] <= r_d;
+                    ks_q[t_i*SB +: SB] <= r_s;
+                end
+            end
+
+            // ---- slot registers written with the slot RAM ------------------------------
             for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                if (mv_q && mv_s_q == s_i[SB-1:0]) begin
-                    vx_q[s_i*V_W +: V_W] <= m_vx_new;
-                    vy_q[s_i*V_W +: V_W] <= m_vy_new;
-                    px_q[s_i*P_W +: P_W] <= m_px_new;
-                    py_q[s_i*P_W +: P_W] <= m_py_new;
-                    miss_q[s_i*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
-                    lx_q[s_i*16 +: 16] <= m_x;
-                    ly_q[s_i*16 +: 16] <= m_y;
+                if (s_we && sa == s_i[SB-1:0]) begin
+                    miss_q[s_i*HOLD_W +: HOLD_W] <= w_miss;
+                    prx_q[s_i*PR_W +: PR_W] <= w_prx;
+                    pry_q[s_i*PR_W +: PR_W] <= w_pry;
                 end
             end
 
             // ---- matching / lifts / news / update -------------------------------------
+            mv_q <= 1'b0;
+            rc_q <= 1'b0;
             case (state_q)
                 S_MATCH: begin
-                    mph_q <= ~mph_q;
-                    if (!mph_q) begin
-                        rk_q <= tk[MTP*KW-1:0];
-                        ri_q <= ti[MTP*LW-1:0];
-                    end else if (m_found) begin
+                    if (st_v_q || rc_q) begin
+                        // a cached key is being written this cycle: pick next cycle
+                    end else if (!m_found) begin
+                        state_q <= S_LIFT;
+                    end else if (m_fresh) begin
                         tused_q[m_t] <= 1'b1;
                         sused_q[m_s] <= 1'b1;
                         mv_q   <= 1'b1;
                         mv_s_q <= m_s;
                         mv_t_q <= m_t;
                     end else begin
-                        state_q <= S_LIFT;
+                        rc_q   <= 1'b1;           // stale: recompute this touch's minimum
+                        rc_t_q <= m_t;
                     end
                 end
                 S_LIFT: begin
@@ -474,43 +536,28 @@ module fmt_tracker #(
                     if (n_found) begin
                         tused_q[n_t] <= 1'b1;
                         if (f_found) begin
-                            act_q[f_s]  <= 1'b1;
+                            act_q[f_s]   <= 1'b1;
+                            for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                                if (f_s == s_i[SB-1:0]) gen_q[s_i*GEN_W +: GEN_W] <= f_gen;
                             sused_q[f_s] <= 1'b1;
-                            for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                                if (f_s == s_i[SB-1:0]) begin
-                                    gen_q[s_i*GEN_W +: GEN_W] <= f_gen;
-                                    px_q[s_i*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-1 -: 16], {VF{1'b0}}};
-                                    py_q[s_i*P_W +: P_W] <= {{(P_W-16-VF){1'b0}}, n_touch[TD_W-17 -: 16], {VF{1'b0}}};
-                                    vx_q[s_i*V_W +: V_W] <= {V_W{1'b0}};
-                                    vy_q[s_i*V_W +: V_W] <= {V_W{1'b0}};
-                                    miss_q[s_i*HOLD_W +: HOLD_W] <= {HOLD_W{1'b0}};
-                                    lx_q[s_i*16 +: 16] <= n_touch[TD_W-1 -: 16];
-                                    ly_q[s_i*16 +: 16] <= n_touch[TD_W-17 -: 16];
-                                end
-                            end
-                            next_slot_q <= f_next;
+                            next_slot_q  <= f_next;
                         end else begin
                             noslot_flag_o <= 1'b1;
                         end
                     end else begin
                         state_q <= S_UPD;
+                        u_q     <= {SB{1'b0}};
                     end
                 end
                 S_UPD: begin
-                    for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                        if (act_q[s_i] && !sused_q[s_i]) begin
-                            miss_q[s_i*HOLD_W +: HOLD_W] <= miss_q[s_i*HOLD_W +: HOLD_W] + 1'b1;
-                            px_q[s_i*P_W +: P_W] <= px_q[s_i*P_W +: P_W] +
-                                {{(P_W-V_W){vx_q[s_i*V_W+V_W-1]}}, vx_q[s_i*V_W +: V_W]};
-                            py_q[s_i*P_W +: P_W] <= py_q[s_i*P_W +: P_W] +
-                                {{(P_W-V_W){vy_q[s_i*V_W+V_W-1]}}, vy_q[s_i*V_W +: V_W]};
-                        end
+                    u_q <= u_q + 1'b1;
+                    if ({1'b0, u_q} == MT - 1) begin
+                        tcnt_q  <= {TCW{1'b0}};
+                        tused_q <= {MT{1'b0}};
+                        sused_q <= {MT{1'b0}};
+                        kv_q    <= {MT{1'b0}};
+                        state_q <= S_IDLE;
                     end
-                    tcnt_q  <= {TCW{1'b0}};
-                    tused_q <= {MT{1'b0}};
-                    sused_q <= {MT{1'b0}};
-                    cand_q  <= {NL{1'b0}};
-                    state_q <= S_IDLE;
                 end
                 default: ;
             endcase

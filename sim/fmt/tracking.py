@@ -53,6 +53,7 @@ from .params import SensorConfig
 from .settings import TouchSettings
 
 EV_NEW, EV_MOVE, EV_LIFT, EV_BLOB = 0, 1, 2, 3
+NO_CAND = np.iinfo(np.int64).max        # distance of a pair that is not a candidate
 EV_TYPES = ("new", "move", "lift", "blob")
 EV_CODE = {n: i for i, n in enumerate(EV_TYPES)}
 
@@ -191,21 +192,12 @@ class Tracker:
         nt = len(touches)
         sl = self.slots
         events: list[TouchEvent] = []
-        # 1-2. predictions and the distance matrix, shape (touch, slot)
-        half = 1 << (vf - 1)
-        predx = np.array([(s.px + half) >> vf for s in sl], dtype=np.int64)
-        predy = np.array([(s.py + half) >> vf for s in sl], dtype=np.int64)
-        act = np.array([s.active for s in sl], dtype=bool)
-        gate = np.array([p.max_jump_q if s.miss == 0 else p.hold_jump_q for s in sl],
-                        dtype=np.int64)
         matched_touch = [-1] * n          # slot -> touch
         t_used = np.zeros(nt, dtype=bool)
         if nt:
-            tx = np.array([t.x_q for t in touches], dtype=np.int64)
-            ty = np.array([t.y_q for t in touches], dtype=np.int64)
-            d = np.abs(tx[:, None] - predx[None, :]) + np.abs(ty[:, None] - predy[None, :])
-            big = np.iinfo(np.int64).max
-            dm = np.where(act[None, :] & (d <= gate[None, :]), d, big)
+            # 1-2. predictions and the distance matrix, shape (touch, slot)
+            dm = self.candidates(touches)
+            big = NO_CAND
             # 3. greedy global nearest pairs (argmin = lowest flat index t*n+s on ties)
             while True:
                 k = int(np.argmin(dm))
@@ -265,6 +257,25 @@ class Tracker:
                                      tt.angle, tt.flags))
         return events
 
+    def candidates(self, touches) -> np.ndarray:
+        """Steps 1-2 of :meth:`step` for this frame's touches (the first max_touches) and
+        the current slot state: the L1 distance matrix, shape (touch, slot), with
+        ``NO_CAND`` where the pair is not a candidate.  Does not change the state."""
+        p = self.p
+        vf = p.vel_frac
+        sl = self.slots
+        touches = [as_touch(t) for t in touches][:p.max_touches]
+        half = 1 << (vf - 1)
+        predx = np.array([(s.px + half) >> vf for s in sl], dtype=np.int64)
+        predy = np.array([(s.py + half) >> vf for s in sl], dtype=np.int64)
+        act = np.array([s.active for s in sl], dtype=bool)
+        gate = np.array([p.max_jump_q if s.miss == 0 else p.hold_jump_q for s in sl],
+                        dtype=np.int64)
+        tx = np.array([t.x_q for t in touches], dtype=np.int64)
+        ty = np.array([t.y_q for t in touches], dtype=np.int64)
+        d = np.abs(tx[:, None] - predx[None, :]) + np.abs(ty[:, None] - predy[None, :])
+        return np.where(act[None, :] & (d <= gate[None, :]), d, NO_CAND)
+
     def _alloc(self) -> int:
         n = self.p.max_touches
         for k in range(n):
@@ -273,6 +284,56 @@ class Tracker:
                 self.next_slot = (s + 1) % n
                 return s
         return -1
+
+
+def lazy_greedy(dm: np.ndarray) -> tuple[list[tuple[int, int]], int]:
+    """The match order of the RTL (rtl/fmt_tracker.v, MATCH) and its cost.
+
+    ``dm``: candidate distances (touch, slot), ``NO_CAND`` where not a candidate (from
+    :meth:`Tracker.candidates`).  Each touch caches its best key (D, s) over the free
+    slots (ties to the lower slot); a pick takes the smallest cached (D, t); if its slot
+    is still free the pair is assigned, else the pick was stale and the touch's key is
+    recomputed over the free slots.  Cached keys are lower bounds of the current keys,
+    so the pairs are exactly the greedy order of :meth:`Tracker.step` (smallest
+    (D, t, s) first).  Returns (pairs in assignment order, number of stale picks);
+    the RTL spends 1 cycle per assignment and 2 per stale pick."""
+    nt, ns = dm.shape
+    free = np.ones(ns, dtype=bool)
+    used = np.zeros(nt, dtype=bool)
+
+    def row_min(t):
+        row = np.where(free, dm[t], NO_CAND)
+        s = int(np.argmin(row))
+        return int(row[s]), s
+
+    cache = [row_min(t) for t in range(nt)]
+    pairs, stale = [], 0
+    while True:
+        best = -1
+        for t in range(nt):
+            if not used[t] and cache[t][0] != NO_CAND and (best < 0 or cache[t][0] < cache[best][0]):
+                best = t
+        if best < 0:
+            return pairs, stale
+        s = cache[best][1]
+        if free[s]:
+            pairs.append((best, s))
+            used[best] = True
+            free[s] = False
+        else:
+            stale += 1
+            cache[best] = row_min(best)
+
+
+def tail_cycles(events, stale: int, no_slot: int) -> int:
+    """RTL timing: tp_eof high in cycle c -> the frame's last event valid in cycle c + lat
+    (a plain register would be lat = 1), for a frame with these events (m moves, l
+    lifts, n news), ``stale`` stale picks (:func:`lazy_greedy`) and ``no_slot`` new
+    touches without a free slot: MATCH m + 2 stale + 1, LIFT l + 1, NEW n + no_slot + 1,
+    holding register 1.  Touches end before the tp_eof cycle (one more cycle if the
+    last touch comes with tp_eof).  The tracker stays busy max_touches cycles longer
+    (UPDATE).  Before the lazy minima the RTL took 2m + l + n + no_slot + 6."""
+    return len(events) + 2 * stale + no_slot + 4
 
 
 def track(touch_frames, params: TrackParams, first_frame: int = 0, tracker: Tracker | None = None):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
 import pytest
 
 from fmt import params
@@ -278,3 +279,49 @@ def test_greedy_global_order_and_tiebreak():
     track([[Touch(1000, 1000), Touch(1200, 1000)]], p, tracker=tr)
     out = track([[Touch(1100, 1000), Touch(1300, 1000)]], p, tracker=tr)[0]
     assert [(e.id, e.x_q) for e in out] == [(tr.slot_id(0), 1100), (tr.slot_id(1), 1300)]
+
+
+def flat_greedy(dm):
+    """Greedy nearest pairs by the flat argmin over the whole matrix (Tracker.step)."""
+    from fmt.tracking import NO_CAND
+    dm = dm.copy()
+    n = dm.shape[1]
+    pairs = []
+    while dm.size and dm.min() != NO_CAND:
+        t, s = divmod(int(np.argmin(dm)), n)
+        pairs.append((t, s))
+        dm[t, :] = NO_CAND
+        dm[:, s] = NO_CAND
+    return pairs
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_lazy_greedy_is_greedy(seed):
+    """The RTL's lazily refreshed per-touch minima pick exactly the flat greedy pairs,
+    in the same order, including ties (small distance ranges force many)."""
+    from fmt.tracking import NO_CAND, lazy_greedy
+    rng = np.random.default_rng(seed)
+    stale_seen = 0
+    for _ in range(400):
+        nt, ns = int(rng.integers(0, 17)), int(rng.integers(1, 17))
+        dm = rng.integers(0, int(rng.choice([3, 20, 65536])), size=(nt, ns)).astype(np.int64)
+        dm[rng.random((nt, ns)) < rng.random()] = NO_CAND
+        pairs, stale = lazy_greedy(dm)
+        assert pairs == flat_greedy(dm)
+        assert stale <= nt * (nt - 1) // 2     # once per remaining touch per assignment
+        stale_seen += stale
+    assert stale_seen > 0
+
+
+def test_lazy_greedy_worst_case():
+    """All touches ranking the slots alike: every remaining touch goes stale after each
+    assignment, 15 + 14 + ... + 1 = 120 stale picks at 16 x 16."""
+    from fmt.tracking import lazy_greedy
+    n = 16
+    dm = np.array([[100 * s + t for s in range(n)] for t in range(n)], dtype=np.int64)
+    pairs, stale = lazy_greedy(dm)
+    assert pairs == [(t, t) for t in range(n)]
+    assert stale == n * (n - 1) // 2
+    # spread fingers, each nearest its own slot: no stale pick
+    dm = np.array([[abs(s - t) * 500 + 3 for s in range(n)] for t in range(n)], dtype=np.int64)
+    assert lazy_greedy(dm)[1] == 0

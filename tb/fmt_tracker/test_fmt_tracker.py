@@ -6,8 +6,12 @@ vanish and flicker, random order, more than MAX_TOUCHES touches, random settings
 scripted scenarios on a scaled timeline (drumroll, merge/split, fast crossing,
 flicker, hold-off expiry, 17 touches with 16 slots), plus a reset in the middle of a
 frame.  Also measures and checks the tail latency: the frame's last event is on the
-output exactly n_events + n_moves + n_noslot + 6 cycles after the tp_eof cycle
-(n_noslot = new touches dropped for want of a slot, one cycle each).
+output exactly fmt.tracking.tail_cycles cycles after the tp_eof cycle,
+n_events + 2 n_stale + n_noslot + 4 (n_stale = stale picks of the lazy match, counted
+by fmt.tracking.lazy_greedy on the model's candidate matrix; n_noslot = new touches
+dropped for want of a slot, one cycle each), and that busy_o falls MAX_TOUCHES cycles
+(the slot update) after that.  The worst case of the match (all touches ranking the
+slots alike, 120 stale picks at 16) is a test of its own.
 """
 from __future__ import annotations
 
@@ -22,9 +26,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.tracking import EV_TYPES, Touch, Tracker, TrackParams
-
-TAIL_FIXED = 6
+from fmt.tracking import Touch, Tracker, TrackParams, lazy_greedy, tail_cycles
 
 
 class TB(ClockedTB):
@@ -35,6 +37,8 @@ class TB(ClockedTB):
         self.cycle = 0
         self.events = []          # (cycle, tuple)
         self.eof_cycles = []
+        self.stale_total = 0      # stale picks of the lazy match (model count)
+        self.idle_cycle = 0
         self.idle()
         cocotb.start_soon(self._count())
         cocotb.start_soon(self._monitor())
@@ -111,6 +115,7 @@ class TB(ClockedTB):
             await ReadOnly()
             if int(d.busy_o.value) == 0:
                 break
+        self.idle_cycle = self.cycle   # first cycle with busy_o low
         await RisingEdge(self.clk)
         await RisingEdge(self.clk)
         return eof
@@ -131,6 +136,7 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
         eof = await tb.send_frame(fr, touches, rng)
         got = tb.events[n0:]
         ns0 = model.stats.no_slot
+        _, stale = lazy_greedy(model.candidates(touches)) if touches else ([], 0)
         exp = model.step(fr, touches)
         noslot = model.stats.no_slot - ns0
         g = [x[1] for x in got]
@@ -141,10 +147,12 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
             # cycle c + lat (a plain register would be lat = 1)
             lat = got[-1][0] - eof + 1
-            moves = sum(1 for x in exp if x.type == "move")
-            assert lat == len(got) + moves + noslot + TAIL_FIXED, \
-                f"tail latency {lat} for {len(got)} events ({moves} moves)"
-            tail.append((len(got), lat))
+            assert lat == tail_cycles(exp, stale, noslot), \
+                f"tail latency {lat} for {len(got)} events, {stale} stale picks"
+            # the slot update: busy_o low MAX_TOUCHES cycles after the last event
+            assert tb.idle_cycle - got[-1][0] == tb.mt, "busy after the last event"
+            tail.append((len(got), stale, lat))
+        tb.stale_total += stale
     return model, tail
 
 
@@ -192,8 +200,9 @@ async def random_streams(dut):
                 ts = []
             frames.append(ts)
         _, tail = await run_frames(tb, p, frames, rng, start_frame=rng.randrange(1 << 16))
-        dut._log.info(f"trial {trial}: tail latency (events, cycles) max "
-                      f"{max(tail) if tail else None}")
+        dut._log.info(f"trial {trial}: tail latency (events, stale picks, cycles) max "
+                      f"{max(tail, key=lambda x: x[2]) if tail else None}")
+    dut._log.info(f"stale picks in all trials: {tb.stale_total}")
 
 
 def two_finger_frames(pa, pb, merge_q, merged_at="mid"):
@@ -273,6 +282,31 @@ async def over_limit_touches(dut):
     assert int(dut.drop_flag_o.value) == 1
     assert int(dut.noslot_flag_o.value) == 1
     assert int(dut.overrun_flag_o.value) == 0
+
+
+@cocotb.test()
+async def match_timing(dut):
+    """Tail latency of 1, 3 and MAX_TOUCHES spread moving fingers (no stale pick), and
+    the worst case of the lazy match: every touch ranks the slots alike (slots on a
+    line, all touches left of it), MT(MT-1)/2 stale picks."""
+    tb = TB(dut)
+    mt = tb.mt
+    p = TrackParams(max_jump_q=0xFFFF, hold_jump_q=0xFFFF, hold_off_frames=2, vel_shift=3,
+                    max_touches=mt)
+    tb.set_params(p)
+    for n in sorted({1, min(3, mt), mt}):
+        await tb.reset()
+        frames = [[Touch(q(10 + 12 * (i % 8)) + 40 * k, q(10 + 12 * (i // 8)) + 25 * k, 900 + i)
+                   for i in range(n)] for k in range(4)]
+        _, tail = await run_frames(tb, p, frames)
+        dut._log.info(f"{n} spread fingers: (events, stale picks, tail cycles) {tail}")
+        assert all(st == 0 for _, st, _ in tail[1:])
+    await tb.reset()
+    slots = [Touch(1000 + 300 * s, 2000, 100 + s) for s in range(mt)]
+    worst = [Touch(999 - t, 2000, 500 + t) for t in range(mt)]
+    _, tail = await run_frames(tb, p, [slots, worst])
+    dut._log.info(f"worst case: (events, stale picks, tail cycles) {tail}")
+    assert tail[1][1] == mt * (mt - 1) // 2
 
 
 @cocotb.test()
