@@ -445,6 +445,113 @@ def build_args(sim: str, fast_sim: bool = True) -> list:
     return args
 
 
+# ---- the standalone C++ harness (tb/fmt_core/sim_main.cpp) -------------------------------
+HARNESS_SRC = ROOT / "tb" / "fmt_core" / "sim_main.cpp"
+HARNESS_CFLAGS = "-O2"
+STATUS_REGS = ("FRAME_COUNT", "STATUS", "EV_DROP_COUNT", "EV_SKIP_COUNT", "FLAT_SAT_COUNT",
+               "LM_DROP_COUNT", "LAT_FIRST_MIN", "LAT_FIRST_MAX", "LAT_FIRST_COUNT",
+               "LAT_LAST_MIN", "LAT_LAST_MAX", "LAT_LAST_COUNT")
+
+
+def harness_dir(cfg, cps: int, tag: str = "") -> Path:
+    return ROOT / "build" / "sim_cpp" / f"{cfg.name}_c{cps}{'_' + tag if tag else ''}"
+
+
+def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAGS) -> list:
+    """Verilator command line of the harness build: fast model (-O3, x fast, no
+    assertions, no tracing, one thread), fmt_core_sim_top with EXT_CHANNEL = 1 (the
+    channel in C++), the log files of the job folder ``d`` (Verilog parameters)."""
+    p = sim_parameters(cfg, cps, d)
+    for k in ("NOISE_FILE", "UPD_FILE"):
+        p.pop(k)                                   # the C++ channel reads them (job file)
+    p["NOISE_LEN"] = 1
+    p["UPD_LEN"] = 1
+    p["EXT_CHANNEL"] = 1
+    args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
+            "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "--output-split", "0",
+            "--top-module", "fmt_core_sim_top", "-Mdir", str(bdir), "-o", "Vfmt_core_sim_top",
+            f"-I{ROOT / 'rtl'}", f'-DFMT_ROM_DIR="{ROOT / "rtl"}/"',
+            "-CFLAGS", cflags, "-MAKEFLAGS", "--no-print-directory"]
+    args += [f"-G{k}={v}" for k, v in p.items()]
+    return args + [str(s) for s in sim_sources()] + [str(HARNESS_SRC)]
+
+
+def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_CFLAGS,
+                  quiet: bool = False) -> tuple[Path, float]:
+    """Build (or reuse) the harness executable; rebuilt only when a source file, the
+    command line or the Verilator version changed.  Returns (executable, build seconds)."""
+    import hashlib
+    import shutil
+    import subprocess
+    bdir = harness_dir(cfg, cps, tag)
+    exe = bdir / "Vfmt_core_sim_top"
+    args = harness_args(cfg, cps, d, bdir, cflags)
+    verilator = shutil.which("verilator")
+    if verilator is None:
+        raise RuntimeError("verilator not on PATH (source scripts/env.sh)")
+    h = hashlib.sha1(json.dumps(args).encode())
+    h.update(subprocess.run([verilator, "--version"], capture_output=True, text=True).stdout.encode())
+    for s in sim_sources() + [HARNESS_SRC, ROOT / "rtl" / "fmt_defaults.vh"]:
+        h.update(Path(s).read_bytes())
+    for s in sorted((ROOT / "rtl").glob("*.vh")) + sorted((ROOT / "rtl").glob("*.hex")):
+        h.update(s.name.encode() + Path(s).read_bytes())
+    key = h.hexdigest()
+    stamp = bdir / "build.key"
+    if exe.exists() and stamp.exists() and stamp.read_text() == key:
+        return exe, 0.0
+    if bdir.exists():
+        shutil.rmtree(bdir)
+    bdir.mkdir(parents=True)
+    env = dict(os.environ)
+    if "OBJCACHE" not in env and shutil.which("ccache"):
+        env["OBJCACHE"] = "ccache"
+    if not quiet:
+        print(f"building the Verilator harness in {bdir} (full size: minutes) ...", file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    r = subprocess.run([verilator] + args, cwd=bdir, env=env, capture_output=True, text=True)
+    (bdir / "build.log").write_text(r.stdout + r.stderr)
+    if r.returncode != 0 or not exe.exists():
+        raise RuntimeError(f"harness build failed, see {bdir / 'build.log'}:\n{r.stderr[-3000:]}")
+    stamp.write_text(key)
+    return exe, time.perf_counter() - t0
+
+
+def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool) -> None:
+    """The job of the C++ harness: the same phases as the cocotb run_scene."""
+    from . import regmap as _regmap
+    addr = lambda n: _regmap.lookup(n).addr
+    lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
+             f"progress {int(progress)}", f"noise_len {noise_len(cfg)}",
+             f"noise_file {d / 'noise.hex'}", f"upd_file {d / 'upd.hex'}",
+             f"reset_cycles {job['reset_cycles']}", f"run_cycles {job['run_cycles']}",
+             f"out {d / 'result.json'}"]
+    for key in ("cal", "regs"):
+        lines.append(f"{key} {len(job[key])}")
+        lines += [f"{addr(n)} {int(v) & 0xFFFFFFFF}" for n, v in job[key]]
+    lines.append(f"status {len(STATUS_REGS)}")
+    lines += [f"{n} {addr(n)}" for n in STATUS_REGS]
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene",
+                tag: str = "cpp", quiet: bool = False, cflags: str = HARNESS_CFLAGS):
+    """Build (cached) and run the C++ harness on a prepared job folder; returns
+    (job folder, reference, calibration, number of updates, result dict, build seconds)."""
+    import subprocess
+    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, cal=cal, tag=tag)
+    exe, build_s = harness_build(scene.cfg, cps, d, tag=tag, cflags=cflags, quiet=quiet)
+    job = json.loads((d / "job.json").read_text())
+    write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d, progress=not quiet)
+    t0 = time.perf_counter()
+    r = subprocess.run([str(exe), str(d / "job_cpp.txt")], cwd=d, stderr=None if not quiet else subprocess.PIPE)
+    proc_s = time.perf_counter() - t0
+    if r.returncode != 0:
+        raise RuntimeError(f"harness failed ({r.returncode}): {r.stderr.decode()[-2000:] if r.stderr else ''}")
+    res = json.loads((d / "result.json").read_text())
+    res["process_s"] = proc_s
+    return d, ref, cal, n_upd, res, build_s
+
+
 def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene", tag: str = ""):
     """Write the job folder (records, noise, job.json) and compute the reference."""
     from . import run_sim as _run_sim
@@ -477,11 +584,26 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
 
 
 def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int = 3,
-        sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None) -> dict:
-    sys.path.insert(0, str(ROOT / "tb"))
-    from common.runner import run_cocotb
+        sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None,
+        engine: str = "cpp") -> dict:
+    """engine "cpp": the standalone C++ harness (Verilator only, the default of
+    ``make sim``); "cocotb": the cocotb test run_scene (Verilator or Icarus)."""
     frames = frames or scene.frames
     scene = scene.replace(frames=frames)
+    if engine == "cpp" and sim == "verilator":
+        t0 = time.perf_counter()
+        d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet)
+        rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal)
+        rep.update({"engine": "cpp", "build_s": build_s, "sim_clk_per_s": res["clk_per_s"],
+                    "sim_run_clk": res["run_clk"], "coupling_updates": n_upd,
+                    "upd_late": res.get("upd_late"), "upd_done": res.get("upd_done"),
+                    "total_s": time.perf_counter() - t0})
+        if out_dir is not None:
+            Path(rep["report"]).write_text(json.dumps({k: v for k, v in rep.items() if k != "report"},
+                                                      indent=1) + "\n")
+        return rep
+    sys.path.insert(0, str(ROOT / "tb"))
+    from common.runner import run_cocotb
     t0 = time.perf_counter()
     d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag="" if sim == "verilator" else sim)
     t1 = time.perf_counter()
@@ -522,11 +644,15 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=int, default=None)
     ap.add_argument("--cps", type=int, default=3, help="clk cycles per sample (CLK_PER_SAMPLE)")
     ap.add_argument("--sim", default="verilator", choices=("verilator", "icarus"))
+    ap.add_argument("--engine", default="cpp", choices=("cpp", "cocotb"),
+                    help="cpp: the standalone C++ Verilator harness (default, Verilator only); "
+                         "cocotb: the cocotb test run_scene (Verilator or Icarus, ~40x slower)")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     sc = _scene.load(a.scene)
-    rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet)
+    rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
+              engine=a.engine)
     print(_summary(rep))
     print(f"report: {rep['report']}")
     return 0 if rep["golden_mismatches"] == 0 else 1

@@ -23,6 +23,13 @@
 // first edge with rst low is cycle 0).  The loggers and counters run while play_i = 1.  Logs are flushed when flush_i is high.
 // Ports: the core's control ports are passed through (clock, reset, UART, local bus,
 // trigger, event ready).
+//
+// EXT_CHANNEL = 1 (the standalone C++ harness tb/fmt_core/sim_main.cpp, `make sim`):
+// no fmt_channel_sim and no player; the core's ADC inputs come from adc_ext_i and the
+// harness computes them from ce_o / dac_o itself (the same formula, bit-exact, in C++:
+// a 30 x 40 matrix product per sample is far cheaper there); upd_late_o, upd_done_o
+// and clip_o are then 0 / 1 / 0 (the harness counts them).  EXT_CHANNEL = 0 (cocotb
+// tests): the Verilog channel and player as described above; adc_ext_i is unused.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -43,7 +50,8 @@ module fmt_core_sim_top #(
     parameter UPD_FILE       = "",               // coupling-update records ($readmemh), "" = none
     parameter HM_LOG         = "",               // heat-map log file
     parameter EV_LOG         = "",               // event log file
-    parameter FE_LOG         = ""                // frame-end log file
+    parameter FE_LOG         = "",               // frame-end log file
+    parameter EXT_CHANNEL    = 0                 // 1: ADC words from adc_ext_i (C++ channel)
 ) (
     input  wire        clk,          // processing clock
     input  wire        rst,          // synchronous reset of core and channel
@@ -63,7 +71,10 @@ module fmt_core_sim_top #(
     output reg  [31:0] events_o,     // events since reset
     output reg  [31:0] upd_late_o,   // commits issued at or after their stamp
     output wire        upd_done_o,   // the player reached the end record
-    output wire        clip_o        // the channel clipped (sticky)
+    output wire        clip_o,       // the channel clipped (sticky)
+    output wire        ce_o,         // the core's sample strobe (for the C++ channel)
+    output wire [ROWS*`FMT_DAC_BITS-1:0] dac_o,      // the core's DAC words (row r at [r*12 +: 12])
+    input  wire [COLS*`FMT_ADC_BITS-1:0] adc_ext_i   // ADC words when EXT_CHANNEL = 1
 );
     localparam ROW_W = (ROWS > 1) ? $clog2(ROWS) : 1;
     localparam COL_W = (COLS > 1) ? $clog2(COLS) : 1;
@@ -95,65 +106,76 @@ module fmt_core_sim_top #(
         .bus_wdata_i(bus_wdata_i), .bus_rdata_o(bus_rdata_o),
         .status_o(status), .frame_count_o(frame_count));
 
-    // ---------------------------------------------------------------- channel + player
-    reg  [63:0]      upd_mem [0:UPD_LEN-1];
-    reg  [31:0]      upd_ptr_q;
-    reg              upd_wait_q;
-    reg              upd_we, upd_commit;
-    reg  [ROW_W-1:0] upd_row;
-    reg  [COL_W-1:0] upd_col;
-    reg  [15:0]      upd_data;
-    reg  [31:0]      upd_stamp;
-    wire [31:0]      ch_sample;
-    wire             ch_clip;
-    integer          k;
-    initial begin
-        for (k = 0; k < UPD_LEN; k = k + 1) upd_mem[k] = 64'd0;
-        if (UPD_FILE != "") $readmemh(UPD_FILE, upd_mem);
-        upd_ptr_q  = 32'd0;
-        upd_wait_q = 1'b0;
-    end
-    wire [63:0] rec  = (upd_ptr_q < UPD_LEN) ? upd_mem[upd_ptr_q] : 64'd0;
-    wire [3:0]  kind = rec[63:60];
-    assign upd_done_o = (kind == 4'd0);
-    always @(*) begin
-        upd_we     = 1'b0;
-        upd_commit = 1'b0;
-        upd_row    = rec[52 +: ROW_W];
-        upd_col    = rec[44 +: COL_W];
-        upd_data   = rec[15:0];
-        upd_stamp  = rec[31:0];
-        if (play_i && !upd_wait_q) begin
-            if (kind == 4'd1) upd_we = 1'b1;
-            if (kind == 4'd2 && !rst) upd_commit = 1'b1;
-        end
-    end
-    always @(posedge clk) begin
-        if (upd_wait_q) begin
-            if (!u_ch.armed_q) upd_wait_q <= 1'b0;
-        end else if (upd_we) begin
-            upd_ptr_q <= upd_ptr_q + 32'd1;
-        end else if (upd_commit) begin
-            upd_ptr_q  <= upd_ptr_q + 32'd1;
-            upd_wait_q <= 1'b1;
-        end
-    end
-    always @(posedge clk) begin
-        if (rst) upd_late_o <= 32'd0;
-        // the copy happens at the first ce edge with sample >= stamp: late if that edge
-        // has passed already (next sample index > stamp)
-        else if (upd_commit && upd_stamp != 32'd0 &&
-                 (u_ch.k_q > upd_stamp || (u_ch.k_q == upd_stamp && ce))) upd_late_o <= upd_late_o + 32'd1;
-    end
+    assign ce_o  = ce;
+    assign dac_o = dac;
 
-    fmt_channel_sim #(
-        .ROWS(ROWS), .COLS(COLS), .DAC_BITS(`FMT_DAC_BITS), .ADC_BITS(`FMT_ADC_BITS), .COUP_BITS(16), .COUP_FRAC(16),
-        .NOISE_BITS(16), .NOISE_FRAC(4), .NOISE_LEN(NOISE_LEN), .NOISE_FILE(NOISE_FILE)
-    ) u_ch (
-        .clk(clk), .rst(rst), .ce(ce), .dac_i(dac),
-        .upd_we_i(upd_we), .upd_row_i(upd_row), .upd_col_i(upd_col), .upd_data_i(upd_data),
-        .upd_commit_i(upd_commit), .upd_stamp_i(upd_stamp),
-        .adc_o(adc), .clip_o(ch_clip), .clip_sticky_o(clip_o), .sample_o(ch_sample));
+    // ---------------------------------------------------------------- channel + player
+    generate if (EXT_CHANNEL != 0) begin : g_ext
+        assign adc        = adc_ext_i;
+        assign upd_done_o = 1'b1;
+        assign clip_o     = 1'b0;
+        always @(posedge clk) upd_late_o <= 32'd0;
+    end else begin : g_ch
+        reg  [63:0]      upd_mem [0:UPD_LEN-1];
+        reg  [31:0]      upd_ptr_q;
+        reg              upd_wait_q;
+        reg              upd_we, upd_commit;
+        reg  [ROW_W-1:0] upd_row;
+        reg  [COL_W-1:0] upd_col;
+        reg  [15:0]      upd_data;
+        reg  [31:0]      upd_stamp;
+        wire [31:0]      ch_sample;
+        wire             ch_clip;
+        integer          k;
+        initial begin
+            for (k = 0; k < UPD_LEN; k = k + 1) upd_mem[k] = 64'd0;
+            if (UPD_FILE != "") $readmemh(UPD_FILE, upd_mem);
+            upd_ptr_q  = 32'd0;
+            upd_wait_q = 1'b0;
+        end
+        wire [63:0] rec  = (upd_ptr_q < UPD_LEN) ? upd_mem[upd_ptr_q] : 64'd0;
+        wire [3:0]  kind = rec[63:60];
+        assign upd_done_o = (kind == 4'd0);
+        always @(*) begin
+            upd_we     = 1'b0;
+            upd_commit = 1'b0;
+            upd_row    = rec[52 +: ROW_W];
+            upd_col    = rec[44 +: COL_W];
+            upd_data   = rec[15:0];
+            upd_stamp  = rec[31:0];
+            if (play_i && !upd_wait_q) begin
+                if (kind == 4'd1) upd_we = 1'b1;
+                if (kind == 4'd2 && !rst) upd_commit = 1'b1;
+            end
+        end
+        always @(posedge clk) begin
+            if (upd_wait_q) begin
+                if (!u_ch.armed_q) upd_wait_q <= 1'b0;
+            end else if (upd_we) begin
+                upd_ptr_q <= upd_ptr_q + 32'd1;
+            end else if (upd_commit) begin
+                upd_ptr_q  <= upd_ptr_q + 32'd1;
+                upd_wait_q <= 1'b1;
+            end
+        end
+        always @(posedge clk) begin
+            if (rst) upd_late_o <= 32'd0;
+            // the copy happens at the first ce edge with sample >= stamp: late if that edge
+            // has passed already (next sample index > stamp)
+            else if (upd_commit && upd_stamp != 32'd0 &&
+                     (u_ch.k_q > upd_stamp || (u_ch.k_q == upd_stamp && ce))) upd_late_o <= upd_late_o + 32'd1;
+        end
+
+        fmt_channel_sim #(
+            .ROWS(ROWS), .COLS(COLS), .DAC_BITS(`FMT_DAC_BITS), .ADC_BITS(`FMT_ADC_BITS), .COUP_BITS(16), .COUP_FRAC(16),
+            .NOISE_BITS(16), .NOISE_FRAC(4), .NOISE_LEN(NOISE_LEN), .NOISE_FILE(NOISE_FILE)
+        ) u_ch (
+            .clk(clk), .rst(rst), .ce(ce), .dac_i(dac),
+            .upd_we_i(upd_we), .upd_row_i(upd_row), .upd_col_i(upd_col), .upd_data_i(upd_data),
+            .upd_commit_i(upd_commit), .upd_stamp_i(upd_stamp),
+            .adc_o(adc), .clip_o(ch_clip), .clip_sticky_o(clip_o), .sample_o(ch_sample));
+        wire unused_ch = &{1'b0, ch_sample, ch_clip, rec};
+    end endgenerate
 
     // ---------------------------------------------------------------- counters + logs
     integer fh_hm, fh_ev, fh_fe;
@@ -189,7 +211,7 @@ module fmt_core_sim_top #(
             if (fh_fe != 0) $fflush(fh_fe);
         end
     end
-    wire unused_ok = &{1'b0, ch_sample, ch_clip, status, frame_count, rec};
+    wire unused_ok = &{1'b0, status, frame_count, adc_ext_i};
 endmodule
 
 `default_nettype wire

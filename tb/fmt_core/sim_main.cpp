@@ -1,0 +1,343 @@
+// sim_main.cpp -- standalone Verilator harness of tb/fmt_core/fmt_core_sim_top.v
+// (EXT_CHANNEL = 1): the full-chain RTL simulation of `make sim` without cocotb.
+//
+// It replays exactly what the cocotb test run_scene (tb/fmt_core/test_fmt_core.py)
+// does, cycle for cycle, with the clock toggled here (two evals per clk cycle, no
+// tracing, single thread):
+//   phase 1: rst for 8 cycles, one idle cycle, the calibration writes (one per cycle)
+//            through the local bus (play_i = 0);
+//   phase 2: play_i = 1, one cycle later rst for reset_cycles cycles, one idle cycle
+//            (cycle 0), the register writes (one per cycle), then the clock runs until
+//            run_cycles cycles have passed since the first register write;
+//   then:    ev_ready_i = 0, 4 cycles, the status registers read over the bus
+//            (two cycles each), flush_i pulsed, result JSON written.
+//
+// The channel (sim/verilog/fmt_channel_sim.v, bit-exact, in C++): at every clk edge
+// with rst low and ce_o high (sample k = k-th such edge since reset)
+//   acc[c] = sum_r dac[r] * G[r][c] + noise[(k mod NOISE_LEN)][c] << (16 - 4)
+//   adc[c] = clip((acc[c] + 2^15) >> 16, -2048, 2047)     (arithmetic shift: floor)
+// registered (the core sees it from the next edge on), rst clears it.  G is 0 until
+// phase 2; the coupling updates come from the same record file as the Verilog player's
+// (upd.hex: kind 1 = pending write, kind 2 = commit stamped with a sample, 0 = end):
+// a commit arms a copy G := pending at the first ce edge whose sample index is >= the
+// stamp.  The first commit (the initial matrix) is armed by the first edge after the
+// phase-2 reset, as the player does; the later ones are armed right after the previous
+// copy (no load time here), and a copy at a sample later than its stamp counts as late.
+//
+// Usage: Vfmt_core_sim_top <job.txt>   (written by sim/fmt/run_sim_rtl.py, write_cpp_job)
+// Progress on stderr when the job says so; result JSON to the job's out path.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "Vfmt_core_sim_top.h"
+#include "verilated.h"
+
+namespace {
+
+// Word view of a Verilator port of any width (IData / QData / VlWide), little endian.
+inline const uint32_t* words_of(const uint32_t& v) { return &v; }
+inline const uint32_t* words_of(const uint64_t& v) { return reinterpret_cast<const uint32_t*>(&v); }
+template <std::size_t N> inline const uint32_t* words_of(const VlWide<N>& v) { return v.data(); }
+inline uint32_t* words_of(uint32_t& v) { return &v; }
+inline uint32_t* words_of(uint64_t& v) { return reinterpret_cast<uint32_t*>(&v); }
+template <std::size_t N> inline uint32_t* words_of(VlWide<N>& v) { return v.data(); }
+
+// Signed field [lsb +: w] (w <= 32) of a little-endian word array.
+inline int32_t get_field(const uint32_t* w, int lsb, int width) {
+    const int i = lsb >> 5, s = lsb & 31;
+    uint64_t v = w[i];
+    if (s + width > 32) v |= static_cast<uint64_t>(w[i + 1]) << 32;
+    v = (v >> s) & ((1ull << width) - 1);
+    const uint64_t sign = 1ull << (width - 1);
+    return static_cast<int32_t>(static_cast<int64_t>(v ^ sign) - static_cast<int64_t>(sign));
+}
+
+struct Update {
+    uint32_t stamp;
+    std::vector<int32_t> g;   // column-major [c * rows + r]
+};
+
+struct Job {
+    int rows = 0, cols = 0, cps = 3, noise_len = 1, frames = 0, progress = 0;
+    std::string noise_file, upd_file, out;
+    std::vector<std::pair<uint32_t, uint32_t>> cal, regs;
+    std::vector<std::pair<std::string, uint32_t>> status;
+    long long reset_cycles = 16, run_cycles = 0;
+};
+
+double cpu_seconds() {   // user + system CPU time of this process
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+[[noreturn]] void die(const std::string& msg) {
+    std::fprintf(stderr, "sim_main: %s\n", msg.c_str());
+    std::exit(2);
+}
+
+Job read_job(const char* path) {
+    FILE* f = std::fopen(path, "r");
+    if (!f) die(std::string("cannot open job ") + path);
+    Job j;
+    char key[64], sval[4096];
+    auto pairs = [&](std::vector<std::pair<uint32_t, uint32_t>>& v) {
+        long n;
+        if (std::fscanf(f, "%ld", &n) != 1) die("bad count");
+        for (long i = 0; i < n; ++i) {
+            unsigned a, d;
+            if (std::fscanf(f, "%u %u", &a, &d) != 2) die("bad pair");
+            v.emplace_back(a, d);
+        }
+    };
+    while (std::fscanf(f, "%63s", key) == 1) {
+        const std::string k(key);
+        if (k == "rows") { if (std::fscanf(f, "%d", &j.rows) != 1) die(k); }
+        else if (k == "cols") { if (std::fscanf(f, "%d", &j.cols) != 1) die(k); }
+        else if (k == "cps") { if (std::fscanf(f, "%d", &j.cps) != 1) die(k); }
+        else if (k == "frames") { if (std::fscanf(f, "%d", &j.frames) != 1) die(k); }
+        else if (k == "progress") { if (std::fscanf(f, "%d", &j.progress) != 1) die(k); }
+        else if (k == "noise_len") { if (std::fscanf(f, "%d", &j.noise_len) != 1) die(k); }
+        else if (k == "reset_cycles") { if (std::fscanf(f, "%lld", &j.reset_cycles) != 1) die(k); }
+        else if (k == "run_cycles") { if (std::fscanf(f, "%lld", &j.run_cycles) != 1) die(k); }
+        else if (k == "noise_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.noise_file = sval; }
+        else if (k == "upd_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.upd_file = sval; }
+        else if (k == "out") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.out = sval; }
+        else if (k == "cal") pairs(j.cal);
+        else if (k == "regs") pairs(j.regs);
+        else if (k == "status") {
+            long n;
+            if (std::fscanf(f, "%ld", &n) != 1) die(k);
+            for (long i = 0; i < n; ++i) {
+                unsigned a;
+                if (std::fscanf(f, "%4095s %u", sval, &a) != 2) die(k);
+                j.status.emplace_back(sval, a);
+            }
+        } else die("unknown job key " + k);
+    }
+    std::fclose(f);
+    if (j.rows <= 0 || j.cols <= 0 || j.out.empty()) die("job lacks rows/cols/out");
+    return j;
+}
+
+// The channel of fmt_channel_sim.v plus the coupling-update sequencing.
+struct Channel {
+    int rows, cols, noise_len;
+    std::vector<int32_t> g, pending;          // column-major
+    std::vector<int64_t> noise;               // [k * cols + c], already << 12
+    std::vector<Update> updates;              // commits in record order
+    std::vector<int32_t> dac;
+    std::vector<uint32_t> adc_words;          // registered output, packed
+    size_t next_upd = 0;                      // next commit to arm
+    bool armed = false, arm_next = false, playing = false;
+    uint32_t stamp = 0, k = 0;
+    long long late = 0, copies = 0, clip_samples = 0;
+    bool clip_sticky = false;
+
+    Channel(const Job& j, size_t adc_nwords)
+        : rows(j.rows), cols(j.cols), noise_len(j.noise_len),
+          g(static_cast<size_t>(rows) * cols, 0), pending(g.size(), 0),
+          noise(static_cast<size_t>(noise_len) * cols, 0), dac(rows, 0), adc_words(adc_nwords, 0) {
+        if (!j.noise_file.empty()) load_noise(j.noise_file);
+        if (!j.upd_file.empty()) load_updates(j.upd_file);
+    }
+
+    void load_noise(const std::string& path) {
+        FILE* f = std::fopen(path.c_str(), "r");
+        if (!f) die("cannot open noise " + path);
+        unsigned v;
+        size_t i = 0;
+        while (i < noise.size() && std::fscanf(f, "%x", &v) == 1) {
+            const int32_t s = static_cast<int32_t>(static_cast<int16_t>(v & 0xFFFF));
+            noise[i++] = static_cast<int64_t>(s) * (1 << (16 - 4));
+        }
+        std::fclose(f);
+    }
+
+    void load_updates(const std::string& path) {
+        FILE* f = std::fopen(path.c_str(), "r");
+        if (!f) die("cannot open updates " + path);
+        std::vector<int32_t> pend(g.size(), 0);
+        unsigned long long rec;
+        while (std::fscanf(f, "%llx", &rec) == 1) {
+            const unsigned kind = static_cast<unsigned>(rec >> 60);
+            if (kind == 0) break;
+            if (kind == 1) {
+                const int r = static_cast<int>((rec >> 52) & 0xFF), c = static_cast<int>((rec >> 44) & 0xFF);
+                if (r < rows && c < cols) pend[static_cast<size_t>(c) * rows + r] = static_cast<int32_t>(rec & 0xFFFF);
+            } else if (kind == 2) {
+                updates.push_back(Update{static_cast<uint32_t>(rec & 0xFFFFFFFFu), pend});
+            }
+        }
+        std::fclose(f);
+    }
+
+    // Values at a clk edge (before it): rst, ce, the DAC words; updates the registered
+    // output that the core sees from the next edge on.
+    template <typename DacT>
+    void edge(bool rst, bool ce, const DacT& dac_port) {
+        if (rst) {
+            k = 0;
+            armed = false;
+            clip_sticky = false;
+            std::fill(adc_words.begin(), adc_words.end(), 0u);
+            if (playing && next_upd == 0) arm_next = true;   // the initial matrix: first edge after reset
+            return;
+        }
+        bool arm_now = false;
+        if (ce) {
+            if (armed && k >= stamp) {
+                g = pending;
+                ++copies;
+                if (k > stamp && stamp != 0) ++late;   // as the player: stamp 0 = at once
+                armed = false;
+                if (next_upd < updates.size()) arm_now = true;   // next commit, armed from the next edge
+            }
+            const uint32_t* dw = words_of(dac_port);
+            for (int r = 0; r < rows; ++r) dac[r] = get_field(dw, r * 12, 12);
+            const int64_t* nz = &noise[static_cast<size_t>(k % static_cast<uint32_t>(noise_len)) * cols];
+            std::fill(adc_words.begin(), adc_words.end(), 0u);
+            bool clip = false;
+            for (int c = 0; c < cols; ++c) {
+                const int32_t* gc = &g[static_cast<size_t>(c) * rows];
+                int64_t acc = 0;
+                for (int r = 0; r < rows; ++r) acc += static_cast<int64_t>(dac[r]) * gc[r];
+                acc += nz[c];
+                int64_t y = (acc + (1 << 15)) >> 16;
+                if (y > 2047) { y = 2047; clip = true; }
+                if (y < -2048) { y = -2048; clip = true; }
+                const uint64_t u = static_cast<uint64_t>(y) & 0xFFF;
+                const int lsb = c * 12, i = lsb >> 5, s = lsb & 31;
+                adc_words[i] |= static_cast<uint32_t>(u << s);
+                if (s + 12 > 32) adc_words[i + 1] |= static_cast<uint32_t>(u >> (32 - s));
+            }
+            if (clip) { clip_sticky = true; ++clip_samples; }
+            ++k;
+        }
+        if (arm_next || arm_now) {          // registered: takes effect from the next edge
+            if (next_upd < updates.size()) {
+                pending = updates[next_upd].g;
+                stamp = updates[next_upd].stamp;
+                ++next_upd;
+                armed = true;
+            }
+            arm_next = false;
+        }
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) die("usage: Vfmt_core_sim_top <job.txt>");
+    const Job job = read_job(argv[1]);
+    auto ctx = std::make_unique<VerilatedContext>();
+    ctx->commandArgs(1, argv);
+    auto top = std::make_unique<Vfmt_core_sim_top>(ctx.get(), "TOP");
+    constexpr size_t ADC_NWORDS = (sizeof(top->adc_ext_i) + 3) / 4;
+    if (static_cast<size_t>(job.cols) * 12 > ADC_NWORDS * 32 ||
+        static_cast<size_t>(job.rows) * 12 > sizeof(top->dac_o) * 8)
+        die("job size does not match the build");
+    Channel ch(job, ADC_NWORDS);
+
+    long long cycle = 0;   // clk edges since time 0 (all phases)
+    auto tick = [&]() {
+        ch.edge(top->rst != 0, top->ce_o != 0, top->dac_o);
+        top->clk = 1;
+        top->eval();
+        std::memcpy(words_of(top->adc_ext_i), ch.adc_words.data(), ADC_NWORDS * 4);
+        top->clk = 0;
+        top->eval();
+        ++cycle;
+    };
+    auto ticks = [&](long long n) { for (long long i = 0; i < n; ++i) tick(); };
+    auto bus_write = [&](uint32_t addr, uint32_t data) {
+        top->bus_we_i = 1;
+        top->bus_addr_i = addr & 0xFFFF;
+        top->bus_wdata_i = data;
+        tick();
+        top->bus_we_i = 0;
+    };
+    auto bus_read = [&](uint32_t addr) -> uint32_t {
+        top->bus_re_i = 1;
+        top->bus_addr_i = addr & 0xFFFF;
+        tick();
+        top->bus_re_i = 0;
+        tick();
+        return top->bus_rdata_o;
+    };
+
+    top->clk = 0; top->rst = 0; top->ev_ready_i = 1; top->trig_i = 0; top->uart_rx_i = 1;
+    top->bus_we_i = 0; top->bus_re_i = 0; top->bus_addr_i = 0; top->bus_wdata_i = 0;
+    top->flush_i = 0; top->play_i = 0;
+    top->eval();
+
+    // phase 1: calibration (kept through the next reset)
+    top->rst = 1; ticks(8); top->rst = 0;
+    tick();
+    for (const auto& w : job.cal) bus_write(w.first, w.second);
+    // phase 2: the run
+    top->play_i = 1; ch.playing = true;
+    tick();
+    top->rst = 1; ticks(job.reset_cycles); top->rst = 0;
+    tick();                                                  // cycle 0
+    for (const auto& w : job.regs) bus_write(w.first, w.second);
+    long long done = static_cast<long long>(job.regs.size());
+    const long long total = job.run_cycles;
+    const long long step = std::max<long long>(1000, total / 100);
+    const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = cpu_seconds();
+    while (done < total) {
+        const long long n = std::min(step, total - done);
+        ticks(n);
+        done += n;
+        if (job.progress) {
+            const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const unsigned fr = top->frames_o;
+            std::fprintf(stderr, "\r  fmt_core (Verilator, C++ harness): frame %u/%d  %3d%%  %.0f frames/s, %.0f clk/s   ",
+                         fr, job.frames, static_cast<int>(100.0 * done / total), fr / std::max(dt, 1e-9),
+                         (done - static_cast<long long>(job.regs.size())) / std::max(dt, 1e-9));
+            std::fflush(stderr);
+        }
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double cpu = cpu_seconds() - c0;
+    if (job.progress) std::fprintf(stderr, "\n");
+    const unsigned frames = top->frames_o, events = top->events_o;
+    const long long run_clk = total - static_cast<long long>(job.regs.size());
+    // stop the event consumer so that the counters hold still while they are read
+    top->ev_ready_i = 0;
+    ticks(4);
+    const unsigned status_cycle = top->cycle_o, frames_before = top->frames_o;
+    std::string st;
+    for (const auto& s : job.status) {
+        const uint32_t v = bus_read(s.second);
+        st += (st.empty() ? "" : ", ") + ("\"" + s.first + "\": " + std::to_string(v));
+    }
+    const unsigned frames_at = top->frames_o;
+    top->flush_i = 1; tick(); top->flush_i = 0; ticks(2);
+    top->final();
+
+    FILE* o = std::fopen(job.out.c_str(), "w");
+    if (!o) die("cannot write " + job.out);
+    std::fprintf(o,
+                 "{\"engine\": \"cpp\", \"wall_s\": %.6f, \"cpu_s\": %.6f, \"run_clk\": %lld, \"clk_per_s\": %.1f, "
+                 "\"frames\": %u, \"events\": %u, \"upd_late\": %lld, \"upd_done\": %d, \"upd_copies\": %lld, "
+                 "\"clip\": %d, \"clip_samples\": %lld, \"status_cycle\": %u, \"frames_before_status\": %u, "
+                 "\"status\": {%s}, \"frames_at_status\": %u}\n",
+                 wall, cpu, run_clk, run_clk / std::max(wall, 1e-9), frames, events, ch.late,
+                 (ch.next_upd == ch.updates.size() && !ch.armed) ? 1 : 0, ch.copies,
+                 ch.clip_sticky ? 1 : 0, ch.clip_samples, status_cycle, frames_before, st.c_str(), frames_at);
+    std::fclose(o);
+    return 0;
+}
