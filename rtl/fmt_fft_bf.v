@@ -15,7 +15,11 @@
 //
 // Fixed point: input DW bits signed, output DW + 1 bits, exact (no rounding, cannot
 // overflow: |a +- b| < 2^DW; the -j swap only moves a component).
-// Latency: D + 1 ce-steps (delay line + output register).  out_valid_o is 1 for the
+// Channels: with CH > 1 the input is CH interleaved streams (one element of each
+// channel in turn, all CH of a sample index carrying the same idx); the delay line is
+// D x CH steps long, so each element meets its own channel's partner (fmt_fft_r22sdf CH).
+// Latency: D x CH + 1 ce-steps (delay line + output register): the element leaves one
+// step after the input that pairs with it.  out_valid_o is 1 for the
 // elements that came from valid inputs (the first valid input has idx 0 after reset).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -25,7 +29,8 @@ module fmt_fft_bf #(
     parameter LOG2_D  = 0,           // delay D = 2^LOG2_D (D = N/2 for the first stage)
     parameter DW      = 13,          // input width (signed); output is DW + 1
     parameter MINUS_J = 0,           // 1: BF2II stage (-j on the second half of each 4D block)
-    parameter RAM_MIN = 8            // delay lines this long or longer use the RAM form
+    parameter RAM_MIN = 8,           // delay lines this long or longer use the RAM form
+    parameter CH      = 1            // interleaved channels (delay line D x CH steps)
 ) (
     input  wire              clk,
     input  wire              rst,          // synchronous, active high
@@ -77,7 +82,7 @@ module fmt_fft_bf #(
 
     wire [2*OW-1:0] dl_in = ctrl ? {dif_re, dif_im} : {b_re, b_im};
 
-    fmt_fft_delay #(.W(2 * OW), .DEPTH(D), .RAM_MIN(RAM_MIN)) u_delay (
+    fmt_fft_delay #(.W(2 * OW), .DEPTH(D * CH), .RAM_MIN(RAM_MIN)) u_delay (
         .clk(clk), .rst(rst), .ce(ce), .din_i(dl_in), .dout_o(dl_out));
 
     // validity: the output element idx - D is valid once D valid samples came in

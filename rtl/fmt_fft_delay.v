@@ -7,17 +7,19 @@
 //
 // DEPTH < RAM_MIN: a shift register (maps to SRLC32E with clock enable, or to flip-flops
 //   when tiny).
-// DEPTH >= RAM_MIN: a ring of DEPTH words (DEPTH a power of two) with one write port and
-//   one registered read port whose read address runs one ahead of the write address,
-//   so ring + read register = DEPTH steps; it maps to LUT RAM or block RAM (simple
-//   dual port), cheaper than SRLs from 8 words on (2 bits per LUT in a RAM32M).
+// DEPTH >= RAM_MIN: a ring of DEPTH words with one write port and one registered read
+//   port whose read address runs one ahead of the write address, so ring + read
+//   register = DEPTH steps; it maps to LUT RAM or block RAM (simple dual port), cheaper
+//   than SRLs from 8 words on (2 bits per LUT in a RAM32M).  DEPTH need not be a power
+//   of two (the FFT's channel-interleaved lines are D x CH deep): the pointer then
+//   wraps at DEPTH - 1 (one comparator more).
 // Latency: exactly DEPTH ce-steps (no extra register).
 `default_nettype none
 `include "fmt_defaults.vh"
 
 module fmt_fft_delay #(
     parameter W       = 16,   // word width (bits)
-    parameter DEPTH   = 8,    // delay in samples, >= 1; a power of two when >= RAM_MIN
+    parameter DEPTH   = 8,    // delay in samples, >= 1
     parameter RAM_MIN = 8     // depth from which the ring-buffer (RAM) form is used, >= 2
 ) (
     input  wire         clk,
@@ -33,7 +35,14 @@ module fmt_fft_delay #(
             reg [W-1:0]  mem [0:DEPTH-1];
             reg [AW-1:0] wptr_q;
             reg [W-1:0]  rd_q;
-            wire [AW-1:0] rptr = wptr_q + 1'b1;   // the oldest word: written DEPTH-1 steps ago
+            wire [AW-1:0] rptr;                   // the oldest word: written DEPTH-1 steps ago
+            if ((1 << AW) == DEPTH) begin : g_pow2
+                assign rptr = wptr_q + 1'b1;
+            end else begin : g_mod
+                localparam integer  TOP_I = DEPTH - 1;
+                localparam [AW-1:0] TOP   = TOP_I[AW-1:0];
+                assign rptr = (wptr_q == TOP) ? {AW{1'b0}} : wptr_q + 1'b1;
+            end
             always @(posedge clk) begin
                 if (ce) begin
                     mem[wptr_q] <= din_i;

@@ -40,6 +40,18 @@
 // synth_xilinx -family xc5v: about 1.4k LUT6 (LUT RAM counted as 4 LUTs per RAM32M/64M),
 // 1.65k FF, 12 DSP48E, 2 RAMB18 (see README; the DSP48E's own pipeline registers are
 // not used by Yosys, XST would absorb part of the FFs).
+//
+// Channels (CH > 1): one engine transforms CH independent streams time-multiplexed, for
+// a clock CH (or more) times the sample rate.  Each ce is one STEP carrying one element
+// of channel 0, 1, .., CH-1 in turn (the first ce after reset is channel 0); the window
+// counter advances after channel CH-1, the delay lines are D x CH steps long (LUT RAM /
+// SRL / block RAM, e.g. 384 x 28 bits at N = 256, CH = 3: one RAMB18), the twiddle ROMs
+// are indexed per element, the arithmetic is that of CH = 1 (every channel bit-exact with
+// fft_fixed).  Outputs interleave the same way; out_ch_o names the channel.  Latency in
+// steps: channel c's slot s leaves on step t_c + LATENCY0 + s * CH, t_c = the step of
+// channel c's last window sample (the register stages count steps, the delay lines
+// samples).  Cost at N = 256, CH = 3: about the logic of one CH = 1 engine plus the
+// longer delay lines, 12 DSP48E for three streams (see README).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -51,11 +63,13 @@ module fmt_fft_r22sdf #(
     parameter GUARD   = 3,                   // twiddle product bits kept below the output LSB
     parameter OUT_W   = IN_W + LOG2_N + 1 + FRAC_W,  // output width, <= FULL_W
     parameter RAM_MIN = 8,                   // delay lines this long or longer use a RAM ring (LUT or block RAM)
-    parameter TW_DIR  = "rtl/"               // directory of the twiddle hex files, trailing /
+    parameter TW_DIR  = "rtl/",              // directory of the twiddle hex files, trailing /
+    parameter CH      = 1,                   // interleaved channels per engine (1 = one stream)
+    parameter CH_W    = (CH > 1) ? $clog2(CH) : 1   // width of out_ch_o
 ) (
     input  wire                 clk,
     input  wire                 rst,         // synchronous, active high
-    input  wire                 ce,          // sample strobe: one complex sample per ce
+    input  wire                 ce,          // step strobe: one complex sample (of channel out_ch order) per ce
     input  wire signed [IN_W-1:0] in_re,     // input, real part (natural order)
     input  wire signed [IN_W-1:0] in_im,     // input, imaginary part
     output wire                 out_valid,   // 1 on the ce cycles that carry an output
@@ -63,6 +77,7 @@ module fmt_fft_r22sdf #(
     output wire [LOG2_N-1:0]    out_bin,     // natural bin index = bit-reversed slot
     output wire signed [OUT_W-1:0] out_re,   // X[bin] * 2^-SHIFT, real part
     output wire signed [OUT_W-1:0] out_im,   // imaginary part
+    output wire [CH_W-1:0]      out_ch_o,    // channel of the output element (0 when CH = 1)
     output wire                 ovf_o        // sticky: internal saturation since reset
 );
 
@@ -94,19 +109,30 @@ module fmt_fft_r22sdf #(
     wire [LOG2_N:0]              bus_valid;
     wire [LOG2_N:0]              bus_ovf;              // per stage: twiddle saturation flag
 
-    // ---- input register and window counter ----
+    localparam integer CHM1 = CH - 1;
+    localparam [CH_W-1:0] CH_LAST = CHM1[CH_W-1:0];
+
+    // ---- input register, channel and window counters ----
     reg [LOG2_N-1:0]      cnt_q;
+    reg [CH_W-1:0]        ich_q;                       // channel of the input element
     reg [LOG2_N-1:0]      in_idx_q;
     reg                   in_valid_q;
     reg signed [IN_W-1:0] in_re_q, in_im_q;
+    wire                  ich_last = (ich_q == CH_LAST);
 
     always @(posedge clk) begin
         if (rst) begin
             cnt_q      <= {LOG2_N{1'b0}};
+            ich_q      <= {CH_W{1'b0}};
             in_idx_q   <= {LOG2_N{1'b0}};
             in_valid_q <= 1'b0;
         end else if (ce) begin
-            cnt_q      <= cnt_q + 1'b1;
+            if (ich_last) begin
+                cnt_q <= cnt_q + 1'b1;
+                ich_q <= {CH_W{1'b0}};
+            end else begin
+                ich_q <= ich_q + 1'b1;
+            end
             in_idx_q   <= cnt_q;
             in_valid_q <= 1'b1;
         end
@@ -139,7 +165,7 @@ module fmt_fft_r22sdf #(
 
             fmt_fft_bf #(
                 .LOG2_N(LOG2_N), .LOG2_D(LOG2_N - 1 - s), .DW(DW),
-                .MINUS_J(s % 2), .RAM_MIN(RAM_MIN)
+                .MINUS_J(s % 2), .RAM_MIN(RAM_MIN), .CH(CH)
             ) u_bf (
                 .clk(clk), .rst(rst), .ce(ce),
                 .in_valid_i(bus_valid[s]),
@@ -235,6 +261,17 @@ module fmt_fft_r22sdf #(
             assign out_bin[b] = out_slot[LOG2_N-1-b];
         end
     endgenerate
+
+    // output channel: the valid elements leave channel 0, 1, .., CH-1 in turn from the
+    // first one after reset (validity starts at a channel-0 element and never stops)
+    reg [CH_W-1:0] och_q;
+    always @(posedge clk) begin
+        if (rst)
+            och_q <= {CH_W{1'b0}};
+        else if (ce && out_valid_q)
+            och_q <= (och_q == CH_LAST) ? {CH_W{1'b0}} : och_q + 1'b1;
+    end
+    assign out_ch_o  = och_q;
 
     assign out_valid = out_valid_q & ce;
     assign ovf_o     = (|bus_ovf) | out_ovf;

@@ -12,6 +12,10 @@
 // a bit saying whether it was k or N-k); when its partner arrives, (2A, 2B) of row r
 // leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
 // clears it.  Twin: sim/fmt/rx_fixed.py pair_split_fixed.
+// Channels (CH > 1): the input interleaves CH independent FFT streams (fmt_fft_r22sdf
+// CH, in_ch = its out_ch_o); the held memory and bits are per {channel, row} (CH x
+// 2^ROW_W entries, still LUT RAM), out_ch names the output's channel.  One split serves
+// the CH column pairs of one time-multiplexed FFT engine.
 // Requires BIN_LO >= 1 and BIN_LO + (ROWS-1)*BIN_STEP < N/2 (checked by params.py), so
 // a bin and its mirror are never the same bin.  BIN_STEP that is not a power of two
 // costs a constant divider on the bin index.
@@ -25,7 +29,9 @@ module fmt_pair_split #(
     parameter BIN_STEP = `FMT_BIN_STEP,  // bins between rows
     parameter W        = 18,             // FFT output width (signed)
     parameter TAG_W    = 4,              // side band carried from the second bin to the output
-    parameter ROW_W    = (ROWS > 1) ? $clog2(ROWS) : 1  // row index width
+    parameter ROW_W    = (ROWS > 1) ? $clog2(ROWS) : 1, // row index width
+    parameter CH       = 1,              // interleaved channels (column pairs)
+    parameter CH_W     = (CH > 1) ? $clog2(CH) : 1      // channel index width
 ) (
     input  wire                 clk,
     input  wire                 rst,       // synchronous, active high
@@ -35,13 +41,15 @@ module fmt_pair_split #(
     input  wire signed [W-1:0]  in_re,     // Z[bin] real
     input  wire signed [W-1:0]  in_im,     // Z[bin] imaginary
     input  wire [TAG_W-1:0]     in_tag,    // side band (taken with the second bin of a pair)
+    input  wire [CH_W-1:0]      in_ch,     // channel of the input bin (CH > 1; unused when CH = 1)
     output reg                  out_valid, // one row's (2A, 2B) this ce cycle
     output reg  [ROW_W-1:0]     out_row,   // row index r
     output reg  signed [W:0]    a_re,      // 2 Re A[k]
     output reg  signed [W:0]    a_im,      // 2 Im A[k]
     output reg  signed [W:0]    b_re,      // 2 Re B[k]
     output reg  signed [W:0]    b_im,      // 2 Im B[k]
-    output reg  [TAG_W-1:0]     out_tag    // in_tag of the second bin
+    output reg  [TAG_W-1:0]     out_tag,   // in_tag of the second bin
+    output reg  [CH_W-1:0]      out_ch     // channel of the output row
 );
 
     localparam N   = 1 << LOG2_N;
@@ -71,12 +79,27 @@ module fmt_pair_split #(
     wire [ROW_W-1:0]     row    = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
     wire                 hit    = in_valid && (hit_k || hit_m);
 
-    // ---- held first-of-pair memory ----
-    reg [2*W:0]   mem [0:ROWS-1];          // {is_mirror, re, im}
-    reg [ROWS-1:0] held_q;
+    // ---- held first-of-pair memory, per {channel, row} ----
+    localparam AW = (CH > 1) ? CH_W + ROW_W : ROW_W;
+    localparam MD = (CH > 1) ? (1 << AW) : ROWS;
+    wire [AW-1:0] addr;
+    generate
+        if (CH > 1) begin : g_ch
+            assign addr = {in_ch, row};
+        end else begin : g_one
+            assign addr = row;
+            // one channel: in_ch is not used
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire unused_ch = &{1'b0, in_ch};
+            /* verilator lint_on UNUSEDSIGNAL */
+        end
+    endgenerate
 
-    wire [2*W:0]        rd       = mem[row];
-    wire                held     = held_q[row];
+    reg [2*W:0]   mem [0:MD-1];            // {is_mirror, re, im}
+    reg [MD-1:0]  held_q;
+
+    wire [2*W:0]        rd       = mem[addr];
+    wire                held     = held_q[addr];
     wire signed [W-1:0] h_re     = rd[2*W-1:W];
     wire signed [W-1:0] h_im     = rd[W-1:0];
     // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
@@ -90,23 +113,23 @@ module fmt_pair_split #(
 
     always @(posedge clk) begin
         if (ce && hit && !second) begin
-            mem[row] <= {hit_m, in_re, in_im};
+            mem[addr] <= {hit_m, in_re, in_im};
         end
     end
 
     always @(posedge clk) begin
         if (rst) begin
-            held_q    <= {ROWS{1'b0}};
+            held_q    <= {MD{1'b0}};
             out_valid <= 1'b0;
         end else if (ce) begin
             out_valid <= 1'b0;
             if (hit) begin
                 // the second arrival must be the other member of the pair
                 if (second) begin
-                    held_q[row] <= 1'b0;
+                    held_q[addr] <= 1'b0;
                     out_valid   <= 1'b1;
                 end else begin
-                    held_q[row] <= 1'b1;   // first arrival (or a repeat: keep the newest)
+                    held_q[addr] <= 1'b1;  // first arrival (or a repeat: keep the newest)
                 end
             end
         end
@@ -120,6 +143,7 @@ module fmt_pair_split #(
             b_re    <= p_im + q_im;
             b_im    <= q_re - p_re;
             out_tag <= in_tag;
+            out_ch  <= in_ch;
         end
     end
 

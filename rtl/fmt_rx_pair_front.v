@@ -76,12 +76,13 @@ module fmt_rx_pair_front #(
     wire                f_valid;
     wire [LOG2_N-1:0]   f_slot, f_bin;
     wire signed [W-1:0] f_re, f_im;
+    wire                f_ch;          // one channel: always 0
     fmt_fft_r22sdf #(
         .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W), .TW_DIR(TW_DIR)
     ) u_fft (
         .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re(xa), .in_im(xb),
         .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
-        .out_re(f_re), .out_im(f_im), .ovf_o(fft_ovf_o));
+        .out_re(f_re), .out_im(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
 
     // The FFT's out_valid is 1 only on ce cycles: its outputs are taken on ce edges; the
     // split registers and the result memory run on every clk (POST_CLK = 1) or on ce.
@@ -114,6 +115,10 @@ module fmt_rx_pair_front #(
     end
 
     // ---- pair split ----
+    // one channel per engine here (fmt_rx_group_front shares one between column pairs)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire ps_ch;
+    /* verilator lint_on UNUSEDSIGNAL */
     fmt_pair_split #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
@@ -122,7 +127,8 @@ module fmt_rx_pair_front #(
         .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
         .in_tag({m_cur, w_first, w_last}),
         .out_valid(ps_valid_o), .out_row(ps_row_o),
-        .a_re(ps_ar_o), .a_im(ps_ai_o), .b_re(ps_br_o), .b_im(ps_bi_o), .out_tag(ps_tag_o));
+        .a_re(ps_ar_o), .a_im(ps_ai_o), .b_re(ps_br_o), .b_im(ps_bi_o), .out_tag(ps_tag_o),
+        .in_ch(f_ch), .out_ch(ps_ch));
 
     // ---- result memory: row r's (2A, 2B), written when the row completes ----
     generate

@@ -39,26 +39,46 @@ class TB(ClockedTB):
         lo = env_int("BIN_LO", 9)
         self.bins = list(range(lo, lo + env_int("ROWS", 4)))   # the comb (bin step 1)
         self.lat0 = F.latency0(self.log2_n, self.in_w, self.out_w)
+        self.ch = env_int("CH", 1)            # interleaved channels (fmt_fft_r22sdf CH)
         dut.ce.value = 0
         dut.in_re.value = 0
         dut.in_im.value = 0
         dut.rst.value = 0
 
+    def channels(self, xr, xi):
+        """CH channel inputs (CH, windows, N) derived from one (windows, N) pair:
+        channel 0 = the given samples, channel c rolled by c windows, re/im swapped on
+        odd channels and complemented (~x = -1 - x, stays in range) on channels 2, 3 mod
+        4, so that any mixing of channels shows in the exact check."""
+        xs_r, xs_i = [], []
+        for c in range(self.ch):
+            r, i = (xr, xi) if c % 2 == 0 else (xi, xr)
+            if (c // 2) % 2:
+                r, i = ~r, ~i
+            xs_r.append(np.roll(r, c, axis=0))
+            xs_i.append(np.roll(i, c, axis=0))
+        return np.stack(xs_r), np.stack(xs_i)
+
     async def stream(self, xr, xi, ce_prob=1.0, rng=None, reset_first=True):
         """Feed the (windows, N) samples (then zeros until every window is out), with ce
         high on a fraction ce_prob of the cycles.  Returns the outputs of the fed
         windows as (re, im) in slot order (windows, N) after checking slot, bin,
-        latency and the overflow flag."""
+        latency and the overflow flag.  CH > 1: the steps interleave the CH channels of
+        ``channels(xr, xi)`` (channel 0 = xr, xi is returned); channels 1 .. CH-1 are
+        checked bit-exact here, out_ch_o and the latency (in steps) for all."""
         dut = self.dut
+        ch = self.ch
         rng = rng or random.Random(1)
         if reset_first:
             await self.reset()
         wins = xr.shape[0]
-        fr, fi = xr.ravel(), xi.ravel()
-        total = wins * self.n
-        last_in = [(w + 1) * self.n - 1 for w in range(wins)]   # ce index of each window's last sample
-        outs = []                 # (ce index, slot, bin, re, im)
-        k = 0                     # ce cycles so far (= index of the sample presented)
+        cr, ci = self.channels(xr, xi)
+        # step k carries sample k // CH of channel k % CH
+        fr = cr.reshape(ch, wins * self.n).T.ravel()
+        fi = ci.reshape(ch, wins * self.n).T.ravel()
+        total = wins * self.n * ch
+        outs = []                 # (ce index, slot, bin, channel, re, im)
+        k = 0                     # ce cycles (steps) so far (= index of the element presented)
         while len(outs) < total:
             await self.writable()
             ce = 1 if rng.random() < ce_prob else 0
@@ -70,20 +90,32 @@ class TB(ClockedTB):
             if int(dut.out_valid.value):
                 assert ce, "out_valid without ce"
                 outs.append((k, int(dut.out_slot.value), int(dut.out_bin.value),
+                             int(dut.out_ch_o.value),
                              dut.out_re.value.to_signed(), dut.out_im.value.to_signed()))
             assert int(dut.ovf_o.value) == 0, "overflow flag set"
             k += ce
-            assert k < total + 4 * self.n + 200, "outputs missing"
+            assert k < total + (4 * self.n + 200) * ch, "outputs missing"
         await self.writable()
         dut.ce.value = 0
         o = np.array(outs, dtype=np.int64)
-        slots = np.tile(np.arange(self.n), wins)
+        # output element j: slot (j // CH) % N of window j // (CH N), channel j % CH
+        j = np.arange(total)
+        slots = (j // ch) % self.n
+        chans = j % ch
+        win = j // (ch * self.n)
         assert np.array_equal(o[:, 1], slots), "out_slot sequence"
         assert np.array_equal(o[:, 2], F.output_slot_order(self.log2_n)[slots]), "out_bin"
-        expect_k = np.repeat(np.array(last_in), self.n) + self.lat0 + slots
+        assert np.array_equal(o[:, 3], chans), "out_ch_o sequence"
+        # channel c's last sample of window w is step ((w + 1) N - 1) CH + c
+        last_in = ((win + 1) * self.n - 1) * ch + chans
+        expect_k = last_in + self.lat0 + slots * ch
         assert np.array_equal(o[:, 0], expect_k), \
             f"latency: first output at ce {o[0, 0]}, expected {expect_k[0]} (LATENCY0 = {self.lat0})"
-        return o[:, 3].reshape(wins, self.n), o[:, 4].reshape(wins, self.n)
+        yr = o[:, 4].reshape(wins, self.n, ch).transpose(2, 0, 1)
+        yi = o[:, 5].reshape(wins, self.n, ch).transpose(2, 0, 1)
+        for c in range(1, ch):
+            self.check_exact(cr[c], ci[c], yr[c], yi[c], f"channel {c}")
+        return yr[0], yi[0]
 
     def check_exact(self, xr, xi, yr, yi, what):
         mr, mi, movf = F.fft_fixed_slots(xr, xi, self.log2_n, self.in_w, out_w=self.out_w)
@@ -246,11 +278,11 @@ async def reset_mid_window(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-def _run(sim, cfg, out_w=None, comb_min=95.0, testcase=None):
+def _run(sim, cfg, out_w=None, comb_min=95.0, testcase=None, ch=1):
     in_w = cfg.adc_bits + 1
-    prm = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "TW_DIR": f'"{RTL}/"'}
+    prm = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "TW_DIR": f'"{RTL}/"', "CH": ch}
     env = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "BIN_LO": cfg.bin_lo, "ROWS": cfg.rows,
-           "COMB_MIN_DB": comb_min}
+           "COMB_MIN_DB": comb_min, "CH": ch}
     if out_w is not None:
         prm["OUT_W"] = out_w
         env["OUT_W"] = out_w
@@ -266,6 +298,13 @@ def _run(sim, cfg, out_w=None, comb_min=95.0, testcase=None):
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
 def test_fmt_fft_r22sdf(sim, cfg):
     _run(sim, cfg)
+
+
+@pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
+def test_fmt_fft_r22sdf_ch3(sim, cfg):
+    """CH = 3 channels time-multiplexed (the receive array's engine at 3 x fs): every
+    channel bit-exact, out_ch_o, latency in steps, random step gaps, mid-window reset."""
+    _run(sim, cfg, ch=3, testcase="random_ce_always,random_ce_gaps,hard_cases,reset_mid_window")
 
 
 def test_fmt_fft_r22sdf_out_w(sim):

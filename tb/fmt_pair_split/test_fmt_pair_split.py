@@ -27,7 +27,7 @@ class TB(ClockedTB):
         super().__init__(dut)
         self.cfg = params.get(env_str("CFG", "small"))
         self.w = env_int("W", 18)
-        for s in ("ce", "in_valid", "in_bin", "in_re", "in_im", "in_tag"):
+        for s in ("ce", "in_valid", "in_bin", "in_re", "in_im", "in_tag", "in_ch"):
             getattr(dut, s).value = 0
 
     async def run(self, order, z_re, z_im, ce_prob=1.0, rng=None, gaps=False):
