@@ -1,10 +1,17 @@
 // fmt_rx_array -- the receive back end of all columns, emitting the HEAT-MAP STREAM of
-// docs/ARCHITECTURE.md.  Per column pair p (column 2p = lane a, 2p+1 = lane b; COLS even)
-// a fmt_rx_pair_front (despread x2, FFT, pair split, result memory) runs in lockstep with
-// the others; MAG_UNITS magnitude units (fmt_magnitude) and ONE accumulator memory are
-// shared by all columns:
-//   queue   every pair completes a row's comb bins in the same slot (pair 0 stands for
-//           all); {row, log2 M, first, last} enter a FIFO (2^ROW_W entries, LUT RAM)
+// docs/ARCHITECTURE.md.  Column pair p = columns 2p (lane a) and 2p+1 (lane b; COLS
+// even) shares one complex FFT.  FFT_CH = G > 1 (default G = CLK_PER_SAMPLE when
+// POST_CLK = 1): pairs gG .. gG+G-1 share ONE time-multiplexed FFT engine, pair split and
+// capture / despread (fmt_rx_group_front; ceil(PAIRS / G) engines, the last may carry
+// fewer pairs; 30 x 40 at 3 x fs: 7 engines for 20 pairs); ce must then come at most
+// once every G clk (else the sticky overrun is set).  FFT_CH = 1: one
+// fmt_rx_pair_front (despread x2, FFT, pair split, result memory) per pair.  All
+// engines run in lockstep; MAG_UNITS magnitude units (fmt_magnitude) and ONE
+// accumulator memory are shared by all columns:
+//   queue   every engine completes a row's comb bins in the same slot, pair c of an
+//           engine c clk after its pair 0 (engine 0 stands for all); the row is queued
+//           when the last pair has it: {row, log2 M, first, last} enter a FIFO (2^ROW_W
+//           entries, LUT RAM)
 //   engine  takes a row from the FIFO and reads the pairs' result memories at that row
 //           (one address for all pairs), feeding unit u with cell c = g*MAG_UNITS + u in
 //           step g = 0 .. P-1, P = ceil(COLS / MAG_UNITS): a row takes P steps
@@ -31,14 +38,19 @@
 // M = 2^m_log2_i windows (fmt_rx_pair_front); a reset in the middle of a window drops it
 // and the stream restarts with the first full frame.
 // Latency (M = 1), from the ce edge that takes a window's last ADC sample: row r's pair
-// split output is registered LATENCY0 + slot_r + 1 ce cycles later (step a_r); the row is
-// queued at a_r + 1, loaded at L_r >= a_r + 2, and its beat is at step
-// L_r + P + MAG_ITER + 6 (P unit input steps, MAG_ITER + 3 magnitude stages, accumulator
-// read, sum, round, row register).  N = 256, 30 x 40: last row 298 ce cycles after the
-// window's last sample at ce = 1 (K = 10); at 3 x fs (K = 4) 852 clk = 284.0 fs cycles,
-// hm_eof 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
+// split output (the last pair's, FFT_CH > 1) is registered at step a_r = LATENCY0 +
+// slot_r + 1 ce cycles later (FFT_CH = 1) or, FFT_CH = G with ce every G clk, at clk
+// G + LATENCY0 + G slot_r (the FFT's register stages step on clk cycles:
+// rx_fixed.rx_split_clk); the row is queued at a_r + 1, loaded at L_r >= a_r + 2, and its
+// beat is at step L_r + P + MAG_ITER + 6 (P unit input steps, MAG_ITER + 3 magnitude
+// stages, accumulator read, sum, round, row register).  N = 256, 30 x 40: last row 298
+// ce cycles after the window's last sample at ce = 1 (K = 10); at 3 x fs (K = 4) 808
+// clk = 269.3 fs cycles with FFT_CH = 3 (852 clk with FFT_CH = 1), hm_eof 1 step later
+// (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
-// heat-map cell saturated, ovf_o = either or a queue overrun (the magnitude cannot overflow).
+// heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
+// before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
+// cannot overflow).
 // Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (values), rx_row_beats (timing).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -60,7 +72,10 @@ module fmt_rx_array #(
     parameter CLK_PER_SAMPLE = (POST_CLK != 0) ? 3 : 1,   // smallest clk per ce period the
                                            // shared units must keep up with (POST_CLK = 1)
     parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
-    parameter MAG_UNITS  = 0               // shared magnitude units K; 0 = the default rule
+    parameter MAG_UNITS  = 0,              // shared magnitude units K; 0 = the default rule
+    parameter FFT_CH     = (POST_CLK != 0) ? CLK_PER_SAMPLE : 1  // column pairs per FFT engine
+                                           // (time-multiplexed, needs ce at most every
+                                           // FFT_CH clk and POST_CLK = 1); 1 = one engine per pair
 ) (
     input  wire                     clk,
     input  wire                     rst,       // synchronous, active high
@@ -139,47 +154,113 @@ module fmt_rx_array #(
     endgenerate
 
     // ---- per pair: despread, FFT, pair split, result memory ----
-    wire [PAIRS-1:0]        p_valid, p_ovf;
-    wire [PAIRS*ROW_W-1:0]  p_row;
-    wire [PAIRS*(SH_W+2)-1:0] p_tag;
+    // FFT_CH = 1: one fmt_rx_pair_front per pair, in lockstep (pair 0 stands for all).
+    // FFT_CH = G > 1: one fmt_rx_group_front per G pairs (pairs g G .. g G + G-1 share an
+    // engine, the last group may have fewer), all groups in lockstep; pair c of a group
+    // completes a row c clk after pair 0 (group 0 stands for all groups): the row is
+    // queued when group 0's last pair (channel G-1) has it, the hazard check is done
+    // when its first pair (channel 0) rewrites the row.
+    localparam GC    = (FFT_CH > 1) ? FFT_CH : 1;
+    localparam NGRP  = (PAIRS + GC - 1) / GC;
+    localparam GCH_W = (GC > 1) ? $clog2(GC) : 1;
+    localparam integer GCM1 = GC - 1;
+    localparam [GCH_W-1:0] GCH_LAST = GCM1[GCH_W-1:0];
+
     wire [P*K*CW-1:0]       cells;       // the engine's row: cell c = {im, re} at [c*CW +: CW]
     reg  [ROW_W-1:0]        row_q;       // engine row (result memory read address)
+    wire                    push_v;      // a row is complete in every pair: queue it
+    wire [ROW_W-1:0]        push_row;
+    wire [SH_W+1:0]         push_tag;
+    wire                    chk_v;       // a row's result memories start to be rewritten
+    wire [ROW_W-1:0]        chk_row;
+    wire                    seq_ovf;     // a time-multiplexed engine missed a sample
+    wire                    fft_ovf_any;
 
-    // split outputs are used through the result memories only
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire [PAIRS*4*MW-1:0]   p_split;
-    /* verilator lint_on UNUSEDSIGNAL */
-
-    genvar p;
     generate
-        for (p = 0; p < PAIRS; p = p + 1) begin : g_pair
-            fmt_rx_pair_front #(
-                .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-                .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
-                .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
-            ) u_front (
-                .clk(clk), .rst(rst), .ce(ce),
-                .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
-                .adc_b_i(adc_i[(2*p+1)*ADC_BITS +: ADC_BITS]),
-                .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
-                .ps_valid_o(p_valid[p]), .ps_row_o(p_row[p*ROW_W +: ROW_W]),
-                .ps_tag_o(p_tag[p*(SH_W+2) +: SH_W+2]),
-                .ps_ar_o(p_split[(4*p)*MW +: MW]), .ps_ai_o(p_split[(4*p+1)*MW +: MW]),
-                .ps_br_o(p_split[(4*p+2)*MW +: MW]), .ps_bi_o(p_split[(4*p+3)*MW +: MW]),
-                .rd_row_i(row_q), .rd_data_o(cells[p*2*CW +: 2*CW]),   // {cell b, cell a}
-                .fft_ovf_o(p_ovf[p]));
+        if (GC > 1 && POST_CLK == 0) begin : g_check_ch
+            // a shared FFT engine steps on clk cycles: it needs POST_CLK = 1
+            fmt_rx_array_FFT_CH_needs_POST_CLK u_bad ();
         end
         if (P * K > COLS) begin : g_pad
             assign cells[P*K*CW-1:COLS*CW] = {((P*K-COLS)*CW){1'b0}};
         end
     endgenerate
 
-    // the pairs run in lockstep: pair 0's valid, row and tag stand for all
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire [PAIRS-1:0]          unused_valid = p_valid;
-    wire [PAIRS*ROW_W-1:0]    unused_row   = p_row;
-    wire [PAIRS*(SH_W+2)-1:0] unused_tag   = p_tag;
-    /* verilator lint_on UNUSEDSIGNAL */
+    genvar p;
+    generate
+        if (GC == 1) begin : g_pairs
+            wire [PAIRS-1:0]          p_valid, p_ovf;
+            wire [PAIRS*ROW_W-1:0]    p_row;
+            wire [PAIRS*(SH_W+2)-1:0] p_tag;
+            // split outputs are used through the result memories only; the pairs run in
+            // lockstep: pair 0's valid, row and tag stand for all
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [PAIRS*4*MW-1:0]     p_split;
+            wire [PAIRS-1:0]          unused_valid = p_valid;
+            wire [PAIRS*ROW_W-1:0]    unused_row   = p_row;
+            wire [PAIRS*(SH_W+2)-1:0] unused_tag   = p_tag;
+            /* verilator lint_on UNUSEDSIGNAL */
+            for (p = 0; p < PAIRS; p = p + 1) begin : g_pair
+                fmt_rx_pair_front #(
+                    .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
+                    .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
+                    .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
+                ) u_front (
+                    .clk(clk), .rst(rst), .ce(ce),
+                    .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
+                    .adc_b_i(adc_i[(2*p+1)*ADC_BITS +: ADC_BITS]),
+                    .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+                    .ps_valid_o(p_valid[p]), .ps_row_o(p_row[p*ROW_W +: ROW_W]),
+                    .ps_tag_o(p_tag[p*(SH_W+2) +: SH_W+2]),
+                    .ps_ar_o(p_split[(4*p)*MW +: MW]), .ps_ai_o(p_split[(4*p+1)*MW +: MW]),
+                    .ps_br_o(p_split[(4*p+2)*MW +: MW]), .ps_bi_o(p_split[(4*p+3)*MW +: MW]),
+                    .rd_row_i(row_q), .rd_data_o(cells[p*2*CW +: 2*CW]),   // {cell b, cell a}
+                    .fft_ovf_o(p_ovf[p]));
+            end
+            assign push_v      = p_valid[0];
+            assign push_row    = p_row[ROW_W-1:0];
+            assign push_tag    = p_tag[SH_W+1:0];
+            assign chk_v       = p_valid[0];
+            assign chk_row     = p_row[ROW_W-1:0];
+            assign seq_ovf     = 1'b0;
+            assign fft_ovf_any = |p_ovf;
+        end else begin : g_groups
+            wire [NGRP-1:0]          g_valid, g_ovf, g_seq;
+            wire [NGRP*GCH_W-1:0]    g_ch;
+            wire [NGRP*ROW_W-1:0]    g_row;
+            wire [NGRP*(SH_W+2)-1:0] g_tag;
+            // the groups run in lockstep: group 0's valid, channel, row and tag stand for all
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [NGRP*GCH_W-1:0]    unused_ch  = g_ch;
+            wire [NGRP*ROW_W-1:0]    unused_row = g_row;
+            wire [NGRP*(SH_W+2)-1:0] unused_tag = g_tag;
+            wire [NGRP-1:0]          unused_v   = g_valid;
+            /* verilator lint_on UNUSEDSIGNAL */
+            for (p = 0; p < NGRP; p = p + 1) begin : g_grp
+                localparam NPG = (PAIRS - p * GC < GC) ? PAIRS - p * GC : GC;
+                fmt_rx_group_front #(
+                    .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
+                    .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
+                    .TW_DIR(TW_DIR), .G(GC), .NP(NPG), .ROW_W(ROW_W), .SH_W(SH_W),
+                    .CH_W(GCH_W)
+                ) u_front (
+                    .clk(clk), .rst(rst), .ce(ce),
+                    .adc_i(adc_i[(2*p*GC)*ADC_BITS +: 2*NPG*ADC_BITS]),
+                    .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+                    .ps_valid_o(g_valid[p]), .ps_ch_o(g_ch[p*GCH_W +: GCH_W]),
+                    .ps_row_o(g_row[p*ROW_W +: ROW_W]), .ps_tag_o(g_tag[p*(SH_W+2) +: SH_W+2]),
+                    .rd_row_i(row_q), .rd_data_o(cells[p*GC*2*CW +: NPG*2*CW]),
+                    .fft_ovf_o(g_ovf[p]), .seq_ovf_o(g_seq[p]));
+            end
+            assign push_v      = g_valid[0] && (g_ch[GCH_W-1:0] == GCH_LAST);
+            assign push_row    = g_row[ROW_W-1:0];
+            assign push_tag    = g_tag[SH_W+1:0];
+            assign chk_v       = g_valid[0] && (g_ch[GCH_W-1:0] == {GCH_W{1'b0}});
+            assign chk_row     = g_row[ROW_W-1:0];
+            assign seq_ovf     = |g_seq;
+            assign fft_ovf_any = |g_ovf;
+        end
+    endgenerate
 
     // the stages after the split advance on every clk (POST_CLK = 1) or on ce
     wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
@@ -194,13 +275,13 @@ module fmt_rx_array #(
     reg [G_W-1:0]        g_q;            // group being fed
     reg [SH_W+1:0]       etag_q;         // the row's {log2 M, first, last}
 
-    wire q_push = post_ce && p_valid[0];
+    wire q_push = post_ce && push_v;
     wire q_full = (q_cnt_q == QD[ROW_W:0]);
     wire load   = post_ce && (q_cnt_q != {(ROW_W+1){1'b0}}) && (!busy_q || g_q == G_LAST);
     wire [ROW_W+SH_W+1:0] q_head = q_mem[q_rd_q];
 
     always @(posedge clk) begin
-        if (q_push && !q_full) q_mem[q_wr_q] <= {p_row[ROW_W-1:0], p_tag[SH_W+1:0]};
+        if (q_push && !q_full) q_mem[q_wr_q] <= {push_row, push_tag};
     end
 
     always @(posedge clk) begin
@@ -213,7 +294,7 @@ module fmt_rx_array #(
             g_q       <= {G_W{1'b0}};
         end else begin
             if (q_push && !q_full) q_wr_q <= q_wr_q + 1'b1;
-            if ((q_push && q_full) || hazard) overrun_q <= 1'b1;
+            if ((q_push && q_full) || hazard || seq_ovf) overrun_q <= 1'b1;
             if (load)              q_rd_q <= q_rd_q + 1'b1;
             case ({q_push && !q_full, load})
                 2'b10:   q_cnt_q <= q_cnt_q + 1'b1;
@@ -230,12 +311,11 @@ module fmt_rx_array #(
         end
     end
 
-    // data hazard: a row completes again (its result memories are rewritten) while the
-    // previous window's copy is still queued or being fed
+    // data hazard: a row completes again (its result memories start to be rewritten)
+    // while the previous window's copy is still queued or being fed
     reg  [ROWS-1:0]  pend_q;             // row queued or being fed
-    wire [ROW_W-1:0] push_row = p_row[ROW_W-1:0];
     wire             fed     = post_ce && busy_q && (g_q == G_LAST);   // row_q's last group read
-    wire             hazard  = q_push && pend_q[push_row] && !(fed && row_q == push_row);
+    wire             hazard  = post_ce && chk_v && pend_q[chk_row] && !(fed && row_q == chk_row);
     always @(posedge clk) begin
         if (rst) begin
             pend_q <= {ROWS{1'b0}};
@@ -433,7 +513,7 @@ module fmt_rx_array #(
         if (post_ce && row_done) hm_row <= c_row_q;
     end
 
-    assign fft_ovf_o = |p_ovf;
+    assign fft_ovf_o = fft_ovf_any;
     assign sat_o     = sat_q;
     assign ovf_o     = fft_ovf_o | sat_q | overrun_q;
 

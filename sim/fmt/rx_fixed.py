@@ -264,14 +264,42 @@ def max_completions_in(cfg, slots: int = 8) -> int:
     return int(max(np.searchsorted(s, v + slots) - i for i, v in enumerate(s)))
 
 
+def rx_fft_ch_default(post_clk: int = 1, cps=None) -> int:
+    """fmt_rx_array's default FFT_CH: column pairs per time-multiplexed FFT engine,
+    CLK_PER_SAMPLE when POST_CLK = 1, else 1 (one engine per pair)."""
+    if cps is None:
+        cps = 3 if post_clk else 1
+    return cps if post_clk else 1
+
+
+def rx_split_clk(latency0: int, slot: int, every: int, fft_ch: int, ch: int) -> int:
+    """clk cycle (from the ce edge that takes a window's last ADC sample, that edge = 0)
+    at whose end the pair split registers slot ``slot`` of pair ``ch`` of an engine.
+    fft_ch = 1 (fmt_rx_pair_front): the despread register, then LATENCY0 + slot ce
+    cycles: (latency0 + 1 + slot) * every.  fft_ch = G > 1 (fmt_rx_group_front): channel
+    c enters on the clk c + 1 after the ce edge (step j G + c for sample j); slot s leaves
+    the FFT on step t_c + latency0 + s G; step j G + q runs on clk j every + 1 + q (the
+    engine steps on the G clk cycles after each ce, ce every ``every`` >= G clk)."""
+    if fft_ch <= 1:
+        return (latency0 + 1 + slot) * every
+    if every < fft_ch:
+        raise ValueError(f"ce every {every} clk is too fast for {fft_ch} pairs per FFT engine")
+    d = ch + latency0 + slot * fft_ch          # steps after the last sample's channel-0 step
+    return (d // fft_ch) * every + 1 + d % fft_ch
+
+
 def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None,
-                 units=None):
+                 units=None, fft_ch=None):
     """clk cycles from the ce edge that takes a window's last ADC sample to each row's
     heat-map beat (M = 1), dict row -> clk.  every = clk per ce in the run; cps =
     fmt_rx_array CLK_PER_SAMPLE (default: 3 if post_clk else 1); units = MAG_UNITS
-    (default: the rule).  latency0 = fft_fixed.latency0 of the receiver's FFT."""
+    (default: the rule); fft_ch = FFT_CH (default rx_fft_ch_default: the row is queued
+    when the engine's last pair, channel FFT_CH - 1, has it).  latency0 =
+    fft_fixed.latency0 of the receiver's FFT."""
     if cps is None:
         cps = 3 if post_clk else 1
+    if fft_ch is None:
+        fft_ch = rx_fft_ch_default(post_clk, cps)
     steps_cfg = cps if post_clk else 1        # what the RTL sizes K for
     if units is None:
         units = rx_mag_units_default(cfg, steps_cfg)
@@ -280,5 +308,6 @@ def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None
     p, sched, keeps, _ = rx_share_schedule(cfg, units, steps_run)
     if not keeps:
         raise ValueError(f"{units} magnitude units do not keep up at {steps_run} steps per slot")
-    base = (latency0 + 1) * every             # split of slot 0, clk (a ce edge)
+    # split of slot 0 (the queue push), clk; the schedule counts from there
+    base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1)
     return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}

@@ -38,7 +38,7 @@ FLOAT_BOUND_LSB = 2.0
 # the precompiled-header rule of split (parallel) C++ builds: build unsplit.  -O0: the
 # C++ compile dominates these short runs.
 VERILATOR_ARGS = ["--output-split", "0", "-CFLAGS", "-O0"]
-RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
+RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_rx_group_front", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
              "fmt_fft_delay", "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
 
 
@@ -48,6 +48,8 @@ class TB(ClockedTB):
         self.cfg = params.get(env_str("CFG", "small"))
         if env_int("COLS", 0):
             self.cfg = self.cfg.replace(cols=env_int("COLS", 0))
+        # column pairs per FFT engine: ce may come at most every fft_ch clk
+        self.fft_ch = env_int("FFT_CH", 1)
         dut.ce.value = 0
         dut.adc_i.value = 0
         dut.rx_sign_i.value = 0
@@ -74,7 +76,7 @@ class TB(ClockedTB):
         dut, cfg = self.dut, self.cfg
         n = cfg.n_fft
         if ce_every is None:
-            ce_every = env_int("CE_EVERY", 1)
+            ce_every = env_int("CE_EVERY", self.fft_ch)
         tail = n + 80 if tail is None else tail
         total = len(adc) + tail
         beats, eofs, taken = [], [], []
@@ -203,7 +205,7 @@ async def reset_mid_window(dut):
     check_exact(tb, adc, rx, 0, beats, eofs)
 
 
-def row_beats_formula(cfg, every=1, post_clk=1, cps=None):
+def row_beats_formula(cfg, every=1, post_clk=1, cps=None, fft_ch=None):
     """clk cycles from the ce edge that takes a window's last ADC sample to the edge that
     puts each row on the heat-map stream (M = 1), dict row -> clk: the pair split takes
     slot s on the ce edge latency0 + s + 1 ce cycles later (latency0 counts from the FFT
@@ -212,7 +214,7 @@ def row_beats_formula(cfg, every=1, post_clk=1, cps=None):
     unit input steps, MAG_ITER + 3 magnitude stages, accumulator read, sum, round, row
     register; a step is a clk with POST_CLK = 1, a ce period with POST_CLK = 0)."""
     lat0 = fft_fixed.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
-    return R.rx_row_beats(cfg, lat0, every, post_clk, cps)
+    return R.rx_row_beats(cfg, lat0, every, post_clk, cps, fft_ch=fft_ch)
 
 
 @cocotb.test()
@@ -226,14 +228,18 @@ async def latency_and_slow_ce(dut):
     post_clk = env_int("POST_CLK", 1)
     cps = env_int("CPS", 3 if post_clk else 1)
     res = {}
-    for every in [int(x) for x in env_str("EVERY_LIST", "1,3").split(",")]:
+    fch = tb.fft_ch
+    # a time-multiplexed engine (FFT_CH > 1) needs ce every >= FFT_CH clk: its exact rate
+    # and one clk more (engine idle one clk per sample)
+    every_default = "1,3" if fch == 1 else f"{fch},{fch + 1}"
+    for every in [int(x) for x in env_str("EVERY_LIST", every_default).split(",")]:
         tx, rx, _ = rx_stim.pn(cfg, n, rng)
         adc = rx_stim.tones(cfg, n, rng, tx=tx)
         await tb.reset()
         beats, eofs, taken = await tb.run(adc, rx, 0, ce_every=every)
         check_exact(tb, adc, rx, 0, beats, eofs, float_check=False)
         last_in = taken[n - 1]                      # clk of the window's last sample
-        exp = row_beats_formula(cfg, every, post_clk, cps)
+        exp = row_beats_formula(cfg, every, post_clk, cps, fch)
         got = {b[1]: b[0] - last_in for b in beats[:cfg.rows]}
         assert got == exp, f"ce every {every}: row beats (row: clk) {got}, schedule {exp}"
         lat_row = beats[cfg.rows - 1][0] - last_in  # clk cycles to the last row beat
@@ -243,7 +249,7 @@ async def latency_and_slow_ce(dut):
         assert not int(dut.ovf_o.value), "queue overrun / overflow flag"
         res[every] = (lat_row, lat_eof)
     lines = [f"{cfg.name} (CLK_PER_SAMPLE {cps}, POST_CLK {post_clk}, MAG_UNITS "
-             f"{R.rx_mag_units_default(cfg, cps if post_clk else 1)}): "
+             f"{R.rx_mag_units_default(cfg, cps if post_clk else 1)}, FFT_CH {fch}): "
              f"last ADC sample of a window -> last heat-map row / hm_eof:"]
     budget = int(8e-6 * cfg.fs_hz)
     for every, (row, eof) in res.items():
@@ -281,7 +287,8 @@ async def overrun_flag(dut):
 def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1, cps=None, params_extra=None):
     cfg = params.get(cfg_name)
     cps = (3 if post_clk else 1) if cps is None else cps
-    env = {"CFG": cfg_name, "POST_CLK": post_clk, "CPS": cps}
+    fft_ch = (params_extra or {}).get("FFT_CH", R.rx_fft_ch_default(post_clk, cps))
+    env = {"CFG": cfg_name, "POST_CLK": post_clk, "CPS": cps, "FFT_CH": fft_ch}
     env.update(extra or {})
     run_cocotb(
         sim=sim,

@@ -1,0 +1,190 @@
+// fmt_rx_group_front -- front half of NP <= G column-pair receivers that share ONE
+// time-multiplexed FFT engine (fmt_fft_r22sdf CH = G) and one pair split: capture,
+// despread, FFT, pair split, window / frame bookkeeping and the pairs' result memories
+// (fmt_rx_array with FFT_CH = G; fmt_rx_pair_front is the one-pair-per-engine form).
+//
+// Sequencing: the ce edge that takes ADC sample k latches the 2 NP columns and the
+// receive PN sign (capture registers); on the G clk cycles after it the engine takes
+// pair 0, 1, .., G-1 (channel c on cycle c + 1 after the ce cycle; pairs NP .. G-1 of a
+// partly used engine get zeros), each despread on the way in (sign ? -x : x, ADC_BITS + 1
+// bits, the arithmetic of fmt_despread, one negation per engine lane instead of one per
+// column).  So ce must come at most once every G clk cycles: a ce before the G steps of
+// the previous sample are done sets the sticky seq_ovf_o (the samples are then lost).
+// The FFT, the split and the result memories advance on the engine's steps / every clk.
+//
+// Frames and tags as fmt_rx_pair_front: window k = ADC samples k*N .. k*N + N-1 counted
+// from the first ce after reset; M = 2^m_log2_i windows per frame (sampled when channel
+// 0 starts a window, clamped to M_LOG2_MAX); ps_tag = {log2 M, first window, last window}.
+// Timing: channel c of ADC sample j enters the FFT input register on the edge c + 1
+// clk after sample j's ce edge (step j G + c); its window's slot s leaves the FFT on step
+// t_c + LATENCY0 + s G (fmt_fft_r22sdf) and the split registers it on that step's edge;
+// ps_* show it from the next clk (ps_ch_o = c); the result memory of pair c is written
+// on the next edge (rd_data_o shows it from then on, asynchronous read: LUT RAM).  With
+// ce every G clk (the 3 x fs build) the steps are consecutive clk cycles, so pair c's
+// row r leaves c clk after pair 0's, LATENCY0 + slot_r samples after the window minus
+// LATENCY0 (G - 1) clk (the register stages count clk cycles, not samples).
+// Formats: FFT output W = FFT_OUT_W bits = X * 2^-FFT_SHIFT (see fmt_col_pair_rx);
+// split outputs 2A, 2B exact, W + 1 bits signed.  Flags: fft_ovf_o, seq_ovf_o sticky.
+// Twin: sim/fmt/rx_fixed.py (values rx_heatmaps_fixed, timing rx_row_beats).
+`default_nettype none
+`include "fmt_defaults.vh"
+
+module fmt_rx_group_front #(
+    parameter LOG2_N     = `FMT_LOG2_N,    // FFT size N = 2^LOG2_N
+    parameter ROWS       = `FMT_ROWS,      // comb bins (rows)
+    parameter BIN_LO     = `FMT_BIN_LO,    // bin of row 0
+    parameter BIN_STEP   = `FMT_BIN_STEP,  // bins between rows
+    parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
+    parameter M_LOG2_MAX = 3,              // largest log2 M
+    parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
+    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter G          = 3,              // column pairs per engine (FFT channels), >= 2
+    parameter NP         = G,              // pairs actually connected, 1..G
+    parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
+    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1, // width of m_log2_i
+    parameter CH_W       = (G > 1) ? $clog2(G) : 1              // channel index width
+) (
+    input  wire                       clk,
+    input  wire                       rst,        // synchronous, active high
+    input  wire                       ce,         // sample strobe, at most one per G clk
+    input  wire [2*NP*ADC_BITS-1:0]   adc_i,      // pair j: column a at [2j*ADC_BITS], b at [(2j+1)*ADC_BITS]
+    input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
+    input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
+    output wire                       ps_valid_o, // a row of pair ps_ch_o completed (split output valid)
+    output wire [CH_W-1:0]            ps_ch_o,    // its pair within the group (channel)
+    output wire [ROW_W-1:0]           ps_row_o,   // its row index
+    output wire [SH_W+1:0]            ps_tag_o,   // {log2 M, first window, last window}
+    input  wire [ROW_W-1:0]           rd_row_i,   // result memory read address (row)
+    output wire [NP*(4*FFT_OUT_W+4)-1:0] rd_data_o, // pair j: {2 Im B, 2 Re B, 2 Im A, 2 Re A} at [j*4*(W+1)]
+    output wire                       fft_ovf_o,  // sticky FFT saturation
+    output reg                        seq_ovf_o   // sticky: ce came before the G steps were done
+);
+
+    localparam W  = FFT_OUT_W;
+    localparam MW = W + 1;
+    localparam XW = ADC_BITS + 1;
+    localparam [M_LOG2_MAX:0] ONE  = 1;
+    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
+    localparam integer        GM1  = G - 1;
+    localparam [CH_W-1:0]     CH_LAST = GM1[CH_W-1:0];
+
+    // ---- capture (on ce) and step sequencer ----
+    reg [2*NP*ADC_BITS-1:0] cap_q;
+    reg                     sign_q;
+    reg                     run_q;       // the engine steps this clk
+    reg [CH_W-1:0]          ch_q;        // channel (pair) of this step
+
+    always @(posedge clk) begin
+        if (ce) begin
+            cap_q  <= adc_i;
+            sign_q <= rx_sign_i;
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            run_q     <= 1'b0;
+            ch_q      <= {CH_W{1'b0}};
+            seq_ovf_o <= 1'b0;
+        end else if (ce) begin
+            run_q <= 1'b1;
+            ch_q  <= {CH_W{1'b0}};
+            if (run_q && ch_q != CH_LAST) seq_ovf_o <= 1'b1;
+        end else if (run_q) begin
+            if (ch_q == CH_LAST) run_q <= 1'b0;
+            else                 ch_q  <= ch_q + 1'b1;
+        end
+    end
+
+    // synthesis translate_off
+    always @(posedge clk) begin
+        if (!rst && ce && run_q && ch_q != CH_LAST)
+            $display("%m: ERROR: ce at %0t before the %0d engine steps of the previous sample", $time, G);
+    end
+    // synthesis translate_on
+
+    // ---- channel select and despread: x = sign ? -adc : adc (ADC_BITS + 1 bits) ----
+    reg signed [ADC_BITS-1:0] sel_a, sel_b;
+    integer j;
+    always @* begin
+        sel_a = {ADC_BITS{1'b0}};
+        sel_b = {ADC_BITS{1'b0}};
+        for (j = 0; j < NP; j = j + 1) begin
+            if (ch_q == j[CH_W-1:0]) begin
+                sel_a = cap_q[(2*j)*ADC_BITS +: ADC_BITS];
+                sel_b = cap_q[(2*j+1)*ADC_BITS +: ADC_BITS];
+            end
+        end
+    end
+    wire signed [XW-1:0] ext_a = {sel_a[ADC_BITS-1], sel_a};
+    wire signed [XW-1:0] ext_b = {sel_b[ADC_BITS-1], sel_b};
+    wire signed [XW-1:0] xa    = sign_q ? -ext_a : ext_a;
+    wire signed [XW-1:0] xb    = sign_q ? -ext_b : ext_b;
+
+    // ---- FFT: G channels ----
+    wire                f_valid;
+    wire [LOG2_N-1:0]   f_slot, f_bin;
+    wire [CH_W-1:0]     f_ch;
+    wire signed [W-1:0] f_re, f_im;
+    fmt_fft_r22sdf #(
+        .LOG2_N(LOG2_N), .IN_W(XW), .OUT_W(W), .TW_DIR(TW_DIR), .CH(G), .CH_W(CH_W)
+    ) u_fft (
+        .clk(clk), .rst(rst), .ce(run_q), .in_re(xa), .in_im(xb),
+        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
+        .out_re(f_re), .out_im(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
+
+    // ---- window / frame bookkeeping (at the FFT output; channel 0 opens a window) ----
+    reg                  started_q;
+    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
+    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
+    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
+    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
+    wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}}) && (f_ch == {CH_W{1'b0}});
+    wire                 wrap    = !started_q || (wcnt_q == last_q);
+    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
+    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
+    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
+    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
+    wire                 w_last  = (w_cur == last_cur);
+
+    always @(posedge clk) begin
+        if (rst) begin
+            started_q <= 1'b0;
+            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
+            m_q       <= {SH_W{1'b0}};
+        end else if (new_win) begin
+            started_q <= 1'b1;
+            wcnt_q    <= w_cur;
+            m_q       <= m_cur;
+        end
+    end
+
+    // ---- pair split, shared by the G channels ----
+    wire signed [MW-1:0] s_ar, s_ai, s_br, s_bi;
+    fmt_pair_split #(
+        .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
+        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W), .CH(G), .CH_W(CH_W)
+    ) u_split (
+        .clk(clk), .rst(rst), .ce(1'b1),
+        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
+        .in_tag({m_cur, w_first, w_last}), .in_ch(f_ch),
+        .out_valid(ps_valid_o), .out_row(ps_row_o),
+        .a_re(s_ar), .a_im(s_ai), .b_re(s_br), .b_im(s_bi), .out_tag(ps_tag_o),
+        .out_ch(ps_ch_o));
+
+    // ---- result memories, one per pair (read all at once by the shared magnitude units)
+    genvar p;
+    generate
+        for (p = 0; p < NP; p = p + 1) begin : g_res
+            reg [4*MW-1:0] res_mem [0:ROWS-1];
+            always @(posedge clk) begin
+                if (ps_valid_o && ps_ch_o == p[CH_W-1:0])
+                    res_mem[ps_row_o] <= {s_bi, s_br, s_ai, s_ar};
+            end
+            assign rd_data_o[p*4*MW +: 4*MW] = res_mem[rd_row_i];
+        end
+    endgenerate
+
+endmodule
+
+`default_nettype wire
