@@ -43,14 +43,15 @@
 //            at or after the round-robin pointer; generation + 1; id = {gen, slot};
 //            no free slot -> the touch is dropped (sticky noslot_flag_o).  The cycle
 //            that finds no touch left marks the frame's last event.
-//   UPDATE   MAX_TOUCHES cycles after the last event, one slot per cycle: every
-//            active slot neither matched nor new: miss + 1, p += v.  busy_o stays high.
+//   UPDATE   after the last event, one slot per cycle, lowest first: every active slot
+//            neither matched nor new (a contact in hold-off): miss + 1, p += v; then
+//            one cycle to clear the frame.  busy_o stays high until then.
 // Events leave through a one-event holding register (to mark ev_last_o).  With m
 // matches, k stale picks, l lifts, n news and d new touches without a free slot, the
 // frame's last event is on the output m + 2k + l + n + d + 4 cycles after the tp_eof
 // cycle (MATCH m + 2k + 1, LIFT l + 1, NEW n + d + 1, holding register 1); one more
-// when the last touch arrives in the tp_eof cycle.  busy_o falls MAX_TOUCHES cycles
-// after the last event.  A frame with no events emits nothing.  Touches of the next
+// when the last touch arrives in the tp_eof cycle.  busy_o falls h + 1 cycles after
+// the last event (h contacts in hold-off).  A frame with no events emits nothing.  Touches of the next
 // frame must not arrive before the tracker is idle again (overrun_flag_o; they are
 // dropped).  tp_frame_i is sampled with every touch and with tp_eof (event frame).
 //
@@ -138,13 +139,12 @@ module fmt_tracker #(
     reg                 rc_q;                     // recompute the row of rc_t_q this cycle
     reg [SB-1:0]        rc_t_q;
     reg [MT-1:0]        tused_q;                  // touch assigned (matched / new / dropped)
-    reg [MT-1:0]        sused_q;                  // slot matched or newly allocated
+    reg [MT-1:0]        sused_q;                  // slot matched, newly allocated or updated
     reg [MT-1:0]        act_q;                    // slot active
     reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
     reg [MT*PR_W-1:0]   prx_q, pry_q;             // rounded, saturated predictions
     reg [MT*GEN_W-1:0]  gen_q;                    // generation counters
     reg [SB-1:0]        next_slot_q;              // round-robin allocation pointer
-    reg [SB-1:0]        u_q;                      // UPDATE: slot of this cycle
     reg                 mv_q;                     // the pair assigned last cycle: move now
     reg [SB-1:0]        mv_s_q, mv_t_q;
     // event holding register
@@ -308,6 +308,16 @@ module fmt_tracker #(
     end
     wire [SB-1:0] f_next = ({1'b0, f_s} == MT - 1) ? {SB{1'b0}} : f_s + 1'b1;
 
+    // ---- update: lowest active slot neither matched, new nor updated yet -------------
+    reg          u_found;
+    reg [SB-1:0] u_s;
+    always @* begin
+        u_found = |(act_q & ~sused_q);
+        u_s = {SB{1'b0}};
+        for (s_i = MT - 1; s_i >= 0; s_i = s_i - 1)
+            if (act_q[s_i] && !sused_q[s_i]) u_s = s_i[SB-1:0];
+    end
+
     // ---- slot RAM port (read and write at one address) and touch RAM read ------------
     reg  [SB-1:0]    sa;             // slot of this cycle
     always @* begin
@@ -315,7 +325,7 @@ module fmt_tracker #(
             S_MATCH: sa = mv_s_q;
             S_LIFT:  sa = l_s;
             S_NEW:   sa = f_s;
-            S_UPD:   sa = u_q;
+            S_UPD:   sa = u_s;
             default: sa = mv_s_q;
         endcase
     end
@@ -351,7 +361,7 @@ module fmt_tracker #(
     // unmatched slot in hold-off: p + v
     wire [P_W-1:0]   u_px  = s_px + {{(P_W-V_W){s_vx[V_W-1]}}, s_vx};
     wire [P_W-1:0]   u_py  = s_py + {{(P_W-V_W){s_vy[V_W-1]}}, s_vy};
-    wire             u_en  = (state_q == S_UPD) && act_q[u_q] && !sused_q[u_q];
+    wire             u_en  = (state_q == S_UPD) && u_found;
     wire             n_en  = (state_q == S_NEW) && n_found && f_found;
 
     // slot write: move (mv_q, in MATCH), new, update
@@ -405,7 +415,7 @@ module fmt_tracker #(
     always @* begin
         u_miss = {HOLD_W{1'b0}};
         for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            u_miss = u_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{u_q == s_i[SB-1:0]}});
+            u_miss = u_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{u_s == s_i[SB-1:0]}});
     end
     wire [HOLD_W-1:0] w_miss = (state_q == S_UPD) ? u_miss + 1'b1 : {HOLD_W{1'b0}};
 
@@ -449,7 +459,6 @@ module fmt_tracker #(
             pry_q          <= {(MT*PR_W){1'b0}};
             gen_q          <= {(MT*GEN_W){1'b0}};
             next_slot_q    <= {SB{1'b0}};
-            u_q            <= {SB{1'b0}};
             mv_q           <= 1'b0;
             mv_s_q         <= {SB{1'b0}};
             mv_t_q         <= {SB{1'b0}};
@@ -546,12 +555,12 @@ module fmt_tracker #(
                         end
                     end else begin
                         state_q <= S_UPD;
-                        u_q     <= {SB{1'b0}};
                     end
                 end
                 S_UPD: begin
-                    u_q <= u_q + 1'b1;
-                    if ({1'b0, u_q} == MT - 1) begin
+                    if (u_found) begin
+                        sused_q[u_s] <= 1'b1;     // updated
+                    end else begin
                         tcnt_q  <= {TCW{1'b0}};
                         tused_q <= {MT{1'b0}};
                         sused_q <= {MT{1'b0}};

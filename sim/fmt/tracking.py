@@ -331,8 +331,9 @@ def tail_cycles(events, stale: int, no_slot: int) -> int:
     lifts, n news), ``stale`` stale picks (:func:`lazy_greedy`) and ``no_slot`` new
     touches without a free slot: MATCH m + 2 stale + 1, LIFT l + 1, NEW n + no_slot + 1,
     holding register 1.  Touches end before the tp_eof cycle (one more cycle if the
-    last touch comes with tp_eof).  The tracker stays busy max_touches cycles longer
-    (UPDATE).  Before the lazy minima the RTL took 2m + l + n + no_slot + 6."""
+    last touch comes with tp_eof).  busy stays high h + 1 cycles longer (UPDATE of
+    the h contacts in hold-off).  Before the lazy minima the RTL took
+    2m + l + n + no_slot + 6."""
     return len(events) + 2 * stale + no_slot + 4
 
 

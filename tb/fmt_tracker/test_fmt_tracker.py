@@ -9,8 +9,8 @@ frame.  Also measures and checks the tail latency: the frame's last event is on 
 output exactly fmt.tracking.tail_cycles cycles after the tp_eof cycle,
 n_events + 2 n_stale + n_noslot + 4 (n_stale = stale picks of the lazy match, counted
 by fmt.tracking.lazy_greedy on the model's candidate matrix; n_noslot = new touches
-dropped for want of a slot, one cycle each), and that busy_o falls MAX_TOUCHES cycles
-(the slot update) after that.  The worst case of the match (all touches ranking the
+dropped for want of a slot, one cycle each), and that busy_o falls h + 1 cycles after
+that (h = contacts in hold-off, updated one per cycle).  The worst case of the match (all touches ranking the
 slots alike, 120 stale picks at 16) is a test of its own.
 """
 from __future__ import annotations
@@ -158,8 +158,10 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             lat = got[-1][0] - eof + 1
             assert lat == tail_cycles(exp, stale, noslot) + int(eof_with_last and bool(touches)), \
                 f"tail latency {lat} for {len(got)} events, {stale} stale picks"
-            # the slot update: busy_o low MAX_TOUCHES cycles after the last event
-            assert tb.idle_cycle - got[-1][0] == tb.mt, "busy after the last event"
+            # the update of the h contacts in hold-off (active, missed this frame):
+            # busy_o low h + 1 cycles after the last event
+            h = sum(1 for st in model.slots if st.active and st.miss > 0)
+            assert tb.idle_cycle - got[-1][0] == h + 1, "busy after the last event"
             tail.append((len(got), stale, lat))
         tb.stale_total += stale
     return model, tail
