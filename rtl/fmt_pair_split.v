@@ -12,10 +12,13 @@
 // a bit saying whether it was k or N-k); when its partner arrives, (2A, 2B) of row r
 // leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
 // clears it.  Twin: sim/fmt/rx_fixed.py pair_split_fixed.
-// Channels (CH > 1): the input interleaves CH independent FFT streams (fmt_fft_r22sdf
-// CH, in_ch = its out_ch_o); the held memory and bits are per {channel, row} (CH x
-// 2^ROW_W entries, still LUT RAM), out_ch names the output's channel.  One split serves
-// the CH column pairs of one time-multiplexed FFT engine.
+// Channels (CH > 1): the input interleaves CH FFT streams in lockstep (fmt_fft_r22sdf
+// CH, in_ch = its out_ch_o): every bin arrives for channel 0, 1, .., CH-1 in turn, all
+// channels in the same bin order.  The held memory is per {channel, row} (CH x 2^ROW_W
+// entries, LUT RAM); the held bits stay one per row, read by every channel and updated
+// by channel CH-1 (the channels of a bin all see the state before that bin).  out_ch
+// names the output's channel.  One split serves the CH column pairs of one
+// time-multiplexed FFT engine.
 // Requires BIN_LO >= 1 and BIN_LO + (ROWS-1)*BIN_STEP < N/2 (checked by params.py), so
 // a bin and its mirror are never the same bin.  BIN_STEP that is not a power of two
 // costs a constant divider on the bin index.
@@ -82,12 +85,17 @@ module fmt_pair_split #(
     // ---- held first-of-pair memory, per {channel, row} ----
     localparam AW = (CH > 1) ? CH_W + ROW_W : ROW_W;
     localparam MD = (CH > 1) ? (1 << AW) : ROWS;
-    wire [AW-1:0] addr;
+    localparam integer CHM1 = CH - 1;
+    localparam [CH_W-1:0] CH_LAST = CHM1[CH_W-1:0];
+    wire [AW-1:0] addr;                    // held memory address {channel, row}
+    wire          upd;                     // the last channel of this bin: update held_q
     generate
         if (CH > 1) begin : g_ch
             assign addr = {in_ch, row};
+            assign upd  = (in_ch == CH_LAST);
         end else begin : g_one
             assign addr = row;
+            assign upd  = 1'b1;
             // one channel: in_ch is not used
             /* verilator lint_off UNUSEDSIGNAL */
             wire unused_ch = &{1'b0, in_ch};
@@ -95,11 +103,11 @@ module fmt_pair_split #(
         end
     endgenerate
 
-    reg [2*W:0]   mem [0:MD-1];            // {is_mirror, re, im}
-    reg [MD-1:0]  held_q;
+    reg [2*W:0]    mem [0:MD-1];           // {is_mirror, re, im}
+    reg [ROWS-1:0] held_q;                 // per row, shared by the channels
 
     wire [2*W:0]        rd       = mem[addr];
-    wire                held     = held_q[addr];
+    wire                held     = held_q[row];
     wire signed [W-1:0] h_re     = rd[2*W-1:W];
     wire signed [W-1:0] h_im     = rd[W-1:0];
     // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
@@ -119,17 +127,17 @@ module fmt_pair_split #(
 
     always @(posedge clk) begin
         if (rst) begin
-            held_q    <= {MD{1'b0}};
+            held_q    <= {ROWS{1'b0}};
             out_valid <= 1'b0;
         end else if (ce) begin
             out_valid <= 1'b0;
             if (hit) begin
                 // the second arrival must be the other member of the pair
                 if (second) begin
-                    held_q[addr] <= 1'b0;
-                    out_valid   <= 1'b1;
-                end else begin
-                    held_q[addr] <= 1'b1;  // first arrival (or a repeat: keep the newest)
+                    if (upd) held_q[row] <= 1'b0;
+                    out_valid <= 1'b1;
+                end else if (upd) begin
+                    held_q[row] <= 1'b1;   // first arrival (or a repeat: keep the newest)
                 end
             end
         end
