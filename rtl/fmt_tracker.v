@@ -4,19 +4,20 @@
 // cycle count of the match is modelled by tracking.lazy_greedy (see MATCH below).
 //
 // Contact table: MAX_TOUCHES slots.  In flip-flops (read by all slots in parallel):
-// active flag, miss counter (frames since last seen) and the rounded prediction,
-// saturated to PR_W = 18 bits signed per axis (exact for the gate test: a prediction
-// outside [-2^16, 2^17) is more than 65535 from any x in [0, 65535], so never a
-// candidate, saturated or not) and generation counter.  In a LUT RAM (one word per
-// slot, one slot per cycle; written by NEW before it is read, so not reset): predicted
-// position p (signed, Q.(8+VF): Q8.8 cells with VF extra fraction bits), velocity v
-// (signed V_W bits, 2^-(8+VF) cells/frame) and last measured position (lift event).
+// active flag, miss counter (frames since last seen), generation counter and the
+// rounded prediction pred = (p + 2^(VF-1)) >>> VF per axis, formed when p is written
+// and clamped to PR_W = 18 bits signed, [-2^17, 2^17) (exact for the gate test: a
+// prediction outside that range is, clamped or not, more than 65535 from any x in
+// [0, 65535], so never a candidate).  In a LUT RAM (one word per slot, one slot per
+// cycle; written by NEW before it is read, so not reset): predicted position p
+// (signed, Q.(8+VF): Q8.8 cells with VF extra fraction bits), velocity v (signed V_W
+// bits, 2^-(8+VF) cells/frame) and last measured position (for the lift event).
 //
 // Per frame:
 //   COLLECT  touches arrive (tp_valid, any cycles).  In the cycle a touch arrives its
 //            record goes to a LUT RAM and its L1 distance to the prediction of every
-//            slot is computed in parallel, D = |x - pred_x| + |y - pred_y| with
-//            pred = (p + 2^(VF-1)) >>> VF, and stored (one LUT-RAM row per touch) with
+//            slot is computed in parallel, D = |x - pred_x| + |y - pred_y|, and
+//            stored (one LUT-RAM row per touch, D kept to 16 bits) with
 //            a candidate bit = slot active and D <= gate (max_jump_i for a contact
 //            seen last frame, hold_jump_i for one in hold-off).  The next cycle the row
 //            is read back and one shared min tree over the slots (ties to the lower
@@ -28,8 +29,9 @@
 //            unassigned touches.  Cached keys only grow as slots are taken, so each is
 //            a lower bound of that touch's current key: if the picked touch's cached
 //            slot is still free the pair IS the global greedy choice and is assigned
-//            (1 cycle); otherwise (stale) the touch's row is re-read and its minimum
-//            over the free slots recomputed (1 more cycle), and the pick repeats.  The
+//            (1 cycle); otherwise the pick is stale: the touch's row is re-read and
+//            its minimum over the free slots recomputed (2 cycles in all), and the
+//            pick repeats.  The
 //            cycle after an assignment a move event is issued and the slot's
 //            velocity/prediction updated:
 //              e = (x << VF) - p;  v = clamp(v + (e >>> vel_shift_i), +-max_speed_i);
@@ -50,8 +52,10 @@
 // matches, k stale picks, l lifts, n news and d new touches without a free slot, the
 // frame's last event is on the output m + 2k + l + n + d + 4 cycles after the tp_eof
 // cycle (MATCH m + 2k + 1, LIFT l + 1, NEW n + d + 1, holding register 1); one more
-// when the last touch arrives in the tp_eof cycle.  busy_o falls h + 1 cycles after
-// the last event (h contacts in hold-off).  A frame with no events emits nothing.  Touches of the next
+// when the last touch arrives in the tp_eof cycle.  (Before the lazy minima: 2m + l +
+// n + d + 6.)  Worst case 16 + 240 + 4 = 260 at 16 touches and slots, well inside a
+// frame of 768 clk at 3 x fs.  busy_o falls h + 1 cycles after the last event (h =
+// contacts in hold-off).  A frame with no events emits nothing.  Touches of the next
 // frame must not arrive before the tracker is idle again (overrun_flag_o; they are
 // dropped).  tp_frame_i is sampled with every touch and with tp_eof (event frame).
 //
