@@ -23,11 +23,13 @@
 //       for a free slot only if that bound were wrong; nothing is ever dropped).
 //   X2..X4: masked sums of the run (area, sum z, sum z*c, sum z*r = r * sum z, peak and
 //       its first column, first/last column), 8-column groups then totals
-//   A : the command updates the per-label accumulators (registers): NEW writes the run,
-//       ADD combines the run, MERGE combines label B into A (B is free again).
+//   A : the command updates the per-label accumulators (a distributed RAM, one write
+//       and three asynchronous reads): NEW writes the run, ADD combines the run, MERGE
+//       combines label B into A (B is free again).
 //   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
 //       inserted into a sorted list of MAX_BLOBS entries (area descending, ties by the
-//       raster index of the region's first cell ascending); the smallest falls off.
+//       raster index of the region's first cell ascending); the smallest falls off.  The
+//       list holds the keys and a slot number; the entries sit in distributed RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
 // same for cy) by two pipelined fmt_div (QW + 1 cycles, QW = max index width + 8), one
@@ -139,6 +141,7 @@ module fmt_blob #(
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;
     localparam MB     = MAX_BLOBS;
+    localparam MBI_W  = (MB > 1) ? $clog2(MB) : 1;   // list index width
     // accumulator / list entry fields
     localparam O_AREA = 0;
     localparam O_SZ   = O_AREA + AREA_W;
@@ -159,6 +162,8 @@ module fmt_blob #(
     localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
     localparam [ROW_IDX_W:0]   ROWS_R   = ROWS_I[ROW_IDX_W:0];
     localparam [AREA_W-1:0]    MB_A     = MB_I[AREA_W-1:0];
+    localparam [CNT_W-1:0]     MB_C     = MB_I[CNT_W-1:0];
+    localparam [$clog2(MAX_BLOBS+1)-1:0] MB_S = MB_I[$clog2(MAX_BLOBS+1)-1:0];
     localparam integer LAST_ROW_I = ROWS - 1;
     localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
 
@@ -480,15 +485,38 @@ module fmt_blob #(
     wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
     wire              cl_blob = cl_v_q && cl_isblob;
 
-    reg [MB-1:0]  l_v_q;
-    reg [E_W-1:0] l_e_q [0:MB-1];
+    // The list holds the sort keys (area, raster index of the first cell) and a slot
+    // number per entry; the entries themselves sit in two small distributed RAMs of
+    // MB + 1 slots (pe_mem: the sums for the dividers, po_mem: the output fields), one
+    // write and one read each.  The MB list slots and spare_q are always a permutation
+    // of 0..MB: a closed blob is written to the spare slot and inserted with it; the
+    // entry that falls off the end gives its slot back as the spare.
+    localparam SL_W = $clog2(MB + 1);
+    localparam PE_W = SZ_W + SX_W + SY_W;
+    localparam PO_W = AREA_W + 2 * ROW_IDX_W + 2 * COL_IDX_W + HM_W + IDX_W;
+    reg [MB-1:0]     l_v_q;
+    reg [AREA_W-1:0] l_area_q [0:MB-1];
+    reg [IDX_W-1:0]  l_key_q  [0:MB-1];
+    reg [SL_W-1:0]   l_slot_q [0:MB-1];
+    reg [SL_W-1:0]   spare_q;
+    (* ram_style = "distributed" *)
+    reg [PE_W-1:0]   pe_mem [0:MB];
+    (* ram_style = "distributed" *)
+    reg [PO_W-1:0]   po_mem [0:MB];
+    always @(posedge clk) begin
+        if (cl_blob) begin
+            pe_mem[spare_q] <= {cl_e_q[O_SY +: SY_W], cl_e_q[O_SX +: SX_W], cl_e_q[O_SZ +: SZ_W]};
+            po_mem[spare_q] <= {cl_e_q[O_PC +: COL_IDX_W], cl_e_q[O_PR +: ROW_IDX_W],
+                                cl_e_q[O_PEAK +: HM_W], cl_e_q[O_CMAX +: COL_IDX_W],
+                                cl_e_q[O_CMIN +: COL_IDX_W], cl_e_q[O_RMAX +: ROW_IDX_W],
+                                cl_e_q[O_RMIN +: ROW_IDX_W], cl_area};
+        end
+    end
     reg [MB-1:0]  better;
     always @(*) begin
         for (i = 0; i < MB; i = i + 1)
             better[i] = l_v_q[i] &&
-                ((l_e_q[i][O_AREA +: AREA_W] > cl_area) ||
-                 ((l_e_q[i][O_AREA +: AREA_W] == cl_area) &&
-                  ({l_e_q[i][O_RMIN +: ROW_IDX_W], l_e_q[i][O_FC +: COL_IDX_W]} < cl_key)));
+                ((l_area_q[i] > cl_area) || ((l_area_q[i] == cl_area) && (l_key_q[i] < cl_key)));
     end
     reg [AREA_W-1:0] found_q;
     reg              lab_done_q;              // the last row's command has been applied
@@ -500,18 +528,16 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    /* verilator lint_off UNUSEDSIGNAL */   // entry mux: the dividers use only the sums
-    reg [E_W-1:0]     em_e;
-    /* verilator lint_on UNUSEDSIGNAL */
-    always @(*) begin
-        em_e = l_e_q[0];
-        for (i = 0; i < MB; i = i + 1)
-            if (em_i_q == i[CNT_W-1:0]) em_e = l_e_q[i];
-    end
-    wire [NUM_W-1:0] num_x = {{(NUM_W-SX_W-8){1'b0}}, em_e[O_SX +: SX_W], 8'd0}
-                           + {{(NUM_W-SZ_W+1){1'b0}}, em_e[O_SZ+1 +: SZ_W-1]};
-    wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_e[O_SY +: SY_W], 8'd0}
-                           + {{(NUM_W-SZ_W+1){1'b0}}, em_e[O_SZ+1 +: SZ_W-1]};
+    // the sums of list entry em_i_q (an index >= MB reads entry 0)
+    wire [SL_W-1:0]  em_slot = (em_i_q < MB_C) ? l_slot_q[em_i_q[MBI_W-1:0]] : l_slot_q[0];
+    wire [PE_W-1:0]  em_p    = pe_mem[em_slot];
+    wire [SZ_W-1:0]  em_sz   = em_p[0 +: SZ_W];
+    wire [SX_W-1:0]  em_sx   = em_p[SZ_W +: SX_W];
+    wire [SY_W-1:0]  em_sy   = em_p[SZ_W + SX_W +: SY_W];
+    wire [NUM_W-1:0] num_x = {{(NUM_W-SX_W-8){1'b0}}, em_sx, 8'd0}
+                           + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
+    wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_sy, 8'd0}
+                           + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
     // valid_o duplicates dl_v_q; ovf_o needs sum z = 0 (threshold 0, unsupported; the
     // quotient is then all ones)
     /* verilator lint_off UNUSEDSIGNAL */
@@ -519,10 +545,10 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [QW-1:0] qx, qy;
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_x (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_x), .den_i(em_e[O_SZ +: SZ_W]),
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_x), .den_i(em_sz),
         .valid_o(dx_v), .quot_o(qx), .ovf_o(dx_ovf));
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_y (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_y), .den_i(em_e[O_SZ +: SZ_W]),
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_y), .den_i(em_sz),
         .valid_o(dy_v), .quot_o(qy), .ovf_o(dy_ovf));
     // index and end token travel beside the dividers
     reg [DL-1:0]       dl_v_q, dl_t_q;
@@ -530,14 +556,8 @@ module fmt_blob #(
     wire               out_v   = dl_v_q[DL-1];
     wire               out_tok = dl_t_q[DL-1];
     wire [CNT_W-1:0]   out_i   = dl_i_q[DL-1];
-    /* verilator lint_off UNUSEDSIGNAL */   // entry mux: the sums are not output
-    reg [E_W-1:0]      out_e;
-    /* verilator lint_on UNUSEDSIGNAL */
-    always @(*) begin
-        out_e = l_e_q[0];
-        for (i = 0; i < MB; i = i + 1)
-            if (out_i == i[CNT_W-1:0]) out_e = l_e_q[i];
-    end
+    wire [SL_W-1:0]    out_slot = (out_i < MB_C) ? l_slot_q[out_i[MBI_W-1:0]] : l_slot_q[0];
+    wire [PO_W-1:0]    out_p    = po_mem[out_slot];
 
     // ---- M: membership pass, rows ROWS-1 down to 0, one per cycle ---------------------
     // A label of row r (labels at the row's end: the connected parts of the regions
@@ -580,22 +600,32 @@ module fmt_blob #(
         end
     endgenerate
     // status of the labels of row r, then of its cells
+    // Indexed selects (one 2^LBL_W : 1 multiplexer per label and per column); the
+    // padded vectors return 0 for label 0 and for codes above NL, and bw_s keeps the
+    // close record when a code is outside 1..NL.
+    localparam NLP = 1 << LBL_W;
+    localparam integer NL_I = NL;
+    localparam [LBL_W-1:0] NL_L = NL_I[LBL_W-1:0];
     reg [NL:1]      bw_s;
     reg [COLS-1:0]  bw_m;
     reg [LBL_W-1:0] la_r, lc;
+    reg [NLP-1:0]   sn_pad, bs_pad;
     always @(*) begin
+        sn_pad = {NLP{1'b0}};
+        sn_pad[NL:1] = sn_q;
         for (g = 1; g <= NL; g = g + 1) begin
             la_r = fr_rd_q[(g-1)*LBL_W +: LBL_W];
-            bw_s[g] = cfr[g];
-            if (!bw_first && fr_rd_q[NL*LBL_W + g - 1])
-                for (i = 1; i <= NL; i = i + 1)
-                    if (la_r == i[LBL_W-1:0]) bw_s[g] = sn_q[i];
+            if (!bw_first && fr_rd_q[NL*LBL_W + g - 1] &&
+                la_r != {LBL_W{1'b0}} && la_r <= NL_L)
+                bw_s[g] = sn_pad[la_r];
+            else
+                bw_s[g] = cfr[g];
         end
+        bs_pad = {NLP{1'b0}};
+        bs_pad[NL:1] = bw_s;
         for (i = 0; i < COLS; i = i + 1) begin
             lc = lr_rd_q[i*LBL_W +: LBL_W];
-            bw_m[i] = 1'b0;
-            for (g = 1; g <= NL; g = g + 1)
-                if (lc == g[LBL_W-1:0]) bw_m[i] = bw_s[g];
+            bw_m[i] = bs_pad[lc];
         end
     end
     always @(posedge clk) begin
@@ -662,16 +692,16 @@ module fmt_blob #(
         // emission side registers
         dl_i_q[0] <= em_i_q;
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
-        blob_area_o     <= out_e[O_AREA +: AREA_W];
+        blob_area_o     <= out_p[0 +: AREA_W];
         blob_cx_o       <= {{(16-QW){1'b0}}, qx};
         blob_cy_o       <= {{(16-QW){1'b0}}, qy};
-        blob_rmin_o     <= out_e[O_RMIN +: ROW_IDX_W];
-        blob_cmin_o     <= out_e[O_CMIN +: COL_IDX_W];
-        blob_rmax_o     <= out_e[O_RMAX +: ROW_IDX_W];
-        blob_cmax_o     <= out_e[O_CMAX +: COL_IDX_W];
-        blob_peak_o     <= out_e[O_PEAK +: HM_W];
-        blob_peak_row_o <= out_e[O_PR +: ROW_IDX_W];
-        blob_peak_col_o <= out_e[O_PC +: COL_IDX_W];
+        blob_rmin_o     <= out_p[AREA_W +: ROW_IDX_W];
+        blob_rmax_o     <= out_p[AREA_W + ROW_IDX_W +: ROW_IDX_W];
+        blob_cmin_o     <= out_p[AREA_W + 2*ROW_IDX_W +: COL_IDX_W];
+        blob_cmax_o     <= out_p[AREA_W + 2*ROW_IDX_W + COL_IDX_W +: COL_IDX_W];
+        blob_peak_o     <= out_p[AREA_W + 2*ROW_IDX_W + 2*COL_IDX_W +: HM_W];
+        blob_peak_row_o <= out_p[AREA_W + 2*ROW_IDX_W + 2*COL_IDX_W + HM_W +: ROW_IDX_W];
+        blob_peak_col_o <= out_p[AREA_W + 3*ROW_IDX_W + 2*COL_IDX_W + HM_W +: COL_IDX_W];
         blob_frame_o    <= em_frame_q;
 
         if (rst) begin
@@ -698,6 +728,8 @@ module fmt_blob #(
             x4_v_q   <= 1'b0;
             cl_v_q   <= 1'b0;
             l_v_q    <= {MB{1'b0}};
+            for (i = 0; i < MB; i = i + 1) l_slot_q[i] <= i[SL_W-1:0];
+            spare_q  <= MB_S;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
             em_i_q   <= {CNT_W{1'b0}};
@@ -778,14 +810,19 @@ module fmt_blob #(
                 for (i = 0; i < MB; i = i + 1) begin
                     if (!better[i]) begin
                         if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
-                            l_v_q[i] <= 1'b1;
-                            l_e_q[i] <= cl_e_q;
+                            l_v_q[i]    <= 1'b1;
+                            l_area_q[i] <= cl_area;
+                            l_key_q[i]  <= cl_key;
+                            l_slot_q[i] <= spare_q;
                         end else begin
-                            l_v_q[i] <= l_v_q[(i == 0) ? 0 : i - 1];
-                            l_e_q[i] <= l_e_q[(i == 0) ? 0 : i - 1];
+                            l_v_q[i]    <= l_v_q[(i == 0) ? 0 : i - 1];
+                            l_area_q[i] <= l_area_q[(i == 0) ? 0 : i - 1];
+                            l_key_q[i]  <= l_key_q[(i == 0) ? 0 : i - 1];
+                            l_slot_q[i] <= l_slot_q[(i == 0) ? 0 : i - 1];
                         end
                     end
                 end
+                if (!better[MB-1]) spare_q <= l_slot_q[MB-1];   // the last entry falls off
             end
 
             // ---- finish, emit, release ----

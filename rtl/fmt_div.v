@@ -1,9 +1,14 @@
-// fmt_div -- pipelined unsigned restoring divider, one result per clock.
+// fmt_div -- pipelined unsigned divider, one result per clock.
 //
 // quot_o = floor(num_i / den_i) (low QW bits) and ovf_o = (num_i >= den_i * 2^QW),
 // i.e. the quotient does not fit in QW bits (then quot_o is all ones).  den_i = 0
-// always gives ovf_o = 1.  Stage s (s = 0..QW-1) decides quotient bit QW-1-s by a
-// trial subtraction of den * 2^(QW-1-s) from the partial remainder.
+// always gives ovf_o = 1.
+// Long division with a narrow remainder: when the quotient fits, the numerator's high
+// part num >> QW is below den, so every partial remainder stays below den (DEN_W bits).
+// Stage s (s = 0..QW-1) appends numerator bit QW-1-s to the partial remainder,
+// subtracts den when it fits (a DEN_W + 1 bit subtractor) and shifts the quotient bit
+// into the register that held the numerator's low bits.  On overflow the stages work
+// on a truncated remainder and the result is replaced by all ones.
 // Latency: QW + 1 clock cycles from num_i/den_i/valid_i to quot_o/ovf_o/valid_o (one
 // input register holding the overflow test, then one register per quotient bit).
 // Twin: fmt.interp.div_fixed.
@@ -13,7 +18,7 @@
 module fmt_div #(
     parameter NUM_W = 32,   // dividend width (unsigned)
     parameter DEN_W = 24,   // divisor width (unsigned)
-    parameter QW    = 9     // quotient bits
+    parameter QW    = 9     // quotient bits (>= 2)
 ) (
     input  wire             clk,      // processing clock
     input  wire             rst,      // synchronous active-high reset (clears valid)
@@ -24,22 +29,28 @@ module fmt_div #(
     output wire [QW-1:0]    quot_o,   // floor(num / den), all ones on overflow
     output wire             ovf_o     // quotient >= 2^QW (or den = 0)
 );
-    // Remainder / shifted-divisor width: the divisor shifted by up to QW - 1 bits.
-    localparam RW = ((NUM_W > DEN_W + QW) ? NUM_W : DEN_W + QW) + 1;
+    // numerator zero-extended to at least QW + 1 bits; its high part num >> QW and the
+    // divisor compared at the common width CW
+    localparam NE_W = (NUM_W > QW) ? NUM_W : QW + 1;
+    localparam HI_W = NE_W - QW;
+    localparam CW   = (HI_W > DEN_W) ? HI_W : DEN_W;
 
-    reg [RW-1:0]    rem_q  [0:QW];
-    reg [DEN_W-1:0] den_q  [0:QW];
-    reg [QW-1:0]    quo_q  [0:QW];
-    reg             ovf_q  [0:QW];
-    reg             vld_q  [0:QW];
+    reg [DEN_W-1:0] den_q [0:QW];
+    reg [DEN_W-1:0] rem_q [0:QW];             // partial remainder (< den unless overflow)
+    reg [QW-1:0]    lq_q  [0:QW];             // numerator bits still to use (top) and
+                                              // quotient bits decided so far (bottom)
+    reg             ovf_q [0:QW];
+    reg             vld_q [0:QW];
 
-    // input stage: overflow test num >= den << QW
-    wire [RW+QW-1:0] den_full = {{(RW+QW-DEN_W){1'b0}}, den_i} << QW;
+    // input stage: overflow test num >= den << QW, i.e. (num >> QW) >= den
+    wire [NE_W-1:0] num_e = {{(NE_W-NUM_W){1'b0}}, num_i};
+    wire [CW-1:0]   hi_c  = {{(CW-HI_W){1'b0}}, num_e[NE_W-1:QW]};
+    wire [CW-1:0]   den_c = {{(CW-DEN_W){1'b0}}, den_i};
     always @(posedge clk) begin
-        rem_q[0] <= {{(RW-NUM_W){1'b0}}, num_i};
         den_q[0] <= den_i;
-        quo_q[0] <= {QW{1'b0}};
-        ovf_q[0] <= ({{(RW+QW-NUM_W){1'b0}}, num_i} >= den_full);
+        rem_q[0] <= hi_c[DEN_W-1:0];
+        lq_q[0]  <= num_e[QW-1:0];
+        ovf_q[0] <= (hi_c >= den_c);
         if (rst) vld_q[0] <= 1'b0;
         else     vld_q[0] <= valid_i;
     end
@@ -47,13 +58,14 @@ module fmt_div #(
     genvar s;
     generate
         for (s = 0; s < QW; s = s + 1) begin : g_stage
-            localparam integer BIT = QW - 1 - s;   // quotient bit decided here
-            wire [RW-1:0] trial = {{(RW-DEN_W){1'b0}}, den_q[s]} << BIT;
-            wire          take  = (rem_q[s] >= trial);
+            // append the next numerator bit; subtract den when it fits (no borrow)
+            wire [DEN_W:0]   t    = {rem_q[s], lq_q[s][QW-1]};
+            wire [DEN_W+1:0] d    = {1'b0, t} - {2'b00, den_q[s]};
+            wire             take = !d[DEN_W+1];
             always @(posedge clk) begin
-                rem_q[s+1] <= take ? (rem_q[s] - trial) : rem_q[s];
+                rem_q[s+1] <= take ? d[DEN_W-1:0] : t[DEN_W-1:0];
+                lq_q[s+1]  <= {lq_q[s][QW-2:0], take};
                 den_q[s+1] <= den_q[s];
-                quo_q[s+1] <= quo_q[s] | ({{(QW-1){1'b0}}, take} << BIT);
                 ovf_q[s+1] <= ovf_q[s];
                 if (rst) vld_q[s+1] <= 1'b0;
                 else     vld_q[s+1] <= vld_q[s];
@@ -63,6 +75,6 @@ module fmt_div #(
 
     assign valid_o = vld_q[QW];
     assign ovf_o   = ovf_q[QW];
-    assign quot_o  = ovf_q[QW] ? {QW{1'b1}} : quo_q[QW];
+    assign quot_o  = ovf_q[QW] ? {QW{1'b1}} : lq_q[QW];
 endmodule
 `default_nettype wire

@@ -10,7 +10,8 @@
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most.
 // Storage: the rows are written into an inferred RAM of 2 x ROWS words of COLS*HM_W
 // bits (two frame buffers: the next frame's rows may arrive while the current frame is
-// still being finished) with 3 synchronous read ports (rows r-1, r, r+1).  An arrival
+// still being finished) with 3 synchronous read ports (rows r-1, r, r+1): block RAM,
+// one copy per read port (27 RAMB36 at 30 x 40), no LUTs.  An arrival
 // bitmap per buffer marks the rows present; row r is "ready" as soon as it and its
 // existing neighbour rows are present, so evaluation runs while the frame arrives:
 //   E0: pick the lowest ready row, read rows r-1, r, r+1          (1 row per cycle)
@@ -20,7 +21,8 @@
 //       ties by raster index ascending); the weakest falls off the end.
 // After the frame's hm_eof, once every row is evaluated, the list is emitted, one
 // candidate per cycle: the same three read ports fetch the candidate's rows and a
-// column select forms its 3x3 neighbourhood; then cand_eof.  Settings (threshold_i,
+// column select forms its 3x3 neighbourhood (by column mod 3: three ceil((COLS+2)/3):1
+// selects and a rotation per row); then cand_eof.  Settings (threshold_i,
 // moore_i, limit_i) are used live: change them between frames.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
@@ -97,7 +99,8 @@ module fmt_localmax #(
     localparam [LIM_W-1:0]     K_L      = K_I[LIM_W-1:0];
 
     // ---- frame buffers and arrival bookkeeping ----------------------------------------
-    reg [RW-1:0]         mem [0:2*ROWS-1];
+    (* ram_style = "block" *)                 // one write, three reads: block RAM, one
+    reg [RW-1:0]         mem [0:2*ROWS-1];  // copy per read port (no LUTs)
     reg [ROWS-1:0]       arr_q [0:1];       // rows present, per buffer
     reg [1:0]            eofs_q;            // hm_eof seen, per buffer
     reg [FRAME_W-1:0]    frm_q [0:1];       // frame number, per buffer
@@ -238,26 +241,80 @@ module fmt_localmax #(
     reg [FRAME_W-1:0]   em_frame_q;
     reg [Z9_W-1:0] z9;
     reg [8:0]      miss9;
-    integer j;
-    always @(*) begin
-        z9 = {Z9_W{1'b0}};
-        for (j = 0; j < COLS; j = j + 1) begin
-            if (em_col_q == j[COL_IDX_W-1:0]) begin
-                if (j > 0) begin
-                    z9[0*HM_W +: HM_W] = ra_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
-                    z9[3*HM_W +: HM_W] = rb_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
-                    z9[6*HM_W +: HM_W] = rc_q[((j > 0) ? j - 1 : 0)*HM_W +: HM_W];
-                end
-                z9[1*HM_W +: HM_W] = ra_q[j*HM_W +: HM_W];
-                z9[4*HM_W +: HM_W] = rb_q[j*HM_W +: HM_W];
-                z9[7*HM_W +: HM_W] = rc_q[j*HM_W +: HM_W];
-                if (j < COLS - 1) begin
-                    z9[2*HM_W +: HM_W] = ra_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
-                    z9[5*HM_W +: HM_W] = rb_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
-                    z9[8*HM_W +: HM_W] = rc_q[((j < COLS - 1) ? j + 1 : j)*HM_W +: HM_W];
-                end
+    // The three rows padded with a zero cell at each end (padded cell p = column p - 1);
+    // the candidate's window is padded cells p0 .. p0 + 2, p0 = em_col_q.  The padded
+    // cells are split by p mod 3 into three groups of NGR cells (cell j of group g is
+    // p = 3j + g, 0 beyond the row): the window holds exactly one cell of each group,
+    // cell q or q + 1 (q = p0 / 3, m = p0 mod 3: q + 1 for the groups g < m), and window
+    // position k takes group (m + k) mod 3.  Three NGR : 1 selects and a 3 : 1 rotation
+    // per row and bit instead of three (COLS + 2) : 1 selects.
+    localparam NPC  = COLS + 2;
+    localparam NGR  = (NPC + 2) / 3;
+    localparam QI_W = $clog2(NGR + 1);
+    localparam NGA  = 1 << QI_W;
+    reg [QI_W-1:0] em_q_q;                     // em_col_q / 3
+    reg [1:0]      em_m_q;                     // em_col_q mod 3
+    wire [HM_W-1:0] ga0 [0:NGA-1], ga1 [0:NGA-1], ga2 [0:NGA-1];
+    wire [HM_W-1:0] gb0 [0:NGA-1], gb1 [0:NGA-1], gb2 [0:NGA-1];
+    wire [HM_W-1:0] gc0 [0:NGA-1], gc1 [0:NGA-1], gc2 [0:NGA-1];
+    genvar gj;
+    generate
+        for (gj = 0; gj < NGA; gj = gj + 1) begin : g_grp
+            // padded cell 3j + g is column 3j + g - 1
+            if (3 * gj >= 1 && 3 * gj <= COLS) begin : g_0
+                assign ga0[gj] = ra_q[(3*gj-1)*HM_W +: HM_W];
+                assign gb0[gj] = rb_q[(3*gj-1)*HM_W +: HM_W];
+                assign gc0[gj] = rc_q[(3*gj-1)*HM_W +: HM_W];
+            end else begin : g_0z
+                assign ga0[gj] = {HM_W{1'b0}};
+                assign gb0[gj] = {HM_W{1'b0}};
+                assign gc0[gj] = {HM_W{1'b0}};
+            end
+            if (3 * gj + 1 <= COLS) begin : g_1
+                assign ga1[gj] = ra_q[(3*gj)*HM_W +: HM_W];
+                assign gb1[gj] = rb_q[(3*gj)*HM_W +: HM_W];
+                assign gc1[gj] = rc_q[(3*gj)*HM_W +: HM_W];
+            end else begin : g_1z
+                assign ga1[gj] = {HM_W{1'b0}};
+                assign gb1[gj] = {HM_W{1'b0}};
+                assign gc1[gj] = {HM_W{1'b0}};
+            end
+            if (3 * gj + 2 <= COLS) begin : g_2
+                assign ga2[gj] = ra_q[(3*gj+1)*HM_W +: HM_W];
+                assign gb2[gj] = rb_q[(3*gj+1)*HM_W +: HM_W];
+                assign gc2[gj] = rc_q[(3*gj+1)*HM_W +: HM_W];
+            end else begin : g_2z
+                assign ga2[gj] = {HM_W{1'b0}};
+                assign gb2[gj] = {HM_W{1'b0}};
+                assign gc2[gj] = {HM_W{1'b0}};
             end
         end
+    endgenerate
+    wire [QI_W-1:0] gi0 = em_q_q + {{(QI_W-1){1'b0}}, (em_m_q > 2'd0)};   // group 0
+    wire [QI_W-1:0] gi1 = em_q_q + {{(QI_W-1){1'b0}}, (em_m_q > 2'd1)};   // group 1
+    wire [HM_W-1:0] sa0 = ga0[gi0], sa1 = ga1[gi1], sa2 = ga2[em_q_q];
+    wire [HM_W-1:0] sb0 = gb0[gi0], sb1 = gb1[gi1], sb2 = gb2[em_q_q];
+    wire [HM_W-1:0] sc0 = gc0[gi0], sc1 = gc1[gi1], sc2 = gc2[em_q_q];
+    // quotient and remainder by 3 of a column index (for em_q_q, em_m_q)
+    wire [COL_IDX_W-1:0] nx_col = l_idx_q[0][0 +: COL_IDX_W];
+    reg  [QI_W-1:0]      nx_q;
+    reg  [1:0]           nx_m;
+    integer k3, colv, qv;
+    always @(*) begin
+        colv = {{(32-COL_IDX_W){1'b0}}, nx_col};
+        qv = 0;
+        for (k3 = 1; k3 < NGA; k3 = k3 + 1)
+            if (colv >= 3 * k3) qv = k3;
+        nx_q = qv[QI_W-1:0];
+        colv = colv - 3 * qv;
+        nx_m = colv[1:0];
+    end
+    always @(*) begin
+        case (em_m_q)
+            2'd1:    z9 = {sc0, sc2, sc1, sb0, sb2, sb1, sa0, sa2, sa1};
+            2'd2:    z9 = {sc1, sc0, sc2, sb1, sb0, sb2, sa1, sa0, sa2};
+            default: z9 = {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
+        endcase
         miss9 = 9'd0;
         if (em_col_q == {COL_IDX_W{1'b0}})     miss9 = miss9 | 9'b001_001_001;
         if (em_col_q == LAST_COL)              miss9 = miss9 | 9'b100_100_100;
@@ -311,6 +368,8 @@ module fmt_localmax #(
             em_eof_q <= 1'b0;
             em_row_q <= {ROW_IDX_W{1'b0}};
             em_col_q <= {COL_IDX_W{1'b0}};
+            em_q_q   <= {QI_W{1'b0}};
+            em_m_q   <= 2'd0;
             cand_valid_o      <= 1'b0;
             cand_eof_o        <= 1'b0;
             cand_count_o      <= {LIM_W{1'b0}};
@@ -388,7 +447,9 @@ module fmt_localmax #(
             cand_eof_o   <= em_eof_q;
             if (em_issue) begin
                 em_row_q <= l_row0;
-                em_col_q <= l_idx_q[0][0 +: COL_IDX_W];
+                em_col_q <= nx_col;
+                em_q_q   <= nx_q;
+                em_m_q   <= nx_m;
                 left_q   <= left_q - 1'b1;
                 for (i = 0; i < K - 1; i = i + 1) begin
                     l_v_q[i]   <= l_v_q[i + 1];
