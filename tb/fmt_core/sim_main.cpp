@@ -152,24 +152,42 @@ struct Channel {
         if (!j.upd_file.empty()) load_updates(j.upd_file);
     }
 
-    void load_noise(const std::string& path) {
-        FILE* f = std::fopen(path.c_str(), "r");
-        if (!f) die("cannot open noise " + path);
-        unsigned v;
-        size_t i = 0;
-        while (i < noise.size() && std::fscanf(f, "%x", &v) == 1) {
-            const int32_t s = static_cast<int32_t>(static_cast<int16_t>(v & 0xFFFF));
-            noise[i++] = static_cast<int64_t>(s) * (1 << (16 - 4));
-        }
+    // Hex words of a $readmemh file, one per line (no comments or @ addresses: the
+    // files are written by sim/fmt); a plain parser (scanf is slow on 5 M words).
+    static std::vector<uint64_t> read_hex(const std::string& path) {
+        FILE* f = std::fopen(path.c_str(), "rb");
+        if (!f) die("cannot open " + path);
+        std::string buf;
+        char tmp[1 << 16];
+        size_t n;
+        while ((n = std::fread(tmp, 1, sizeof tmp, f)) > 0) buf.append(tmp, n);
         std::fclose(f);
+        std::vector<uint64_t> out;
+        uint64_t v = 0;
+        bool in = false;
+        for (const char ch : buf) {
+            int d = -1;
+            if (ch >= '0' && ch <= '9') d = ch - '0';
+            else if (ch >= 'a' && ch <= 'f') d = ch - 'a' + 10;
+            else if (ch >= 'A' && ch <= 'F') d = ch - 'A' + 10;
+            if (d >= 0) { v = (v << 4) | static_cast<uint64_t>(d); in = true; }
+            else if (in) { out.push_back(v); v = 0; in = false; }
+        }
+        if (in) out.push_back(v);
+        return out;
+    }
+
+    void load_noise(const std::string& path) {
+        const std::vector<uint64_t> w = read_hex(path);
+        for (size_t i = 0; i < noise.size() && i < w.size(); ++i) {
+            const int32_t s = static_cast<int32_t>(static_cast<int16_t>(w[i] & 0xFFFF));
+            noise[i] = static_cast<int64_t>(s) * (1 << (16 - 4));
+        }
     }
 
     void load_updates(const std::string& path) {
-        FILE* f = std::fopen(path.c_str(), "r");
-        if (!f) die("cannot open updates " + path);
         std::vector<int32_t> pend(g.size(), 0);
-        unsigned long long rec;
-        while (std::fscanf(f, "%llx", &rec) == 1) {
+        for (const uint64_t rec : read_hex(path)) {
             const unsigned kind = static_cast<unsigned>(rec >> 60);
             if (kind == 0) break;
             if (kind == 1) {
@@ -179,7 +197,6 @@ struct Channel {
                 updates.push_back(Update{static_cast<uint32_t>(rec & 0xFFFFFFFFu), pend});
             }
         }
-        std::fclose(f);
     }
 
     // Values at a clk edge (before it): rst, ce, the DAC words; updates the registered
