@@ -5,8 +5,8 @@
 //
 // Contact table: MAX_TOUCHES slots.  In flip-flops (read by all slots in parallel):
 // active flag, miss counter (frames since last seen), generation counter and the
-// rounded prediction pred = (p + 2^(VF-1)) >>> VF per axis, formed when p is written
-// and clamped to PR_W = 18 bits signed, [-2^17, 2^17) (exact for the gate test: a
+// rounded prediction pred = (p + 2^(VF-1)) >>> VF per axis, formed the cycle after p
+// is written and clamped to PR_W = 18 bits signed, [-2^17, 2^17) (exact for the gate test: a
 // prediction outside that range is, clamped or not, more than 65535 from any x in
 // [0, 65535], so never a candidate).  In a LUT RAM (one word per slot, one slot per
 // cycle; written by NEW before it is read, so not reset): predicted position p
@@ -412,8 +412,14 @@ module fmt_tracker #(
                 pred_of = {1'b0, {(PR_W-1){1'b1}}};
         end
     endfunction
-    wire [PR_W-1:0]  w_prx = pred_of(w_px);
-    wire [PR_W-1:0]  w_pry = pred_of(w_py);
+    // the written p is registered and rounded into the prediction registers one cycle
+    // later (off the velocity update's path); the last write lands in the cycle that
+    // clears the frame, before the next frame's touches can arrive
+    reg              pw_q;
+    reg [SB-1:0]     pw_s_q;
+    reg [P_W-1:0]    pw_x_q, pw_y_q;
+    wire [PR_W-1:0]  w_prx = pred_of(pw_x_q);
+    wire [PR_W-1:0]  w_pry = pred_of(pw_y_q);
     // the slot's miss counter: 0 on move / new, + 1 on update (shared incrementer)
     reg [HOLD_W-1:0] u_miss;
     always @* begin
@@ -462,6 +468,10 @@ module fmt_tracker #(
             prx_q          <= {(MT*PR_W){1'b0}};
             pry_q          <= {(MT*PR_W){1'b0}};
             gen_q          <= {(MT*GEN_W){1'b0}};
+            pw_q           <= 1'b0;
+            pw_s_q         <= {SB{1'b0}};
+            pw_x_q         <= {P_W{1'b0}};
+            pw_y_q         <= {P_W{1'b0}};
             next_slot_q    <= {SB{1'b0}};
             mv_q           <= 1'b0;
             mv_s_q         <= {SB{1'b0}};
@@ -514,12 +524,17 @@ module fmt_tracker #(
 
             // ---- slot registers written with the slot RAM ------------------------------
             for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                if (s_we && sa == s_i[SB-1:0]) begin
+                if (s_we && sa == s_i[SB-1:0])
                     miss_q[s_i*HOLD_W +: HOLD_W] <= w_miss;
+                if (pw_q && pw_s_q == s_i[SB-1:0]) begin
                     prx_q[s_i*PR_W +: PR_W] <= w_prx;
                     pry_q[s_i*PR_W +: PR_W] <= w_pry;
                 end
             end
+            pw_q   <= s_we;
+            pw_s_q <= sa;
+            pw_x_q <= w_px;
+            pw_y_q <= w_py;
 
             // ---- matching / lifts / news / update -------------------------------------
             mv_q <= 1'b0;

@@ -123,9 +123,8 @@ class TB(ClockedTB):
             await ReadOnly()
             if int(d.busy_o.value) == 0:
                 break
-        self.idle_cycle = self.cycle   # first cycle with busy_o low
-        await RisingEdge(self.clk)
-        await RisingEdge(self.clk)
+        self.idle_cycle = self.cycle   # first cycle with busy_o low: the next frame's
+        await self.writable()          # touches may come in this cycle (strictest case)
         return eof
 
 
