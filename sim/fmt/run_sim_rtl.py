@@ -457,16 +457,20 @@ def harness_dir(cfg, cps: int, tag: str = "") -> Path:
     return ROOT / "build" / "sim_cpp" / f"{cfg.name}_c{cps}{'_' + tag if tag else ''}"
 
 
-def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAGS) -> list:
+def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAGS,
+                 verilog_channel: bool = False) -> list:
     """Verilator command line of the harness build: fast model (-O3, x fast, no
     assertions, no tracing, one thread), fmt_core_sim_top with EXT_CHANNEL = 1 (the
-    channel in C++), the log files of the job folder ``d`` (Verilog parameters)."""
+    channel in C++), the log files of the job folder ``d`` (Verilog parameters).
+    verilog_channel: EXT_CHANNEL = 0 instead (fmt_channel_sim + the Verilog player; the
+    harness then leaves the channel to the model: a cross-check and a speed comparison)."""
     p = sim_parameters(cfg, cps, d)
-    for k in ("NOISE_FILE", "UPD_FILE"):
-        p.pop(k)                                   # the C++ channel reads them (job file)
-    p["NOISE_LEN"] = 1
-    p["UPD_LEN"] = 1
-    p["EXT_CHANNEL"] = 1
+    if not verilog_channel:
+        for k in ("NOISE_FILE", "UPD_FILE"):
+            p.pop(k)                               # the C++ channel reads them (job file)
+        p["NOISE_LEN"] = 1
+        p["UPD_LEN"] = 1
+    p["EXT_CHANNEL"] = 0 if verilog_channel else 1
     args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
             "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "--output-split", "0",
             "--top-module", "fmt_core_sim_top", "-Mdir", str(bdir), "-o", "Vfmt_core_sim_top",
@@ -480,15 +484,15 @@ def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAG
 
 
 def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_CFLAGS,
-                  quiet: bool = False) -> tuple[Path, float]:
+                  quiet: bool = False, verilog_channel: bool = False) -> tuple[Path, float]:
     """Build (or reuse) the harness executable; rebuilt only when a source file, the
     command line or the Verilator version changed.  Returns (executable, build seconds)."""
     import hashlib
     import shutil
     import subprocess
-    bdir = harness_dir(cfg, cps, tag)
+    bdir = harness_dir(cfg, cps, tag + ("_vch" if verilog_channel else ""))
     exe = bdir / "Vfmt_core_sim_top"
-    args = harness_args(cfg, cps, d, bdir, cflags)
+    args = harness_args(cfg, cps, d, bdir, cflags, verilog_channel)
     verilator = shutil.which("verilator")
     if verilator is None:
         raise RuntimeError("verilator not on PATH (source scripts/env.sh)")
@@ -519,12 +523,14 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
     return exe, time.perf_counter() - t0
 
 
-def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool) -> None:
+def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
+                  verilog_channel: bool = False) -> None:
     """The job of the C++ harness: the same phases as the cocotb run_scene."""
     from . import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
              f"progress {int(progress)}", f"noise_len {noise_len(cfg)}",
+             f"ext_channel {0 if verilog_channel else 1}",
              f"noise_file {d / 'noise.hex'}", f"upd_file {d / 'upd.hex'}",
              f"reset_cycles {job['reset_cycles']}", f"run_cycles {job['run_cycles']}",
              f"out {d / 'result.json'}"]
@@ -537,14 +543,19 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool)
 
 
 def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene",
-                tag: str = "cpp", quiet: bool = False, cflags: str = HARNESS_CFLAGS):
+                tag: str = "cpp", quiet: bool = False, cflags: str = HARNESS_CFLAGS,
+                verilog_channel: bool = False):
     """Build (cached) and run the C++ harness on a prepared job folder; returns
     (job folder, reference, calibration, number of updates, result dict, build seconds)."""
     import subprocess
+    if verilog_channel:
+        tag += "_vch"
     d, ref, cal, n_upd = prepare(scene, frames, cps, settings, cal=cal, tag=tag)
-    exe, build_s = harness_build(scene.cfg, cps, d, tag=tag, cflags=cflags, quiet=quiet)
+    exe, build_s = harness_build(scene.cfg, cps, d, tag=tag, cflags=cflags, quiet=quiet,
+                                 verilog_channel=verilog_channel)
     job = json.loads((d / "job.json").read_text())
-    write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d, progress=not quiet)
+    write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d, progress=not quiet,
+                  verilog_channel=verilog_channel)
     t0 = time.perf_counter()
     r = subprocess.run([str(exe), str(d / "job_cpp.txt")], cwd=d, stderr=None if not quiet else subprocess.PIPE)
     proc_s = time.perf_counter() - t0

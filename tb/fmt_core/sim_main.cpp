@@ -24,6 +24,9 @@
 // phase-2 reset, as the player does; the later ones are armed right after the previous
 // copy (no load time here), and a copy at a sample later than its stamp counts as late.
 //
+// Job "ext_channel 0" (a build with EXT_CHANNEL = 0): the Verilog channel and player of
+// the top run instead (cross-check and speed comparison); the harness only clocks.
+//
 // Usage: Vfmt_core_sim_top <job.txt>   (written by sim/fmt/run_sim_rtl.py, write_cpp_job)
 // Progress on stderr when the job says so; result JSON to the job's out path.
 #include <sys/resource.h>
@@ -67,7 +70,7 @@ struct Update {
 };
 
 struct Job {
-    int rows = 0, cols = 0, cps = 3, noise_len = 1, frames = 0, progress = 0;
+    int rows = 0, cols = 0, cps = 3, noise_len = 1, frames = 0, progress = 0, ext_channel = 1;
     std::string noise_file, upd_file, out;
     std::vector<std::pair<uint32_t, uint32_t>> cal, regs;
     std::vector<std::pair<std::string, uint32_t>> status;
@@ -107,6 +110,7 @@ Job read_job(const char* path) {
         else if (k == "cps") { if (std::fscanf(f, "%d", &j.cps) != 1) die(k); }
         else if (k == "frames") { if (std::fscanf(f, "%d", &j.frames) != 1) die(k); }
         else if (k == "progress") { if (std::fscanf(f, "%d", &j.progress) != 1) die(k); }
+        else if (k == "ext_channel") { if (std::fscanf(f, "%d", &j.ext_channel) != 1) die(k); }
         else if (k == "noise_len") { if (std::fscanf(f, "%d", &j.noise_len) != 1) die(k); }
         else if (k == "reset_cycles") { if (std::fscanf(f, "%lld", &j.reset_cycles) != 1) die(k); }
         else if (k == "run_cycles") { if (std::fscanf(f, "%lld", &j.run_cycles) != 1) die(k); }
@@ -265,14 +269,17 @@ int main(int argc, char** argv) {
     if (static_cast<size_t>(job.cols) * 12 > ADC_NWORDS * 32 ||
         static_cast<size_t>(job.rows) * 12 > sizeof(top->dac_o) * 8)
         die("job size does not match the build");
-    Channel ch(job, ADC_NWORDS);
+    Job chjob = job;
+    if (!job.ext_channel) { chjob.noise_file.clear(); chjob.upd_file.clear(); }
+    Channel ch(chjob, ADC_NWORDS);
+    const bool cpp_channel = job.ext_channel != 0;   // 0: the Verilog channel of the top runs
 
     long long cycle = 0;   // clk edges since time 0 (all phases)
     auto tick = [&]() {
-        ch.edge(top->rst != 0, top->ce_o != 0, top->dac_o);
+        if (cpp_channel) ch.edge(top->rst != 0, top->ce_o != 0, top->dac_o);
         top->clk = 1;
         top->eval();
-        std::memcpy(words_of(top->adc_ext_i), ch.adc_words.data(), ADC_NWORDS * 4);
+        if (cpp_channel) std::memcpy(words_of(top->adc_ext_i), ch.adc_words.data(), ADC_NWORDS * 4);
         top->clk = 0;
         top->eval();
         ++cycle;
@@ -352,9 +359,11 @@ int main(int argc, char** argv) {
                  "\"frames\": %u, \"events\": %u, \"upd_late\": %lld, \"upd_done\": %d, \"upd_copies\": %lld, "
                  "\"clip\": %d, \"clip_samples\": %lld, \"status_cycle\": %u, \"frames_before_status\": %u, "
                  "\"status\": {%s}, \"frames_at_status\": %u}\n",
-                 wall, cpu, run_clk, run_clk / std::max(wall, 1e-9), frames, events, ch.late,
-                 (ch.next_upd == ch.updates.size() && !ch.armed) ? 1 : 0, ch.copies,
-                 ch.clip_sticky ? 1 : 0, ch.clip_samples, status_cycle, frames_before, st.c_str(), frames_at);
+                 wall, cpu, run_clk, run_clk / std::max(wall, 1e-9), frames, events,
+                 cpp_channel ? ch.late : static_cast<long long>(top->upd_late_o),
+                 cpp_channel ? ((ch.next_upd == ch.updates.size() && !ch.armed) ? 1 : 0) : static_cast<int>(top->upd_done_o),
+                 cpp_channel ? ch.copies : -1LL,
+                 cpp_channel ? (ch.clip_sticky ? 1 : 0) : static_cast<int>(top->clip_o), ch.clip_samples, status_cycle, frames_before, st.c_str(), frames_at);
     std::fclose(o);
     return 0;
 }
