@@ -2,8 +2,10 @@
 // fmt_fft_r22sdf (z = a + j b) -> fmt_pair_split, with the window / frame bookkeeping,
 // plus a ROWS-entry result memory that keeps each row's (2A, 2B) until the row's next
 // completion one window later, so that magnitude units shared by many pairs can read it
-// at their own pace (fmt_rx_array).  fmt_col_pair_rx adds its own magnitude units and
-// accumulator to the split outputs (its result memory is then unused and trimmed).
+// at their own pace (fmt_rx_array with FFT_CH = 1; with FFT_CH = G > 1 the array uses
+// fmt_rx_group_front, one time-multiplexed FFT engine per G pairs).  fmt_col_pair_rx
+// adds its own magnitude units and accumulator to the split outputs (its result memory
+// is then unused and trimmed).
 //
 // Frames: window k is ADC samples k*N .. k*N + N-1 counted from the first ce after reset
 // (the FFT is held in reset for that ce while the despreaders fill); a frame is
