@@ -4,13 +4,16 @@ fed from Python through cocotb) and write the heat maps.
 
     source scripts/env.sh
     python scripts/replay_rx.py --in captures.npy --out heatmaps.npy [--config default|small|medium]
-                                [--m 1] [--sign rx_sign.npy] [--check]
+                                [--m 1] [--sign rx_sign.npy] [--cps 1|3] [--check]
 
 captures.npy: (samples, COLS) integers in the ADC range, sample 0 = the first sample
 after reset.  --sign: (samples,) 0/1 receive PN signs (default: PN off).  --m: windows
 per frame (1, 2, 4, 8).  Writes heatmaps.npy (frames, ROWS, COLS) uint32 and
 heatmaps.npy.json (frames, sticky flags).  --check compares with the bit-exact model
-sim/fmt/rx_fixed.py and exits 1 on a difference.
+sim/fmt/rx_fixed.py and exits 1 on a difference.  --cps: the build's CLK_PER_SAMPLE:
+1 (default, fastest: a sample every clk, one FFT engine per column pair) or 2..4 (the
+core's structure: CLK_PER_SAMPLE column pairs per time-multiplexed FFT engine, a
+sample every CLK_PER_SAMPLE clk).
 """
 from __future__ import annotations
 
@@ -35,6 +38,8 @@ def main(argv=None) -> int:
     ap.add_argument("--config", default="default", choices=["default", "small", "medium"])
     ap.add_argument("--m", type=int, default=1, choices=[1, 2, 4, 8], help="windows per frame")
     ap.add_argument("--sign", default="", help="receive PN signs .npy (samples,), default PN off")
+    ap.add_argument("--cps", type=int, default=1, choices=[1, 2, 3, 4],
+                    help="CLK_PER_SAMPLE of the build (clk per sample of the replay)")
     ap.add_argument("--check", action="store_true", help="compare with rx_fixed (bit-exact)")
     a = ap.parse_args(argv)
 
@@ -46,8 +51,10 @@ def main(argv=None) -> int:
     cfg = params.get(a.config)
     m_log2 = a.m.bit_length() - 1
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
+    fft_ch = rx_fixed.rx_fft_ch_default(1, a.cps)
     env = {"CFG": a.config, "M_LOG2": m_log2, "REPLAY_IN": inp, "REPLAY_OUT": out,
-           "REPLAY_SIGN": Path(a.sign).resolve() if a.sign else ""}
+           "REPLAY_SIGN": Path(a.sign).resolve() if a.sign else "",
+           "FFT_CH": fft_ch, "CE_EVERY": a.cps}
     run_cocotb(
         sim="verilator",
         toplevel="fmt_rx_array",
@@ -57,9 +64,8 @@ def main(argv=None) -> int:
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
                     "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
                     "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"',
-                    # the replay feeds a sample every clk: size the shared magnitude units
-                    # for ce = 1 (CLK_PER_SAMPLE 1)
-                    "CLK_PER_SAMPLE": 1},
+                    # a sample every cps clk; FFT_CH defaults to CLK_PER_SAMPLE (POST_CLK 1)
+                    "POST_CLK": 1, "CLK_PER_SAMPLE": a.cps},
         extra_env=env,
         build_args=VERILATOR_ARGS,
     )

@@ -345,7 +345,8 @@ def test_fmt_rx_array_default(sim):
 
 @pytest.mark.verilator_only
 def test_replay_rx_script(sim):
-    """scripts/replay_rx.py on a small generated capture (PN on, M = 2) equals rx_fixed."""
+    """scripts/replay_rx.py on a small generated capture (PN on, M = 2), through the
+    core's structure at 3 clk per sample (FFT_CH 3), equals rx_fixed."""
     import importlib.util
     cfg = params.SMALL
     rng = np.random.default_rng(31)
@@ -360,7 +361,7 @@ def test_replay_rx_script(sim):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     rc = mod.main(["--in", str(d / "cap.npy"), "--out", str(d / "hm.npy"), "--config", "small",
-                   "--m", "2", "--sign", str(d / "sign.npy"), "--check"])
+                   "--m", "2", "--sign", str(d / "sign.npy"), "--cps", "3", "--check"])
     assert rc == 0
     hm = np.load(d / "hm.npy")
     exp, _, _ = R.rx_heatmaps_fixed(adc, rx, cfg, 1)
