@@ -329,7 +329,9 @@ module fmt_blob #(
         end
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
+    (* ram_style = "block" *)                 // one write, one synchronous read
     reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
+    (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
     always @(posedge clk) begin
         if (row_done) lr_mem[cur_row_q] <= c_nx;
@@ -371,25 +373,38 @@ module fmt_blob #(
     reg [AREA_W-1:0]    cnt;
     reg [COL_IDX_W-1:0] cmin, cmax;
     reg [HM_W-1:0]      zc;
+    reg [GS*HM_W-1:0]   gz;
+    reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
+    reg [HM_W+1:0]      gv0, gv1, go;
     always @(*) begin
         gs = {(NG*GSZ_W){1'b0}};
         gx = {(NG*GSX_W){1'b0}};
         gm = {(NG*HM_W){1'b0}};
         gc = {(NG*COL_IDX_W){1'b0}};
         for (g = 0; g < NG; g = g + 1) begin
+            // the group's 8 masked cells (0 beyond the last column)
+            for (i = 0; i < GS; i = i + 1)
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS) ? x1_zm_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
+                                                        : {HM_W{1'b0}};
+            // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
+            // u_i = z_2i + z_2i+1, v_0 = u_0 + u_1, v_1 = u_2 + u_3, sum = v_0 + v_1,
+            // sum j z_j = 4 v_1 + 2 (u_1 + u_3) + (z_1 + z_3 + z_5 + z_7)
+            for (i = 0; i < 4; i = i + 1)
+                gu[i] = {2'b00, gz[(2*i)*HM_W +: HM_W]} + {2'b00, gz[(2*i+1)*HM_W +: HM_W]};
+            gv0 = gu[0] + gu[1];
+            gv1 = gu[2] + gu[3];
+            go  = ({2'b00, gz[1*HM_W +: HM_W]} + {2'b00, gz[3*HM_W +: HM_W]})
+                + ({2'b00, gz[5*HM_W +: HM_W]} + {2'b00, gz[7*HM_W +: HM_W]});
+            gs[g*GSZ_W +: GSZ_W] = {{(GSZ_W-HM_W-2){1'b0}}, gv0} + {{(GSZ_W-HM_W-2){1'b0}}, gv1};
+            gx[g*GSX_W +: GSX_W] = {{(GSX_W-HM_W-5){1'b0}}, gv1, 2'b00}
+                                 + {{(GSX_W-HM_W-3){1'b0}}, gu[1] + gu[3], 1'b0}
+                                 + {{(GSX_W-HM_W-2){1'b0}}, go};
+            // peak of the group: first maximum (strict compare)
             for (i = g * GS; i < g * GS + GS; i = i + 1) begin
-                if (i < COLS) begin
-                    zc = x1_zm_q[i*HM_W +: HM_W];
-                    gs[g*GSZ_W +: GSZ_W] = gs[g*GSZ_W +: GSZ_W] + {{(GSZ_W-HM_W){1'b0}}, zc};
-                    // z * (c mod 8) by shifts (constants: no multiplier)
-                    for (b = 0; b < 3; b = b + 1)
-                        if ((((i - g * GS) >> b) & 1) == 1)
-                            gx[g*GSX_W +: GSX_W] = gx[g*GSX_W +: GSX_W]
-                                                 + ({{(GSX_W-HM_W){1'b0}}, zc} << b);
-                    if (zc > gm[g*HM_W +: HM_W]) begin    // strict: first maximum
-                        gm[g*HM_W +: HM_W] = zc;
-                        gc[g*COL_IDX_W +: COL_IDX_W] = i[COL_IDX_W-1:0];
-                    end
+                zc = gz[(i - g * GS)*HM_W +: HM_W];
+                if (zc > gm[g*HM_W +: HM_W]) begin
+                    gm[g*HM_W +: HM_W] = zc;
+                    gc[g*COL_IDX_W +: COL_IDX_W] = i[COL_IDX_W-1:0];
                 end
             end
         end
@@ -572,6 +587,7 @@ module fmt_blob #(
     reg [COLS*LBL_W-1:0] lr_rd_q;             // labels of row r
     reg [NL*(LBL_W+1)-1:0] fr_rd_q;           // continuation record of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
+    (* ram_style = "block" *)
     reg [COLS-1:0]       mask_mem [0:ROWS-1];
     reg [COLS-1:0]       mask_rd_q;
     reg                  mask_ok_q;           // the mask holds a complete frame
