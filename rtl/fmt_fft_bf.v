@@ -30,6 +30,7 @@ module fmt_fft_bf #(
     parameter DW      = 13,          // input width (signed); output is DW + 1
     parameter MINUS_J = 0,           // 1: BF2II stage (-j on the second half of each 4D block)
     parameter RAM_MIN = 8,           // delay lines this long or longer use the RAM form
+    parameter BRAM_MIN = 96,         // RAM rings this long or longer ask for block RAM
     parameter CH      = 1            // interleaved channels (delay line D x CH steps)
 ) (
     input  wire              clk,
@@ -82,7 +83,7 @@ module fmt_fft_bf #(
 
     wire [2*OW-1:0] dl_in = ctrl ? {dif_re, dif_im} : {b_re, b_im};
 
-    fmt_fft_delay #(.W(2 * OW), .DEPTH(D * CH), .RAM_MIN(RAM_MIN)) u_delay (
+    fmt_fft_delay #(.W(2 * OW), .DEPTH(D * CH), .RAM_MIN(RAM_MIN), .BRAM_MIN(BRAM_MIN)) u_delay (
         .clk(clk), .rst(rst), .ce(ce), .din_i(dl_in), .dout_o(dl_out));
 
     // validity: the output element idx - D is valid once D valid samples came in

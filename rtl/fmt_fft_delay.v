@@ -12,7 +12,9 @@
 //   register = DEPTH steps; it maps to LUT RAM or block RAM (simple dual port), cheaper
 //   than SRLs from 8 words on (2 bits per LUT in a RAM32M).  DEPTH need not be a power
 //   of two (the FFT's channel-interleaved lines are D x CH deep): the pointer then
-//   wraps at DEPTH - 1 (one comparator more).
+//   wraps at DEPTH - 1 (one comparator more).  From BRAM_MIN words on the ring asks for
+//   block RAM (ram_style attribute, Yosys and XST): Yosys maps a 96-deep line (N = 256,
+//   CH = 3) to 3 LUT RAM banks plus read multiplexers, ~130 LUT6, otherwise.
 // Latency: exactly DEPTH ce-steps (no extra register).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -20,7 +22,8 @@
 module fmt_fft_delay #(
     parameter W       = 16,   // word width (bits)
     parameter DEPTH   = 8,    // delay in samples, >= 1
-    parameter RAM_MIN = 8     // depth from which the ring-buffer (RAM) form is used, >= 2
+    parameter RAM_MIN = 8,    // depth from which the ring-buffer (RAM) form is used, >= 2
+    parameter BRAM_MIN = 96   // depth from which the ring is put in block RAM
 ) (
     input  wire         clk,
     input  wire         rst,    // synchronous, active high: clears the ring pointer only
@@ -32,7 +35,6 @@ module fmt_fft_delay #(
     generate
         if (DEPTH >= RAM_MIN) begin : g_ram
             localparam AW = $clog2(DEPTH);
-            reg [W-1:0]  mem [0:DEPTH-1];
             reg [AW-1:0] wptr_q;
             reg [W-1:0]  rd_q;
             wire [AW-1:0] rptr;                   // the oldest word: written DEPTH-1 steps ago
@@ -43,10 +45,21 @@ module fmt_fft_delay #(
                 localparam [AW-1:0] TOP   = TOP_I[AW-1:0];
                 assign rptr = (wptr_q == TOP) ? {AW{1'b0}} : wptr_q + 1'b1;
             end
-            always @(posedge clk) begin
-                if (ce) begin
-                    mem[wptr_q] <= din_i;
-                    rd_q        <= mem[rptr];
+            if (DEPTH >= BRAM_MIN) begin : g_bram
+                (* ram_style = "block" *) reg [W-1:0] mem [0:DEPTH-1];
+                always @(posedge clk) begin
+                    if (ce) begin
+                        mem[wptr_q] <= din_i;
+                        rd_q        <= mem[rptr];
+                    end
+                end
+            end else begin : g_lutram
+                reg [W-1:0] mem [0:DEPTH-1];
+                always @(posedge clk) begin
+                    if (ce) begin
+                        mem[wptr_q] <= din_i;
+                        rd_q        <= mem[rptr];
+                    end
                 end
             end
             always @(posedge clk) begin

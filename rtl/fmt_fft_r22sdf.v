@@ -51,8 +51,9 @@
 // steps: channel c's slot s leaves on step t_c + LATENCY0 + s * CH, t_c = the step of
 // channel c's last window sample (the register stages count steps, the delay lines
 // samples).  Cost at N = 256, IN_W = 13, OUT_W = 20 (the receiver's engine), Yosys xc5v:
-// CH = 1 1,468 LUT6 / 1,697 FF / 12 DSP48E / 2 RAMB18; CH = 3 1,662 LUT6 / 1,585 FF /
-// 12 DSP48E / 3 RAMB18 (the 384-deep first delay line in block RAM) for three streams.
+// CH = 1 1,468 LUT6 / 1,697 FF / 12 DSP48E / 2 RAMB18; CH = 3 1,533 LUT6 / 1,545 FF /
+// 12 DSP48E / 1 RAMB36 + 3 RAMB18 (delay lines of >= BRAM_MIN = 96 words in block RAM:
+// 384, 192, 96 deep) for three streams.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -64,6 +65,7 @@ module fmt_fft_r22sdf #(
     parameter GUARD   = 3,                   // twiddle product bits kept below the output LSB
     parameter OUT_W   = IN_W + LOG2_N + 1 + FRAC_W,  // output width, <= FULL_W
     parameter RAM_MIN = 8,                   // delay lines this long or longer use a RAM ring (LUT or block RAM)
+    parameter BRAM_MIN = 96,                 // rings this long or longer ask for block RAM (ram_style)
     parameter TW_DIR  = "rtl/",              // directory of the twiddle hex files, trailing /
     parameter CH      = 1,                   // interleaved channels per engine (1 = one stream)
     parameter CH_W    = (CH > 1) ? $clog2(CH) : 1   // width of out_ch_o
@@ -166,7 +168,7 @@ module fmt_fft_r22sdf #(
 
             fmt_fft_bf #(
                 .LOG2_N(LOG2_N), .LOG2_D(LOG2_N - 1 - s), .DW(DW),
-                .MINUS_J(s % 2), .RAM_MIN(RAM_MIN), .CH(CH)
+                .MINUS_J(s % 2), .RAM_MIN(RAM_MIN), .BRAM_MIN(BRAM_MIN), .CH(CH)
             ) u_bf (
                 .clk(clk), .rst(rst), .ce(ce),
                 .in_valid_i(bus_valid[s]),
