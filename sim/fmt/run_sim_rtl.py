@@ -2,31 +2,43 @@
 fixed-point model in lockstep as the reference.
 
     python -m fmt.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
-        [--frames F] [--cps 3] [--sim verilator] [--no-plot] [--quiet]
+        [--frames F] [--cps 3] [--engine cpp|cocotb] [--sim verilator|icarus]
+        [--no-plot] [--quiet]
 
 The simulation top ``tb/fmt_core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
-channel ``fmt_channel_sim`` (DAC words x coupling matrix + file noise -> ADC words) +
-a coupling-update player + loggers; Python is off the per-sample path:
+channel (DAC words x coupling matrix + file noise -> ADC words) + a coupling-update
+player + loggers; nothing in Python is on the per-sample path:
 
 1. The scene becomes a coupling plan (:func:`coupling_plan`): the channel matrix G (16
    fraction bits, ADC LSB per DAC LSB) at sample 0 and stamped updates -- at every window
    boundary where the coupling changed (moving contacts: the map at the window's first
    sample, held for the window) and at every sample where a contact's touch starts or
    ends inside a window (the exact onset sample).  Updates too close together to be
-   loaded in time (one pending-matrix write per clk) are merged into the later one; the
-   model uses the same list, so this costs no exactness.  Noise: white Gaussian words
-   with the scene's sigma, 4 fraction bits, NOISE_LEN samples per column repeating.
+   loaded in time by the Verilog player (one pending-matrix write per clk) are merged
+   into the later one; the model uses the same list, so this costs no exactness.  Noise:
+   white Gaussian words with the scene's sigma, 4 fraction bits, NOISE_LEN samples per
+   column repeating.
 2. The model reference (:func:`model_reference`): ``fmt_tx_fixed`` (DDS + PN) ->
    3-sample DAC delay -> :func:`channel_fixed` (int64 twin of ``channel_sim_fixed``) ->
    1-sample ADC register -> ``rx_heatmaps_fixed`` (PN receive delay 4 samples) ->
    ``touch.process_frames(fixed=True)`` with the scene's calibration.
-3. The cocotb test ``run_scene`` in ``tb/fmt_core/test_fmt_core.py`` programs the
-   registers (calibration, settings, REPORT_PERIOD 0) through the core's local bus,
-   runs the clock and reads the status; the loggers write every heat-map beat, every
-   event and every receiver frame end with its clk cycle.
+3. The RTL run.  Engine ``cpp`` (default): the standalone Verilator harness
+   ``tb/fmt_core/sim_main.cpp`` (:func:`run_harness`; built once per sensor size and
+   CLK_PER_SAMPLE under ``build/sim_cpp/`` with -O3 and rebuilt only when a source
+   changes) clocks ``fmt_core_sim_top`` with EXT_CHANNEL = 1 and computes the channel
+   in C++, bit-exact with ``fmt_channel_sim``; it replays the phases of the cocotb test
+   cycle for cycle.  Engine ``cocotb``: the cocotb test ``run_scene`` in
+   ``tb/fmt_core/test_fmt_core.py`` (Verilator or Icarus, the Verilog channel and
+   player; ~40x slower).  Both program the registers (calibration, settings,
+   REPORT_PERIOD 0) through the core's local bus, run the clock and read the status;
+   the loggers write every heat-map beat, every event and every receiver frame end
+   with its clk cycle.
 4. :func:`analyse` compares heat maps and events bit for bit (events sorted by ID per
    frame, time stamps excepted), measures latency and accuracy and writes
    ``<out>/<scene>/report.json``, ``heatmap.png`` and ``latency_hist.png``.
+   ``sim_frames_per_s`` = frames / wall time of the clocked run (the build, the model,
+   loading the files and the analysis excluded); the C++ engine also reports the CPU
+   time of that run (``sim_frames_per_cpu_s``, ``sim_clk_per_s``).
 
 Cycle conventions: cycle 0 = the first clk edge with rst low; channel sample k is formed
 at cycle k * CPS (the ce edges); the receiver takes ADC sample j (= channel sample j - 1)
@@ -490,7 +502,7 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
     import hashlib
     import shutil
     import subprocess
-    bdir = harness_dir(cfg, cps, tag + ("_vch" if verilog_channel else ""))
+    bdir = harness_dir(cfg, cps, tag + ("_vch" if verilog_channel and not tag.endswith("_vch") else ""))
     exe = bdir / "Vfmt_core_sim_top"
     args = harness_args(cfg, cps, d, bdir, cflags, verilog_channel)
     verilator = shutil.which("verilator")
