@@ -32,8 +32,9 @@
 //       list holds the keys and a slot number; the entries sit in distributed RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
-// same for cy) by two pipelined fmt_div (QW + 1 cycles, QW = max index width + 8), one
-// blob per cycle, then blob_eof_o (also for a frame without blobs).
+// same for cy) by one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8) shared
+// by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
+// then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the label
 // of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
@@ -59,10 +60,11 @@
 // Latency (processing-clock cycles, measured by tb/fmt_blob): the labelling takes
 // max(1, runs + merges) cycles per row and starts as soon as rows 0..r are present;
 // after the last labelled row: 4 pipeline cycles, one cycle per closed label, then
-// the emission (QW + 3 + blobs cycles) and, in parallel, the membership pass (ROWS + 2).
+// the emission (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass
+// (ROWS + 2).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 42..47 cycles, -> mask_ready_o 56..61 cycles.  Worst case (checkerboard: 600 runs,
-// every label slot live) 680 cycles from the first row beat to the end: within the
+// 43..48 cycles, -> mask_ready_o 56..61 cycles.  Worst case (checkerboard: 600 runs,
+// every label slot live) 681 cycles from the first row beat to the end: within the
 // 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
@@ -384,8 +386,9 @@ module fmt_blob #(
         for (g = 0; g < NG; g = g + 1) begin
             // the group's 8 masked cells (0 beyond the last column)
             for (i = 0; i < GS; i = i + 1)
-                gz[i*HM_W +: HM_W] = (g * GS + i < COLS) ? x1_zm_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
-                                                        : {HM_W{1'b0}};
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS)
+                                   ? x1_zm_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
+                                   : {HM_W{1'b0}};
             // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
             // u_i = z_2i + z_2i+1, v_0 = u_0 + u_1, v_1 = u_2 + u_3, sum = v_0 + v_1,
             // sum j z_j = 4 v_1 + 2 (u_1 + u_3) + (z_1 + z_3 + z_5 + z_7)
@@ -538,6 +541,7 @@ module fmt_blob #(
 
     // ---- emission -----------------------------------------------------------------------
     reg [CNT_W-1:0]   em_i_q, em_n_q;
+    reg               em_ph_q;                // 0: x quotients of entries 0..n-1, 1: y
     reg [FRAME_W-1:0] em_frame_q;
     reg               em_incomplete_q, em_over_q;
     reg [AREA_W-1:0]  em_found_q;
@@ -553,21 +557,23 @@ module fmt_blob #(
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
     wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_sy, 8'd0}
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
-    // valid_o duplicates dl_v_q; ovf_o needs sum z = 0 (threshold 0, unsupported; the
-    // quotient is then all ones)
+    // One divider for both coordinates: the x quotients of the n list entries are
+    // issued first, then the y quotients; an x result waits in qx_q (indexed by the
+    // entry) for its y result, which comes n cycles later, so the blobs still leave on
+    // consecutive cycles.  valid_o duplicates dl_v_q | dl_x_q; ovf_o needs sum z = 0
+    // (threshold 0, unsupported; the quotient is then all ones).
     /* verilator lint_off UNUSEDSIGNAL */
-    wire          dx_v, dy_v, dx_ovf, dy_ovf;
+    wire          dq_v, dq_ovf;
     /* verilator lint_on UNUSEDSIGNAL */
-    wire [QW-1:0] qx, qy;
-    fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_x (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_x), .den_i(em_sz),
-        .valid_o(dx_v), .quot_o(qx), .ovf_o(dx_ovf));
-    fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div_y (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(num_y), .den_i(em_sz),
-        .valid_o(dy_v), .quot_o(qy), .ovf_o(dy_ovf));
-    // index and end token travel beside the dividers
-    reg [DL-1:0]       dl_v_q, dl_t_q;
+    wire [QW-1:0] dq;
+    fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div (
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_ph_q ? num_y : num_x),
+        .den_i(em_sz), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+    // index, phase and end token travel beside the divider
+    reg [DL-1:0]       dl_v_q, dl_x_q, dl_t_q;
     reg [CNT_W-1:0]    dl_i_q [0:DL-1];
+    reg [QW-1:0]       qx_q [0:MB-1];         // x quotient per list entry
+    wire               out_x   = dl_x_q[DL-1];
     wire               out_v   = dl_v_q[DL-1];
     wire               out_tok = dl_t_q[DL-1];
     wire [CNT_W-1:0]   out_i   = dl_i_q[DL-1];
@@ -709,8 +715,9 @@ module fmt_blob #(
         dl_i_q[0] <= em_i_q;
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
         blob_area_o     <= out_p[0 +: AREA_W];
-        blob_cx_o       <= {{(16-QW){1'b0}}, qx};
-        blob_cy_o       <= {{(16-QW){1'b0}}, qy};
+        if (out_x) qx_q[out_i[MBI_W-1:0]] <= dq;
+        blob_cx_o       <= {{(16-QW){1'b0}}, qx_q[out_i[MBI_W-1:0]]};
+        blob_cy_o       <= {{(16-QW){1'b0}}, dq};
         blob_rmin_o     <= out_p[AREA_W +: ROW_IDX_W];
         blob_rmax_o     <= out_p[AREA_W + ROW_IDX_W +: ROW_IDX_W];
         blob_cmin_o     <= out_p[AREA_W + 2*ROW_IDX_W +: COL_IDX_W];
@@ -749,12 +756,14 @@ module fmt_blob #(
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
             em_i_q   <= {CNT_W{1'b0}};
+            em_ph_q  <= 1'b0;
             em_n_q   <= {CNT_W{1'b0}};
             em_frame_q <= {FRAME_W{1'b0}};
             em_incomplete_q <= 1'b0;
             em_over_q  <= 1'b0;
             em_found_q <= {AREA_W{1'b0}};
             dl_v_q   <= {DL{1'b0}};
+            dl_x_q   <= {DL{1'b0}};
             dl_t_q   <= {DL{1'b0}};
             bw_run_q  <= 1'b0;
             bw_r_q    <= {ROW_IDX_W{1'b0}};
@@ -845,6 +854,7 @@ module fmt_blob #(
             if (fin_ok || fin_abort) begin
                 state_q         <= S_EMIT;
                 em_i_q          <= {CNT_W{1'b0}};
+                em_ph_q         <= 1'b0;
                 em_n_q          <= (fin_ok && complete) ? (over ? MB_A[CNT_W-1:0] : found_q[CNT_W-1:0])
                                                         : {CNT_W{1'b0}};
                 em_frame_q      <= frm_q[pb_q];
@@ -882,9 +892,17 @@ module fmt_blob #(
             end
             if (out_tok) tok_q <= 1'b1;
 
-            if (em_issue) em_i_q <= em_i_q + 1'b1;
+            if (em_issue) begin
+                if (!em_ph_q && em_i_q + 1'b1 == em_n_q) begin
+                    em_i_q  <= {CNT_W{1'b0}};     // x quotients issued: now the y ones
+                    em_ph_q <= 1'b1;
+                end else begin
+                    em_i_q  <= em_i_q + 1'b1;
+                end
+            end
             if (em_tok) state_q <= S_WAIT;
-            dl_v_q <= {dl_v_q[DL-2:0], em_issue};
+            dl_v_q <= {dl_v_q[DL-2:0], em_issue && em_ph_q};
+            dl_x_q <= {dl_x_q[DL-2:0], em_issue && !em_ph_q};
             dl_t_q <= {dl_t_q[DL-2:0], em_tok};
             blob_valid_o <= out_v;
             blob_eof_o   <= out_tok;
