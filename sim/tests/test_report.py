@@ -105,8 +105,8 @@ def test_pooled_statistics():
 
 
 def test_latency_figures():
-    """The receive-chain figure is tb/fmt_rx_array's schedule (852 clk at 3 x fs with the
-    shared magnitude units: 6.8 us); it must fit the 8 us budget and exceed the FFT's
+    """The receive-chain figure is tb/fmt_rx_array's schedule (808 clk at 3 x fs with the
+    shared magnitude units: 6.46 us); it must fit the 8 us budget and exceed the FFT's
     output time."""
     cfg = params.DEFAULT
     rx = report.rx_latency_clk(cfg)
