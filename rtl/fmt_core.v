@@ -9,10 +9,8 @@
 // processing, latency counters and control port on every clk.  Sample k = k-th ce edge
 // after reset: dac_o (registered in fmt_dds_bank) holds DDS sample k after ce edge k+2;
 // adc_i is taken at every ce edge as the receivers' sample k (windows are samples
-// k*N .. k*N+N-1).  fmt_pn_gen has no ce input: it steps on every clk, so the core
-// programs it with CLK_PER_SAMPLE x the chip length and receive delay; with ce on clk
-// cycles 0, C, 2C, ... the signs seen at ce edges are exactly those of a PN generator
-// at fs (the DDS sample k carries PN chip floor((k-1)/L), the receiver sample j the
+// k*N .. k*N+N-1).  fmt_pn_gen steps on ce too, with the chip length and receive delay
+// in samples (the DDS sample k carries PN chip floor((k-1)/L), the receiver sample j the
 // chip floor((j-1-d)/L), d = PN_RX_DELAY) -- tb/fmt_core checks it bit for bit against
 // the models for C = 1 and 3.  The DDS bank shares one engine between C rows
 // (ROWS_PER_ENGINE = C: ce is exactly every C clk cycles) and the receivers size their
@@ -121,8 +119,8 @@ module fmt_core #(
     localparam LIM_W  = $clog2(MAX_TOUCHES + 1);
     localparam CELLS  = ROWS * COLS;
     localparam CPS_W  = (CPS > 1) ? $clog2(CPS) : 1;
-    localparam CHIP_W = 10 + 2;                   // PN chip length in clk cycles (x CPS <= 4)
-    localparam DLY_W  = 6 + 2;                    // PN receive delay in clk cycles
+    localparam CHIP_W = 10;                       // PN chip length in samples (PN_CHIP_LEN)
+    localparam DLY_W  = 6;                        // PN receive delay in samples (PN_RX_DELAY)
     localparam [15:0] COLS16  = COLS[15:0];           // 16-bit copies for width-clean address arithmetic
     localparam [15:0] CELLS16 = CELLS[15:0];
 
@@ -208,10 +206,6 @@ module fmt_core #(
 
     wire [ROWS*DAC_BITS-1:0] dac;
     wire                     rx_sign;
-    wire [9:0]               chip1    = (r_chip_len == 10'd0) ? 10'd1 : r_chip_len;
-    localparam [2:0]         CPS3     = CPS[2:0];
-    wire [CHIP_W-1:0]        chip_clk = {2'b00, chip1} * CPS3;
-    wire [DLY_W-1:0]         dly_clk  = {2'b00, r_rx_delay} * CPS3;
     /* verilator lint_off PINCONNECTEMPTY */  // tx_sign_o, chip_start_o: not needed outside fmt_tx
     fmt_tx #(
         .ROWS(ROWS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
@@ -220,7 +214,7 @@ module fmt_core #(
         .ROWS_PER_ENGINE(CPS), .ROW_W(ROW_W)
     ) u_tx (
         .clk(clk), .rst(rst), .ce(ce),
-        .pn_enable_i(r_pn_en), .chip_len_i(chip_clk), .rx_delay_i(dly_clk),
+        .pn_enable_i(r_pn_en), .chip_len_i(r_chip_len), .rx_delay_i(r_rx_delay),
         .cfg_we_i(dds_we), .cfg_row_i(dds_row), .cfg_sel_i(dds_sel), .cfg_data_i(dds_data),
         .dac_o(dac), .tx_sign_o(), .rx_sign_o(rx_sign), .chip_start_o());
     /* verilator lint_on PINCONNECTEMPTY */

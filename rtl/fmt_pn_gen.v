@@ -11,7 +11,9 @@
 // tx_sign_o is the transmit sign (1 = multiply by -1) of the current sample.
 // rx_sign_o is the same sequence delayed by rx_delay_i samples (0 = no delay,
 // at most 2^DELAY_W - 1), to line up with the channel delay in front of the ADC.
-// Both outputs are registered; sample i after reset is the i-th cycle with rst low.
+// Everything advances on the sample strobe ce (one sample per ce edge; ce = 1 steps on
+// every clk): sample i after reset is the i-th ce edge with rst low, and the outputs,
+// registered, change only at ce edges (constant over the clk cycles of a sample).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -24,6 +26,7 @@ module fmt_pn_gen #(
 ) (
     input  wire               clk,
     input  wire               rst,          // synchronous, active high
+    input  wire               ce,           // sample strobe: the generator steps on ce
     input  wire               enable_i,     // 0: PN off, both signs stay +1
     input  wire [CHIP_W-1:0]  chip_len_i,   // samples per chip; 0 is taken as 1
     input  wire [DELAY_W-1:0] rx_delay_i,   // receive delay in samples
@@ -52,7 +55,7 @@ module fmt_pn_gen #(
             tx_sign_o    <= 1'b0;
             rx_sign_o    <= 1'b0;
             chip_start_o <= 1'b0;
-        end else begin
+        end else if (ce) begin
             if (chip_end) begin
                 count_q <= {CHIP_W{1'b0}};
                 lfsr_q  <= {lfsr_q[PN_BITS-2:0], feedback};
@@ -76,13 +79,20 @@ module fmt_pn_gen #(
         if (past_valid_q && !$past(rst)) begin
             // the LFSR never reaches the all-zero lock-up state
             assert (lfsr_q != {PN_BITS{1'b0}});
+            // the newest history entry is the transmit sign (inductive invariant)
+            assert (history_q[0] == tx_sign_o);
+            // no sample strobe: nothing moves
+            if (!$past(ce))
+                assert (lfsr_q == $past(lfsr_q) && count_q == $past(count_q) &&
+                        history_q == $past(history_q) && tx_sign_o == $past(tx_sign_o) &&
+                        rx_sign_o == $past(rx_sign_o) && chip_start_o == $past(chip_start_o));
             // PN off: the transmit sign is +1
-            if (!$past(enable_i)) assert (!tx_sign_o);
+            if ($past(ce) && !$past(enable_i)) assert (!tx_sign_o);
             // zero receive delay: receive and transmit signs are the same sample
-            if ($past(rx_delay_i) == {DELAY_W{1'b0}}) assert (rx_sign_o == tx_sign_o);
-            // one receive-delay step: rx is tx of the previous sample
-            if ($past(rx_delay_i) == 1 && past_valid_q && !$past(rst, 2))
-                assert (rx_sign_o == $past(tx_sign_o));
+            if ($past(ce) && $past(rx_delay_i) == {DELAY_W{1'b0}}) assert (rx_sign_o == tx_sign_o);
+            // one receive-delay step: rx is tx of the previous sample (the value tx held
+            // before this sample's ce edge)
+            if ($past(ce) && $past(rx_delay_i) == 1) assert (rx_sign_o == $past(tx_sign_o));
             // the chip counter never runs past a chip while the setting is constant
             if ($past(chip_len_i) == chip_len_i && $past(count_q) < last_count)
                 assert (count_q <= last_count);

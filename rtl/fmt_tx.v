@@ -8,14 +8,11 @@
 // dac_o when rx_delay_i = 3 + the channel delay in samples (DAC to despreader input).
 // PN off (pn_enable_i = 0) leaves the tones unmodulated; the LFSR keeps running.
 //
-// ce: fmt_pn_gen has no sample strobe (it steps on every clk).  With ce = 1 (one
-// sample per clock, ROWS_PER_ENGINE = 1) the timing above holds as stated.  With
-// CLK_PER_SAMPLE = C > 1 (ce every C clk cycles; set ROWS_PER_ENGINE = C to share one
-// DDS engine between C rows, which needs exactly that ce spacing) program chip_len_i
-// and rx_delay_i in clk cycles (C x the values in samples): the DDS takes tx_sign_o as
-// it is at each ce edge, so DDS sample k carries the PN sign of clk cycle T_k - 1
-// (T_k = clk edge of ce edge k), i.e. PN chip floor((k - 1) / L) for chip length L
-// samples when the first ce edge is the first clk edge after reset (as in fmt_core).
+// ce: the PN generator and the DDS bank both step on ce, so with ce every C clk cycles
+// (CLK_PER_SAMPLE = C; set ROWS_PER_ENGINE = C to share one DDS engine between C rows,
+// which needs exactly that ce spacing) "sample k" above is the k-th ce edge: DDS sample
+// k carries PN chip floor((k - 1) / L) for chip length L samples, and chip_len_i and
+// rx_delay_i are in samples whatever C is.
 // Twin: sim/fmt/dds.py fmt_tx_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -41,7 +38,7 @@ module fmt_tx #(
 ) (
     input  wire                     clk,
     input  wire                     rst,           // synchronous, active high
-    input  wire                     ce,            // sample strobe of the DDS (see header)
+    input  wire                     ce,            // sample strobe of the PN and the DDS (see header)
     input  wire                     pn_enable_i,   // 0: PN off (sign +1)
     input  wire [CHIP_W-1:0]        chip_len_i,    // samples per chip (0 = 1)
     input  wire [DELAY_W-1:0]       rx_delay_i,    // receive-sign delay in samples
@@ -64,6 +61,7 @@ module fmt_tx #(
     ) u_pn (
         .clk          (clk),
         .rst          (rst),
+        .ce           (ce),
         .enable_i     (pn_enable_i),
         .chip_len_i   (chip_len_i),
         .rx_delay_i   (rx_delay_i),

@@ -3,7 +3,9 @@
 Checks, under both simulators and for several LFSR lengths: bit-exact transmit and
 receive signs for random chip lengths and delays, the enable switch, the maximal
 period 2^L - 1 and the balance of one period (2^(L-1) ones, 2^(L-1) - 1 zeros),
-chip length changes at run time, and a reset in the middle of a chip.
+chip length changes at run time, a reset in the middle of a chip, and the sample
+strobe: with ce high one clk in C (C = 3, as at 3 x fs) or at random, the signs seen at
+the ce edges are the same sequence and nothing changes between ce edges.
 """
 from __future__ import annotations
 
@@ -27,6 +29,7 @@ class TB(ClockedTB):
         self.bits = env_int("PN_BITS", 15)
         self.chip_w = env_int("CHIP_W", 10)
         self.delay_w = env_int("DELAY_W", 6)
+        dut.ce.value = 1
         dut.enable_i.value = 1
         dut.chip_len_i.value = 1
         dut.rx_delay_i.value = 0
@@ -114,6 +117,45 @@ async def reset_mid_chip(dut):
     tx, _, _ = await tb.capture(80)
     mtx, _ = pn_signs(80, chip_len=7, bits=tb.bits)
     assert np.array_equal(tx, mtx)
+
+
+@cocotb.test()
+async def sample_strobe(dut):
+    """ce every 3rd clk, then at random: the outputs after each ce edge follow the model
+    sample by sample (chip length and delay in samples) and hold between ce edges."""
+    tb = TB(dut)
+    rng = random.Random(11)
+    for mode in ("every3", "random"):
+        chip_len, delay = rng.randrange(1, 6), rng.randrange(0, 1 << tb.delay_w)
+        await tb.writable()
+        dut.chip_len_i.value = chip_len
+        dut.rx_delay_i.value = delay
+        dut.ce.value = 0
+        await tb.reset()
+        n = 240
+        tx = np.zeros(n, dtype=np.uint8)
+        rx = np.zeros(n, dtype=np.uint8)
+        k, t = 0, 0
+        held = None
+        while k < n:
+            ce = (t % 3 == 0) if mode == "every3" else (rng.random() < 0.4)
+            await tb.writable()
+            dut.ce.value = int(ce)
+            await RisingEdge(tb.clk)
+            await ReadOnly()
+            now = (int(dut.tx_sign_o.value), int(dut.rx_sign_o.value), int(dut.chip_start_o.value))
+            if ce:
+                tx[k], rx[k] = now[0], now[1]
+                k += 1
+            elif held is not None:
+                assert now == held, f"{mode}: output changed without ce at clk {t}"
+            held = now
+            t += 1
+        mtx, mrx = pn_signs(n, chip_len=chip_len, rx_delay=delay, bits=tb.bits)
+        assert np.array_equal(tx, mtx), f"{mode}: tx mismatch chip_len={chip_len}"
+        assert np.array_equal(rx, mrx), f"{mode}: rx mismatch delay={delay}"
+    await tb.writable()
+    dut.ce.value = 1
 
 
 # ---- pytest entry ------------------------------------------------------------------

@@ -3,12 +3,12 @@ sim/fmt/pn.py + sim/fmt/dds.py.
 
 Checks, under Icarus (Verilator: MEDIUM with R = 3; all variants with FMT_DDS_FULL=1),
 for ROWS_PER_ENGINE R = 1 (ce = 1) and R = 3 (ce on clk cycles 0, 3,
-6, ... after reset, PN chip length and receive delay programmed in clk cycles, as
-fmt_core does): every DAC word bit-exact with the model for random PN settings (chip
-length, PN enable toggled at random clk cycles), random DDS settings written at random
-clk cycles, and a reset in the middle of a window; and, for R = 1, the documented
+6, ... after reset, as fmt_core does; the PN generator steps on ce, chip length and
+receive delay in samples): every DAC word bit-exact with the model for random PN
+settings (chip length, PN enable toggled at random clk cycles), random DDS settings
+written at random clk cycles, and a reset in the middle of a window; and the documented
 alignment: with rx_delay_i = 3, rx_sign_o is the PN sign of the words on dac_o at the
-same edge.
+same ce edge, constant between ce edges.
 """
 from __future__ import annotations
 
@@ -90,10 +90,9 @@ async def bit_exact_pn_and_settings(dut):
     err0 = tb.ce_errors()
     for seg in range(3):
         chip_len = [1, rng.randrange(2, 5), 0][seg]        # samples per chip (0 = 1)
-        chip_clk = chip_len if R == 1 else max(1, chip_len) * R
         await tb.writable()
-        dut.chip_len_i.value = chip_clk
-        dut.rx_delay_i.value = ALIGN_DELAY * R
+        dut.chip_len_i.value = chip_len
+        dut.rx_delay_i.value = ALIGN_DELAY
         dut.ce.value = 0 if R > 1 else 1
         await tb.reset()
         tb.defaults()
@@ -106,17 +105,19 @@ async def bit_exact_pn_and_settings(dut):
             assert not obs[:LATENCY].any()
             assert np.array_equal(obs[LATENCY:], ref[:n - LATENCY]), "fmt_tx_fixed mismatch"
         n_clk = len(pen)
-        tx = pn_tx(n_clk, chip_clk, pen, tb.pn_bits)       # tx_sign_o after clk edge i
-        # DDS sample k (ce edge at clk edge kR) takes tx_sign_o as it is before that edge
-        sign = np.concatenate([[0], tx[R * np.arange(1, n) - 1]])
+        # the PN generator steps on ce: tx_sign_o after ce edge k (clk edge kR) = PN enable
+        # at that edge AND chip (k // chip_len); it holds between ce edges
+        tx = pn_tx(n, chip_len, pen[R * np.arange(n)], tb.pn_bits)
+        # DDS sample k takes tx_sign_o as it is before its ce edge: sample k-1's sign
+        sign = np.concatenate([[0], tx[:n - 1]])
         tb.check(tw, amp, en, sign, obs, what=f"segment {seg} chip_len {chip_len}")
         assert tx.any(), "PN active in this segment"
         assert tb.ce_errors() == err0
-        if R == 1:
-            # rx_sign_o (delay 3) after edge j = tx sign of PN sample j-3 = sign of dac word j
-            exp_rx = np.concatenate([np.zeros(ALIGN_DELAY, dtype=np.int64), tx[:-ALIGN_DELAY]])
-            assert np.array_equal(rxs, exp_rx), "rx_sign_o"
-            assert np.array_equal(rxs[LATENCY:], sign[:n - LATENCY]), "rx sign aligned with dac words"
+        # rx_sign_o (delay 3 samples) after ce edge k = tx sign of PN sample k-3 = the sign
+        # of dac word k; after any clk edge t it is that of the last ce edge t // R
+        rx_s = np.concatenate([np.zeros(ALIGN_DELAY, dtype=np.int64), tx[:-ALIGN_DELAY]])
+        assert np.array_equal(rxs, rx_s[np.arange(n_clk) // R]), "rx_sign_o"
+        assert np.array_equal(rx_s[LATENCY:], sign[:n - LATENCY]), "rx sign aligned with dac words"
         # a reset in the middle of the next window comes with the next segment
         await tb.cycles(rng.randrange(1, tb.cfg.n_fft))
 
