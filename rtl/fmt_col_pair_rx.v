@@ -66,13 +66,27 @@ module fmt_col_pair_rx #(
 
     localparam W    = FFT_OUT_W;
     localparam MW   = W + 1;                        // pair split / magnitude width
-    localparam TAGW = ROW_W + 2 + SH_W;             // {row, first, last, shift}
+    localparam FM_MAX = 1 << M_LOG2_MAX;            // the front counts M = 2^m windows
+    localparam FMC_W  = M_LOG2_MAX + 1;             // width of M (= $clog2(FM_MAX + 1))
+    localparam TAGW = ROW_W + 2 + FMC_W;            // {row, M, first, last}
+    localparam [SH_W-1:0] SH_MAX = M_LOG2_MAX;
+
+    // M = 2^m (m clamped to M_LOG2_MAX) for the front's window counter
+    wire [SH_W-1:0]  m_sh;
+    generate
+        if (M_LOG2_MAX < (1 << SH_W) - 1) begin : g_clamp
+            assign m_sh = (m_log2_i > SH_MAX) ? SH_MAX : m_log2_i;
+        end else begin : g_noclamp
+            assign m_sh = m_log2_i;                 // every SH_W-bit value is <= M_LOG2_MAX
+        end
+    endgenerate
+    wire [FMC_W-1:0] m_pow = {{(FMC_W-1){1'b0}}, 1'b1} << m_sh;
 
     // ---- despread, FFT, frame bookkeeping, pair split (shared with fmt_rx_array) ----
     wire                 ps_valid;
     wire [ROW_W-1:0]     ps_row;
     wire signed [MW-1:0] ps_ar, ps_ai, ps_br, ps_bi;
-    wire [SH_W+1:0]      ps_tag;
+    wire [FMC_W+1:0]     ps_tag;
     // the front's result memory serves shared magnitude units (fmt_rx_array); here the
     // split outputs feed this pair's own units: no result memory (RES_MEM = 0)
     /* verilator lint_off UNUSEDSIGNAL */
@@ -80,11 +94,11 @@ module fmt_col_pair_rx #(
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_rx_pair_front #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W), .TW_DIR(TW_DIR),
-        .POST_CLK(POST_CLK), .RES_MEM(0), .ROW_W(ROW_W), .SH_W(SH_W)
+        .ADC_BITS(ADC_BITS), .M_MAX(FM_MAX), .FFT_OUT_W(W), .TW_DIR(TW_DIR),
+        .POST_CLK(POST_CLK), .RES_MEM(0), .ROW_W(ROW_W), .MC_W(FMC_W)
     ) u_front (
         .clk(clk), .rst(rst), .ce(ce), .adc_a_i(adc_a_i), .adc_b_i(adc_b_i),
-        .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+        .rx_sign_i(rx_sign_i), .m_i(m_pow),
         .ps_valid_o(ps_valid), .ps_row_o(ps_row), .ps_tag_o(ps_tag),
         .ps_ar_o(ps_ar), .ps_ai_o(ps_ai), .ps_br_o(ps_br), .ps_bi_o(ps_bi),
         .rd_row_i({ROW_W{1'b0}}), .rd_data_o(unused_rd), .fft_ovf_o(fft_ovf_o));
@@ -110,7 +124,14 @@ module fmt_col_pair_rx #(
 
     // ---- accumulation over the frame ----
     wire [ROW_W-1:0] mg_row   = mg_tag[TAGW-1 -: ROW_W];
-    wire [SH_W-1:0]  mg_shift = mg_tag[SH_W+1:2];
+    wire [FMC_W-1:0] mg_m     = mg_tag[FMC_W+1:2];
+    reg  [SH_W-1:0]  mg_shift;                       // log2 M (M is a power of two here)
+    integer b;
+    always @* begin
+        mg_shift = {SH_W{1'b0}};
+        for (b = 1; b <= M_LOG2_MAX; b = b + 1)
+            if (mg_m[b]) mg_shift = b[SH_W-1:0];
+    end
     wire             mg_first = mg_tag[1];
     wire             mg_last  = mg_tag[0];
     fmt_accum #(

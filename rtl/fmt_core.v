@@ -17,9 +17,11 @@
 // shared magnitude units for C clk per sample (fmt_rx_array CLK_PER_SAMPLE).
 //
 // Latency (fmt_latency): the frame end is the ce edge that takes the last ADC sample of
-// a frame (M = 2^m windows, m = floor(log2 WINDOWS_M) clamped to M_LOG2_MAX, latched at
-// each frame's first window as fmt_col_pair_rx does); events count when they leave the
-// parallel port (ev_valid_o & ev_ready_i).  trig_i is the external touch trigger.
+// a frame (M = WINDOWS_M windows, any 1 .. M_MAX: 0 is taken as 1, values above M_MAX
+// as M_MAX (only possible when M_MAX < 255; docs/REGISTERS.md); latched at the last
+// sample of each frame's first window and passed from there to the receivers, so both
+// always agree on the frames); events count when they leave the parallel port
+// (ev_valid_o & ev_ready_i).  trig_i is the external touch trigger.
 //
 // Registers (docs/REGISTERS.md) are written/read by the UART control port or by the
 // local bus (bus_*; e.g. a board CPU or a testbench).  Both masters share the register
@@ -68,7 +70,7 @@ module fmt_core #(
     parameter HM_W           = `FMT_HM_W,         // heat-map cell width
     parameter MAX_TOUCHES    = `FMT_MAX_TOUCHES,  // contact limit
     parameter CLK_PER_SAMPLE = 3,                 // clk cycles per ADC sample (1..4)
-    parameter M_LOG2_MAX     = 3,                 // largest log2 of windows per frame
+    parameter M_MAX          = 255,               // largest windows per frame M (1 .. 255)
     parameter EV_DEPTH       = 2048,              // event FIFO entries (power of two)
     parameter UART_DIV       = 1085,              // clk cycles per UART bit (125 MHz: 115200 baud)
     parameter UART_TIMEOUT   = 40,                // control-port inter-byte timeout, bit times
@@ -115,7 +117,7 @@ module fmt_core #(
 );
     localparam CPS    = CLK_PER_SAMPLE;
     localparam N      = 1 << LOG2_N;
-    localparam SH_W   = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1;
+    localparam MC_W   = $clog2(M_MAX + 1);        // width of M
     localparam LIM_W  = $clog2(MAX_TOUCHES + 1);
     localparam CELLS  = ROWS * COLS;
     localparam CPS_W  = (CPS > 1) ? $clog2(CPS) : 1;
@@ -221,48 +223,57 @@ module fmt_core #(
     assign dac_o = r_run ? dac : {(ROWS*DAC_BITS){1'b0}};
 
     // ---------------------------------------------------------------- receive
-    // M = WINDOWS_M -> m = floor(log2 M), clamped to M_LOG2_MAX (0 and 1 -> M = 1)
-    reg [SH_W-1:0] m_log2;
-    integer b;
-    always @(*) begin
-        m_log2 = {SH_W{1'b0}};
-        for (b = 1; b < 8; b = b + 1)
-            if (r_windows_m[b] && b <= M_LOG2_MAX) m_log2 = b[SH_W-1:0];
-        if (r_windows_m > (8'd1 << M_LOG2_MAX)) m_log2 = M_LOG2_MAX[SH_W-1:0];
-    end
+    // M = WINDOWS_M windows per frame: 0 -> 1, above M_MAX -> M_MAX.  The frame's M is
+    // latched on the ce edge that takes the last sample of the frame's first window
+    // (m_act_q, below) and fed to the receivers from there: they take it when their FFT
+    // outputs that window (LATENCY0 < N samples later, before the next latch), so the
+    // receivers' frames and this frame-end counter always agree, whenever WINDOWS_M is
+    // written.
+    localparam [7:0] MMAX8 = M_MAX[7:0];
+    wire [7:0]      m_lim;
+    wire [7:0]      m_win  = (m_lim == 8'd0) ? 8'd1 : m_lim;
+    reg  [7:0]      m_act_q;       // M of the current frame (from its first window's end)
+    wire [MC_W-1:0] m_sel  = m_act_q[MC_W-1:0];
+    generate
+        if (M_MAX < 255) begin : g_m_clamp
+            assign m_lim = (r_windows_m > MMAX8) ? MMAX8 : r_windows_m;
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire unused_m_hi = &{1'b0, m_act_q};  // m_act_q <= M_MAX: its top bits are 0
+            /* verilator lint_on UNUSEDSIGNAL */
+        end else begin : g_m_full
+            assign m_lim = r_windows_m;          // every 8-bit value is a valid M
+        end
+    endgenerate
     wire                  hm_valid, hm_eof, rx_fft_ovf, rx_sat, rx_ovf;
     wire [ROW_W-1:0]      hm_row;
     wire [15:0]           hm_frame;
     wire [COLS*HM_W-1:0]  hm_data;
     fmt_rx_array #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .ADC_BITS(ADC_BITS), .HM_W(HM_W), .FRAME_W(16), .M_LOG2_MAX(M_LOG2_MAX),
-        .TW_DIR(TW_DIR), .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .SH_W(SH_W),
+        .ADC_BITS(ADC_BITS), .HM_W(HM_W), .FRAME_W(16), .M_MAX(M_MAX),
+        .TW_DIR(TW_DIR), .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .MC_W(MC_W),
         .CLK_PER_SAMPLE(CPS)
     ) u_rx (
-        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_i), .rx_sign_i(rx_sign), .m_log2_i(m_log2),
+        .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_i), .rx_sign_i(rx_sign), .m_i(m_sel),
         .hm_valid(hm_valid), .hm_row(hm_row), .hm_frame(hm_frame), .hm_data(hm_data),
         .hm_eof(hm_eof), .fft_ovf_o(rx_fft_ovf), .sat_o(rx_sat), .ovf_o(rx_ovf));
 
     // frame end of the receive side: the ce edge taking a frame's last ADC sample
     reg [LOG2_N-1:0] samp_q;
-    reg [7:0]        win_q;        // window within the frame
-    reg [SH_W-1:0]   m_cur_q;      // log2 M of the current frame
+    reg [7:0]        win_q;        // window within the frame, 0 .. M-1
     reg [15:0]       fend_num_q;   // number of the frame that ends next
-    wire [7:0]       win_last = (8'd1 << m_cur_q) - 8'd1;
-    wire [SH_W-1:0]  m_now    = (win_q == 8'd0) ? m_log2 : m_cur_q;
-    wire             frame_end = ce && (samp_q == N - 1) &&
-                                 (win_q == ((8'd1 << m_now) - 8'd1));
+    wire [7:0]       m_now    = (win_q == 8'd0) ? m_win : m_act_q;
+    wire             frame_end = ce && (samp_q == N - 1) && (win_q == m_now - 8'd1);
     always @(posedge clk) begin
         if (rst) begin
             samp_q     <= {LOG2_N{1'b0}};
             win_q      <= 8'd0;
-            m_cur_q    <= {SH_W{1'b0}};
+            m_act_q    <= 8'd1;
             fend_num_q <= 16'd0;
         end else if (ce) begin
             samp_q <= samp_q + 1'b1;
-            if (samp_q == {LOG2_N{1'b0}} && win_q == 8'd0) m_cur_q <= m_log2;
             if (samp_q == N - 1) begin
+                if (win_q == 8'd0) m_act_q <= m_win;
                 if (frame_end) begin
                     win_q      <= 8'd0;
                     fend_num_q <= fend_num_q + 1'b1;
@@ -272,7 +283,6 @@ module fmt_core #(
             end
         end
     end
-    wire unused_win = &{1'b0, win_last};
 
     // ---------------------------------------------------------------- touch processing
     wire             ev_valid;

@@ -22,7 +22,7 @@ module fmt_regfile (
     output reg  pn_enable_o,                        // PN_ENABLE (rw): 1 = PN stir/unstir on (fmt_pn_gen enable_i)
     output reg  [9:0] pn_chip_len_o,                // PN_CHIP_LEN (rw): Samples per PN chip (fmt_pn_gen chip_len_i; 0 is taken as 1)
     output reg  [5:0] pn_rx_delay_o,                // PN_RX_DELAY (rw): Receive PN delay in samples (fmt_pn_gen rx_delay_i)
-    output reg  [7:0] windows_m_o,                  // WINDOWS_M (rw): FFT windows accumulated per frame
+    output reg  [7:0] windows_m_o,                  // WINDOWS_M (rw): FFT windows accumulated per frame, any M from 1 to M_MAX (fmt_core parameter; 255 in the default build, so every value); 0 is taken as 1, a value above M_MAX as M_MAX
     output reg  [4:0] tone_sel_o,                   // TONE_SEL (rw): Row selector of the tone-plan windows TONE_TW and TONE_AMP
     output wire tone_tw_we_o,                       // TONE_TW (window): write strobe
     output wire [31:0] tone_tw_wdata_o,             // TONE_TW: write data

@@ -10,14 +10,24 @@
 // accumulator memory are shared by all columns:
 //   queue   every engine completes a row's comb bins in the same slot, pair c of an
 //           engine c clk after its pair 0 (engine 0 stands for all); the row is queued
-//           when the last pair has it: {row, log2 M, first, last} enter a FIFO (2^ROW_W
+//           when the last pair has it: {row, M, first, last} enter a FIFO (2^ROW_W
 //           entries, LUT RAM)
 //   engine  takes a row from the FIFO and reads the pairs' result memories at that row
 //           (one address for all pairs), feeding unit u with cell c = g*MAG_UNITS + u in
 //           step g = 0 .. P-1, P = ceil(COLS / MAG_UNITS): a row takes P steps
 //   accum   one memory of 2^(ROW_W+G_W) x MAG_UNITS*SUM_W bits, address {row, g}
-//           (synchronous read: block RAM), sum over the M windows, round, saturate
-//           (arithmetic exactly that of fmt_accum)
+//           (synchronous read: block RAM), exact sum over the M windows (SUM_W = MW +
+//           MC_W bits: M_MAX windows cannot overflow), then the rounded mean
+//             cell = floor((sum + M) / 2M)          (round half up of sum / 2M; the 2 is
+//                                                    the pair split's factor, HM_SHIFT = 1)
+//           by an exact reciprocal multiply: t = sum + M < 2^T (T = SUM_W + 1),
+//           l = ceil(log2 M), R = ceil(2^(T+l) / M) (T + 1 bits), cell = (t R) >>
+//           (T + l + 1) = floor(floor(t / M) / 2) for every t < 2^T (Granlund-Montgomery:
+//           R M - 2^(T+l) < M <= 2^l; rx_fixed.recip / recip_divide, tested exhaustively
+//           at small T and by the bound for every M at the build's T); for M = 2^m exactly
+//           (sum + 2^m) >> (m + 1), the arithmetic of fmt_accum.  R comes from
+//           TW_DIR/fmt_recip.hex (rx_fixed.recip_rom: ceil(2^(40+l) / M) for M = 0..255)
+//           as ceil(entry / 2^(40-T)) (one add per row).  Then saturate to HM_W bits
 //   stream  group g's cells go into the row register at [g*MAG_UNITS*HM_W]; after the
 //           last group hm_valid is high for one clk with the whole row
 // A "step" is a clk (POST_CLK = 1) or a ce cycle (POST_CLK = 0); rows complete at most
@@ -35,18 +45,20 @@
 // Stream: hm_valid one clk per row, hm_row its index, hm_frame the frame number (wraps,
 // FRAME_W bits, from 0 after reset), hm_data column c at [c*HM_W +: HM_W] (valid with
 // hm_valid), hm_eof one step after the frame's last row, never with a row.  Frame =
-// M = 2^m_log2_i windows (fmt_rx_pair_front); a reset in the middle of a window drops it
-// and the stream restarts with the first full frame.
+// M = m_i windows, any 1 .. M_MAX (latched at a frame's first window; 0 is taken as 1,
+// values above M_MAX as M_MAX; fmt_rx_pair_front); a reset in the middle of a window
+// drops it and the stream restarts with the first full frame.
 // Latency (M = 1), from the ce edge that takes a window's last ADC sample: row r's pair
 // split output (the last pair's, FFT_CH > 1) is registered at step a_r = LATENCY0 +
 // slot_r + 1 ce cycles later (FFT_CH = 1) or, FFT_CH = G with ce every G clk, at clk
 // G + LATENCY0 + G slot_r (the FFT's register stages step on clk cycles:
 // rx_fixed.rx_split_clk); the row is queued at a_r + 1, loaded at L_r >= a_r + 2, and its
-// beat is at step L_r + P + MAG_ITER + 6 (P unit input steps, MAG_ITER + 3 magnitude
-// stages, accumulator read, sum, round, row register).  N = 256, 30 x 40: last row 298
-// ce cycles after the window's last sample at ce = 1 (K = 10); at 3 x fs (K = 4) 808
-// clk = 269.3 fs cycles with FFT_CH = 3 (852 clk with FFT_CH = 1), hm_eof 1 step later
-// (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
+// beat is at step L_r + P + MAG_ITER + 8 (P unit input steps, MAG_ITER + 3 magnitude
+// stages, accumulator read, sum, rounding add, reciprocal multiply, shift + saturate,
+// row register); the same for every M (counted from the frame's last window).  N = 256,
+// 30 x 40: last row 300 ce cycles after the window's last sample at ce = 1 (K = 10); at
+// 3 x fs (K = 4) 810 clk = 270.0 fs cycles with FFT_CH = 3 (854 clk with FFT_CH = 1),
+// hm_eof 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
 // heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
 // before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
@@ -64,11 +76,11 @@ module fmt_rx_array #(
     parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
     parameter HM_W       = `FMT_HM_W,      // heat-map cell width (unsigned)
     parameter FRAME_W    = 16,             // frame counter width
-    parameter M_LOG2_MAX = 3,              // largest log2 M
-    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
+    parameter M_MAX      = 255,            // largest windows per frame M (1 .. 255)
+    parameter TW_DIR     = "rtl/",         // directory of the hex files (FFT twiddles, fmt_recip.hex)
     parameter POST_CLK   = 1,              // 1: back end after the FFT on every clk, 0: on ce
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
-    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1, // width of m_log2_i
+    parameter MC_W       = $clog2(M_MAX + 1),                  // width of m_i
     parameter CLK_PER_SAMPLE = (POST_CLK != 0) ? 3 : 1,   // smallest clk per ce period the
                                            // shared units must keep up with (POST_CLK = 1)
     parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
@@ -82,7 +94,7 @@ module fmt_rx_array #(
     input  wire                     ce,        // sample strobe
     input  wire [COLS*ADC_BITS-1:0] adc_i,     // column c ADC sample at [c*ADC_BITS +: ADC_BITS]
     input  wire                     rx_sign_i, // receive PN sign (fmt_pn_gen rx_sign_o)
-    input  wire [SH_W-1:0]          m_log2_i,  // log2 of windows per frame (0 = M = 1)
+    input  wire [MC_W-1:0]          m_i,       // windows per frame M (0 = 1, > M_MAX = M_MAX)
     output reg                      hm_valid,  // heat-map row beat
     output reg  [ROW_W-1:0]         hm_row,    // row index
     output reg  [FRAME_W-1:0]       hm_frame,  // frame number
@@ -137,16 +149,24 @@ module fmt_rx_array #(
     localparam P    = (COLS + K - 1) / K;                    // steps (groups) per row
     localparam G_W  = (P > 1) ? $clog2(P) : 1;               // group index width
     localparam AW   = ROW_W + G_W;                           // accumulator address {row, g}
-    localparam SUM_W = MW + M_LOG2_MAX;                      // exact sum over M windows
-    localparam TS   = M_LOG2_MAX + 1;                        // largest shift (HM_SHIFT = 1)
-    localparam EW   = (SUM_W > HM_W) ? SUM_W + 1 : HM_W + 1; // width after the rounding half
-    localparam TAGW = ROW_W + G_W + SH_W + 2;                // {row, g, log2 M, first, last}
+    localparam SUM_W = MW + MC_W;                            // exact sum over M_MAX windows
+    localparam T    = SUM_W + 1;                             // divider input width (sum + M)
+    localparam TR   = 40;                                    // precision of fmt_recip.hex
+    localparam RW   = TR + 1;                                // ROM word width
+    localparam LW   = 4;                                     // width of l = ceil(log2 M) <= 8
+    localparam PW   = 2 * T + 1;                             // product width
+    localparam QW   = PW - T - 1;                            // product >> (T + 1) width
+    localparam TAGW = ROW_W + G_W + MC_W + 2;                // {row, g, M, first, last}
     localparam QD   = 1 << ROW_W;                            // queue depth (>= ROWS)
     localparam LAST_ROW = last_row_f(0);
     localparam integer PM1 = P - 1;
     localparam [G_W-1:0] G_LAST = PM1[G_W-1:0];
 
     generate
+        if (M_MAX < 1 || M_MAX > 255 || T > TR) begin : g_check_m
+            // M_MAX outside 1 .. 255 (fmt_recip.hex) or the sum too wide for its precision
+            fmt_rx_array_M_MAX_unsupported u_bad_m ();
+        end
         if (ROWS * P > N * STEPC) begin : g_check
             // MAG_UNITS too few to process a window's rows in a window: stop elaboration
             fmt_rx_array_MAG_UNITS_too_few u_too_few ();
@@ -170,7 +190,7 @@ module fmt_rx_array #(
     reg  [ROW_W-1:0]        row_q;       // engine row (result memory read address)
     wire                    push_v;      // a row is complete in every pair: queue it
     wire [ROW_W-1:0]        push_row;
-    wire [SH_W+1:0]         push_tag;
+    wire [MC_W+1:0]         push_tag;
     wire                    chk_v;       // a row's result memories start to be rewritten
     wire [ROW_W-1:0]        chk_row;
     wire                    seq_ovf;     // a time-multiplexed engine missed a sample
@@ -191,27 +211,27 @@ module fmt_rx_array #(
         if (GC == 1) begin : g_pairs
             wire [PAIRS-1:0]          p_valid, p_ovf;
             wire [PAIRS*ROW_W-1:0]    p_row;
-            wire [PAIRS*(SH_W+2)-1:0] p_tag;
+            wire [PAIRS*(MC_W+2)-1:0] p_tag;
             // split outputs are used through the result memories only; the pairs run in
             // lockstep: pair 0's valid, row and tag stand for all
             /* verilator lint_off UNUSEDSIGNAL */
             wire [PAIRS*4*MW-1:0]     p_split;
             wire [PAIRS-1:0]          unused_valid = p_valid;
             wire [PAIRS*ROW_W-1:0]    unused_row   = p_row;
-            wire [PAIRS*(SH_W+2)-1:0] unused_tag   = p_tag;
+            wire [PAIRS*(MC_W+2)-1:0] unused_tag   = p_tag;
             /* verilator lint_on UNUSEDSIGNAL */
             for (p = 0; p < PAIRS; p = p + 1) begin : g_pair
                 fmt_rx_pair_front #(
                     .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-                    .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
-                    .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .SH_W(SH_W)
+                    .ADC_BITS(ADC_BITS), .M_MAX(M_MAX), .FFT_OUT_W(W),
+                    .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .MC_W(MC_W)
                 ) u_front (
                     .clk(clk), .rst(rst), .ce(ce),
                     .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
                     .adc_b_i(adc_i[(2*p+1)*ADC_BITS +: ADC_BITS]),
-                    .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+                    .rx_sign_i(rx_sign_i), .m_i(m_i),
                     .ps_valid_o(p_valid[p]), .ps_row_o(p_row[p*ROW_W +: ROW_W]),
-                    .ps_tag_o(p_tag[p*(SH_W+2) +: SH_W+2]),
+                    .ps_tag_o(p_tag[p*(MC_W+2) +: MC_W+2]),
                     .ps_ar_o(p_split[(4*p)*MW +: MW]), .ps_ai_o(p_split[(4*p+1)*MW +: MW]),
                     .ps_br_o(p_split[(4*p+2)*MW +: MW]), .ps_bi_o(p_split[(4*p+3)*MW +: MW]),
                     .rd_row_i(row_q), .rd_data_o(cells[p*2*CW +: 2*CW]),   // {cell b, cell a}
@@ -219,7 +239,7 @@ module fmt_rx_array #(
             end
             assign push_v      = p_valid[0];
             assign push_row    = p_row[ROW_W-1:0];
-            assign push_tag    = p_tag[SH_W+1:0];
+            assign push_tag    = p_tag[MC_W+1:0];
             assign chk_v       = p_valid[0];
             assign chk_row     = p_row[ROW_W-1:0];
             assign seq_ovf     = 1'b0;
@@ -228,33 +248,33 @@ module fmt_rx_array #(
             wire [NGRP-1:0]          g_valid, g_ovf, g_seq;
             wire [NGRP*GCH_W-1:0]    g_ch;
             wire [NGRP*ROW_W-1:0]    g_row;
-            wire [NGRP*(SH_W+2)-1:0] g_tag;
+            wire [NGRP*(MC_W+2)-1:0] g_tag;
             // the groups run in lockstep: group 0's valid, channel, row and tag stand for all
             /* verilator lint_off UNUSEDSIGNAL */
             wire [NGRP*GCH_W-1:0]    unused_ch  = g_ch;
             wire [NGRP*ROW_W-1:0]    unused_row = g_row;
-            wire [NGRP*(SH_W+2)-1:0] unused_tag = g_tag;
+            wire [NGRP*(MC_W+2)-1:0] unused_tag = g_tag;
             wire [NGRP-1:0]          unused_v   = g_valid;
             /* verilator lint_on UNUSEDSIGNAL */
             for (p = 0; p < NGRP; p = p + 1) begin : g_grp
                 localparam NPG = (PAIRS - p * GC < GC) ? PAIRS - p * GC : GC;
                 fmt_rx_group_front #(
                     .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-                    .ADC_BITS(ADC_BITS), .M_LOG2_MAX(M_LOG2_MAX), .FFT_OUT_W(W),
-                    .TW_DIR(TW_DIR), .G(GC), .NP(NPG), .ROW_W(ROW_W), .SH_W(SH_W),
+                    .ADC_BITS(ADC_BITS), .M_MAX(M_MAX), .FFT_OUT_W(W),
+                    .TW_DIR(TW_DIR), .G(GC), .NP(NPG), .ROW_W(ROW_W), .MC_W(MC_W),
                     .CH_W(GCH_W)
                 ) u_front (
                     .clk(clk), .rst(rst), .ce(ce),
                     .adc_i(adc_i[(2*p*GC)*ADC_BITS +: 2*NPG*ADC_BITS]),
-                    .rx_sign_i(rx_sign_i), .m_log2_i(m_log2_i),
+                    .rx_sign_i(rx_sign_i), .m_i(m_i),
                     .ps_valid_o(g_valid[p]), .ps_ch_o(g_ch[p*GCH_W +: GCH_W]),
-                    .ps_row_o(g_row[p*ROW_W +: ROW_W]), .ps_tag_o(g_tag[p*(SH_W+2) +: SH_W+2]),
+                    .ps_row_o(g_row[p*ROW_W +: ROW_W]), .ps_tag_o(g_tag[p*(MC_W+2) +: MC_W+2]),
                     .rd_row_i(row_q), .rd_data_o(cells[p*GC*2*CW +: NPG*2*CW]),
                     .fft_ovf_o(g_ovf[p]), .seq_ovf_o(g_seq[p]));
             end
             assign push_v      = g_valid[0] && (g_ch[GCH_W-1:0] == GCH_LAST);
             assign push_row    = g_row[ROW_W-1:0];
-            assign push_tag    = g_tag[SH_W+1:0];
+            assign push_tag    = g_tag[MC_W+1:0];
             assign chk_v       = g_valid[0] && (g_ch[GCH_W-1:0] == {GCH_W{1'b0}});
             assign chk_row     = g_row[ROW_W-1:0];
             assign seq_ovf     = |g_seq;
@@ -265,20 +285,20 @@ module fmt_rx_array #(
     // the stages after the split advance on every clk (POST_CLK = 1) or on ce
     wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
 
-    // ---- row queue: {row, log2 M, first, last} ----
-    reg [ROW_W+SH_W+1:0] q_mem [0:QD-1];
+    // ---- row queue: {row, M, first, last} ----
+    reg [ROW_W+MC_W+1:0] q_mem [0:QD-1];
     reg [ROW_W-1:0]      q_wr_q, q_rd_q;
     reg [ROW_W:0]        q_cnt_q;
     reg                  overrun_q;      // sticky: a row arrived with the queue full or
                                          // before its previous copy was read
     reg                  busy_q;         // the engine is feeding a row
     reg [G_W-1:0]        g_q;            // group being fed
-    reg [SH_W+1:0]       etag_q;         // the row's {log2 M, first, last}
+    reg [MC_W+1:0]       etag_q;         // the row's {M, first, last}
 
     wire q_push = post_ce && push_v;
     wire q_full = (q_cnt_q == QD[ROW_W:0]);
     wire load   = post_ce && (q_cnt_q != {(ROW_W+1){1'b0}}) && (!busy_q || g_q == G_LAST);
-    wire [ROW_W+SH_W+1:0] q_head = q_mem[q_rd_q];
+    wire [ROW_W+MC_W+1:0] q_head = q_mem[q_rd_q];
 
     always @(posedge clk) begin
         if (q_push && !q_full) q_mem[q_wr_q] <= {push_row, push_tag};
@@ -327,8 +347,8 @@ module fmt_rx_array #(
 
     always @(posedge clk) begin
         if (load) begin
-            row_q  <= q_head[ROW_W+SH_W+1 -: ROW_W];
-            etag_q <= q_head[SH_W+1:0];
+            row_q  <= q_head[ROW_W+MC_W+1 -: ROW_W];
+            etag_q <= q_head[MC_W+1:0];
         end
     end
 
@@ -399,7 +419,7 @@ module fmt_rx_array #(
     always @* begin
         for (l = 0; l < K; l = l + 1)
             sum_d[l*SUM_W +: SUM_W] = (a_first ? {SUM_W{1'b0}} : acc_rd_q[l*SUM_W +: SUM_W])
-                                    + {{M_LOG2_MAX{1'b0}}, a_mag_q[l*MW +: MW]};
+                                    + {{MC_W{1'b0}}, a_mag_q[l*MW +: MW]};
     end
 
     always @(posedge clk) begin
@@ -412,25 +432,79 @@ module fmt_rx_array #(
     reg [TAGW-1:0]    b_tag_q;
     /* verilator lint_on UNUSEDSIGNAL */
     reg               b_valid_q;
+    // the reciprocal ROM (rx_fixed.recip_rom; 256 words whatever M_MAX, MC_W <= 8), read
+    // with the row's M beside the sum
+    reg [RW-1:0]      recip_rom [0:255];
+    reg [RW-1:0]      b_rom_q;
+    reg  [7:0]        a_m8;              // the row's M as an 8-bit ROM address
+    always @* begin
+        a_m8 = 8'd0;
+        a_m8[MC_W-1:0] = a_tag_q[MC_W+1:2];
+    end
+    initial $readmemh({TW_DIR, "fmt_recip.hex"}, recip_rom);
     always @(posedge clk) begin
         if (post_ce) begin
             b_sum_q <= sum_d;
             b_tag_q <= a_tag_q;
+            b_rom_q <= recip_rom[a_m8];
         end
     end
 
-    // stage C: cell = (sum + 2^(s-1)) >> s, s = log2 M + 1 (round half up), saturated
-    wire [SH_W-1:0] b_shift   = b_tag_q[SH_W+1:2];
-    wire [TS:0]     shift_tot = {{(TS+1-SH_W){1'b0}}, b_shift} + 1'b1;
+    // stage C1: t = sum + M (the rounding half of 2M), R = ceil(entry / 2^(TR-T)) =
+    // ceil(2^(T+l) / M), l = ceil(log2 M)
+    localparam [RW:0] RADD = (42'd1 << (TR - T)) - 42'd1;
+    wire [MC_W-1:0] b_m     = b_tag_q[MC_W+1:2];
+    // only bits TR-T .. TR of the rounded entry are R (R <= 2^T)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [RW:0]     r_round = {1'b0, b_rom_q} + RADD;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg  [LW-1:0]   l_d;
+    reg  [8:0]      m_ext;
+    integer i;
+    always @* begin
+        m_ext = {{(9-MC_W){1'b0}}, b_m};
+        l_d   = {LW{1'b0}};
+        for (i = 0; i < 8; i = i + 1)
+            if (m_ext > (9'd1 << i)) l_d = i[LW-1:0] + 1'b1;
+    end
+    reg [K*T-1:0]         c1_t_q;
+    reg [T:0]             c1_r_q;
+    reg [LW-1:0]          c1_l_q;
+    reg [ROW_W+G_W-1:0]   c1_rg_q;
+    reg                   c1_valid_q;
+    always @(posedge clk) begin
+        if (post_ce) begin
+            for (l = 0; l < K; l = l + 1)
+                c1_t_q[l*T +: T] <= {1'b0, b_sum_q[l*SUM_W +: SUM_W]} + {{(T-MC_W){1'b0}}, b_m};
+            c1_r_q  <= r_round[TR-T +: T+1];
+            c1_l_q  <= l_d;
+            c1_rg_q <= b_tag_q[TAGW-1 -: ROW_W+G_W];
+        end
+    end
+
+    // stage C2: the products t R (exact, 2T + 1 bits)
+    reg [K*PW-1:0]        c2_p_q;
+    reg [LW-1:0]          c2_l_q;
+    reg [ROW_W+G_W-1:0]   c2_rg_q;
+    reg                   c2_valid_q;
+    always @(posedge clk) begin
+        if (post_ce) begin
+            for (l = 0; l < K; l = l + 1)
+                c2_p_q[l*PW +: PW] <= {{(T+1){1'b0}}, c1_t_q[l*T +: T]} * {{T{1'b0}}, c1_r_q};
+            c2_l_q  <= c1_l_q;
+            c2_rg_q <= c1_rg_q;
+        end
+    end
+
+    // stage C3: cell = (t R) >> (T + 1 + l) = floor((sum + M) / 2M), saturated
     reg [K*HM_W-1:0] cell_d;
     reg              clip_d;
-    reg [EW-1:0]     rnd, scaled;
+    reg [QW-1:0]     scaled;
     always @* begin
         clip_d = 1'b0;
         for (l = 0; l < K; l = l + 1) begin
-            rnd    = {{(EW-SUM_W){1'b0}}, b_sum_q[l*SUM_W +: SUM_W]} + ({{(EW-1){1'b0}}, 1'b1} << shift_tot >> 1);
-            scaled = rnd >> shift_tot;
-            if (scaled > {{(EW-HM_W){1'b0}}, {HM_W{1'b1}}}) begin
+            scaled = c2_p_q[l*PW + T + 1 +: QW] >> c2_l_q;
+            if (scaled > {{(QW-HM_W){1'b0}}, {HM_W{1'b1}}}) begin
                 cell_d[l*HM_W +: HM_W] = {HM_W{1'b1}};
                 clip_d = 1'b1;
             end else begin
@@ -447,22 +521,26 @@ module fmt_rx_array #(
     always @(posedge clk) begin
         if (post_ce) begin
             c_cells_q <= cell_d;
-            c_row_q   <= b_tag_q[TAGW-1 -: ROW_W];
-            c_g_q     <= b_tag_q[TAGW-ROW_W-1 -: G_W];
+            c_row_q   <= c2_rg_q[ROW_W+G_W-1 -: ROW_W];
+            c_g_q     <= c2_rg_q[G_W-1:0];
         end
     end
 
     always @(posedge clk) begin
         if (rst) begin
-            a_valid_q <= 1'b0;
-            b_valid_q <= 1'b0;
-            c_valid_q <= 1'b0;
-            sat_q     <= 1'b0;
+            a_valid_q  <= 1'b0;
+            b_valid_q  <= 1'b0;
+            c1_valid_q <= 1'b0;
+            c2_valid_q <= 1'b0;
+            c_valid_q  <= 1'b0;
+            sat_q      <= 1'b0;
         end else if (post_ce) begin
-            a_valid_q <= mg_valid;
-            b_valid_q <= a_valid_q && a_last;
-            c_valid_q <= b_valid_q;
-            if (b_valid_q && clip_d) sat_q <= 1'b1;
+            a_valid_q  <= mg_valid;
+            b_valid_q  <= a_valid_q && a_last;
+            c1_valid_q <= b_valid_q;
+            c2_valid_q <= c1_valid_q;
+            c_valid_q  <= c2_valid_q;
+            if (c2_valid_q && clip_d) sat_q <= 1'b1;
         end
     end
 

@@ -13,8 +13,9 @@
 // The FFT, the split and the result memories advance on the engine's steps / every clk.
 //
 // Frames and tags as fmt_rx_pair_front: window k = ADC samples k*N .. k*N + N-1 counted
-// from the first ce after reset; M = 2^m_log2_i windows per frame (sampled when channel
-// 0 starts a window, clamped to M_LOG2_MAX); ps_tag = {log2 M, first window, last window}.
+// from the first ce after reset; M = m_i windows per frame, any 1 .. M_MAX (sampled when
+// channel 0 starts a frame's first window; 0 is taken as 1, values above M_MAX are
+// clamped to M_MAX); ps_tag = {M, first window, last window}.
 // Timing: channel c of ADC sample j enters the FFT input register on the edge c + 1
 // clk after sample j's ce edge (step j G + c); its window's slot s leaves the FFT on step
 // t_c + LATENCY0 + s G (fmt_fft_r22sdf) and the split registers it on that step's edge;
@@ -35,13 +36,13 @@ module fmt_rx_group_front #(
     parameter BIN_LO     = `FMT_BIN_LO,    // bin of row 0
     parameter BIN_STEP   = `FMT_BIN_STEP,  // bins between rows
     parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
-    parameter M_LOG2_MAX = 3,              // largest log2 M
+    parameter M_MAX      = 255,            // largest windows per frame M (<= 255)
     parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter G          = 3,              // column pairs per engine (FFT channels), >= 2
     parameter NP         = G,              // pairs actually connected, 1..G
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
-    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1, // width of m_log2_i
+    parameter MC_W       = $clog2(M_MAX + 1), // width of m_i
     parameter CH_W       = (G > 1) ? $clog2(G) : 1              // channel index width
 ) (
     input  wire                       clk,
@@ -49,11 +50,11 @@ module fmt_rx_group_front #(
     input  wire                       ce,         // sample strobe, at most one per G clk
     input  wire [2*NP*ADC_BITS-1:0]   adc_i,      // pair j: column a at [2j*ADC_BITS], b at [(2j+1)*ADC_BITS]
     input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
-    input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
+    input  wire [MC_W-1:0]            m_i,        // windows per frame M (0 = 1, > M_MAX = M_MAX)
     output wire                       ps_valid_o, // a row of pair ps_ch_o completed (split output valid)
     output wire [CH_W-1:0]            ps_ch_o,    // its pair within the group (channel)
     output wire [ROW_W-1:0]           ps_row_o,   // its row index
-    output wire [SH_W+1:0]            ps_tag_o,   // {log2 M, first window, last window}
+    output wire [MC_W+1:0]            ps_tag_o,   // {M, first window, last window}
     input  wire [ROW_W-1:0]           rd_row_i,   // result memory read address (row)
     output wire [NP*(4*FFT_OUT_W+4)-1:0] rd_data_o, // pair j: {2 Im B, 2 Re B, 2 Im A, 2 Re A} at [j*4*(W+1)]
     output wire                       fft_ovf_o,  // sticky FFT saturation
@@ -63,8 +64,8 @@ module fmt_rx_group_front #(
     localparam W  = FFT_OUT_W;
     localparam MW = W + 1;
     localparam XW = ADC_BITS + 1;
-    localparam [M_LOG2_MAX:0] ONE  = 1;
-    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
+    localparam [MC_W-1:0]     MMAX = M_MAX[MC_W-1:0];
+    localparam [MC_W-1:0]     MONE = 1;
     localparam integer        GM1  = G - 1;
     localparam [CH_W-1:0]     CH_LAST = GM1[CH_W-1:0];
 
@@ -135,23 +136,31 @@ module fmt_rx_group_front #(
 
     // ---- window / frame bookkeeping (at the FFT output; channel 0 opens a window) ----
     reg                  started_q;
-    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
-    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
-    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
-    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
+    reg [MC_W-1:0]       wcnt_q;                    // window index inside the frame, 0 .. M-1
+    reg [MC_W-1:0]       m_q;                       // M of the current frame
+    wire [MC_W-1:0]      m_lim;                     // m_i clamped to M_MAX
+    wire [MC_W-1:0]      m_in    = (m_lim == {MC_W{1'b0}}) ? MONE : m_lim;
+    generate
+        if (M_MAX < (1 << MC_W) - 1) begin : g_clamp
+            assign m_lim = (m_i > MMAX) ? MMAX : m_i;
+        end else begin : g_noclamp
+            assign m_lim = m_i;                     // every MC_W-bit value is <= M_MAX
+        end
+    endgenerate
+    wire [MC_W-1:0]      last_q  = m_q - 1'b1;
     wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}}) && (f_ch == {CH_W{1'b0}});
     wire                 wrap    = !started_q || (wcnt_q == last_q);
-    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
-    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
-    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
-    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
+    wire [MC_W-1:0]      w_cur   = new_win ? (wrap ? {MC_W{1'b0}} : wcnt_q + 1'b1) : wcnt_q;
+    wire [MC_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
+    wire [MC_W-1:0]      last_cur = m_cur - 1'b1;
+    wire                 w_first = (w_cur == {MC_W{1'b0}});
     wire                 w_last  = (w_cur == last_cur);
 
     always @(posedge clk) begin
         if (rst) begin
             started_q <= 1'b0;
-            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
-            m_q       <= {SH_W{1'b0}};
+            wcnt_q    <= {MC_W{1'b0}};
+            m_q       <= MONE;
         end else if (new_win) begin
             started_q <= 1'b1;
             wcnt_q    <= w_cur;
@@ -163,7 +172,7 @@ module fmt_rx_group_front #(
     wire signed [MW-1:0] s_ar, s_ai, s_br, s_bi;
     fmt_pair_split #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W), .CH(G), .CH_W(CH_W)
+        .W(W), .TAG_W(MC_W + 2), .ROW_W(ROW_W), .CH(G), .CH_W(CH_W)
     ) u_split (
         .clk(clk), .rst(rst), .ce(1'b1),
         .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),

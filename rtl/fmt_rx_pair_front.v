@@ -9,8 +9,9 @@
 //
 // Frames: window k is ADC samples k*N .. k*N + N-1 counted from the first ce after reset
 // (the FFT is held in reset for that ce while the despreaders fill); a frame is
-// M = 2^m_log2_i consecutive windows (m_log2_i sampled at the first window of a frame,
-// values above M_LOG2_MAX clamped).  ps_tag = {log2 M, first window, last window}.
+// M = m_i consecutive windows, any 1 .. M_MAX (m_i sampled at the first window of a
+// frame; 0 is taken as 1, values above M_MAX are clamped).  ps_tag = {M, first window,
+// last window}.
 // Timing: the pair split takes slot s of a window on the ce edge LATENCY0 + s + 1 ce
 // cycles after the ce edge that takes the window's last ADC sample (LATENCY0 of
 // fmt_fft_r22sdf, counted from its input register which the despread register feeds);
@@ -27,13 +28,13 @@ module fmt_rx_pair_front #(
     parameter BIN_LO     = `FMT_BIN_LO,    // bin of row 0
     parameter BIN_STEP   = `FMT_BIN_STEP,  // bins between rows
     parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
-    parameter M_LOG2_MAX = 3,              // largest log2 M
+    parameter M_MAX      = 255,            // largest windows per frame M (<= 255)
     parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
     parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter POST_CLK   = 1,              // 1: split and result memory on every clk, 0: on ce
     parameter RES_MEM    = 1,              // 1: result memory and read port, 0: none (rd_data_o = 0)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
-    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of m_log2_i
+    parameter MC_W       = $clog2(M_MAX + 1)    // width of m_i
 ) (
     input  wire                       clk,
     input  wire                       rst,        // synchronous, active high
@@ -41,10 +42,10 @@ module fmt_rx_pair_front #(
     input  wire signed [ADC_BITS-1:0] adc_a_i,    // column a ADC sample (even column)
     input  wire signed [ADC_BITS-1:0] adc_b_i,    // column b ADC sample (odd column)
     input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
-    input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
+    input  wire [MC_W-1:0]            m_i,        // windows per frame M (0 = 1, > M_MAX = M_MAX)
     output wire                       ps_valid_o, // a row's pair completed (split output valid)
     output wire [ROW_W-1:0]           ps_row_o,   // its row index
-    output wire [SH_W+1:0]            ps_tag_o,   // {log2 M, first window, last window}
+    output wire [MC_W+1:0]            ps_tag_o,   // {M, first window, last window}
     output wire signed [FFT_OUT_W:0]  ps_ar_o,    // 2 Re A (column a)
     output wire signed [FFT_OUT_W:0]  ps_ai_o,    // 2 Im A
     output wire signed [FFT_OUT_W:0]  ps_br_o,    // 2 Re B (column b)
@@ -56,8 +57,8 @@ module fmt_rx_pair_front #(
 
     localparam W  = FFT_OUT_W;
     localparam MW = W + 1;
-    localparam [M_LOG2_MAX:0] ONE  = 1;
-    localparam [SH_W-1:0]     MMAX = M_LOG2_MAX;
+    localparam [MC_W-1:0]     MMAX = M_MAX[MC_W-1:0];
+    localparam [MC_W-1:0]     MONE = 1;
 
     // ---- despread ----
     wire signed [ADC_BITS:0] xa, xb;
@@ -92,23 +93,31 @@ module fmt_rx_pair_front #(
 
     // ---- window / frame bookkeeping (at the FFT output) ----
     reg                  started_q;
-    reg [M_LOG2_MAX:0]   wcnt_q;                    // window index inside the frame
-    reg [SH_W-1:0]       m_q;                       // log2 M of the current frame
-    wire [SH_W-1:0]      m_in   = (m_log2_i > M_LOG2_MAX) ? MMAX : m_log2_i;
-    wire [M_LOG2_MAX:0]  last_q = (ONE << m_q) - 1'b1;
+    reg [MC_W-1:0]       wcnt_q;                    // window index inside the frame, 0 .. M-1
+    reg [MC_W-1:0]       m_q;                       // M of the current frame
+    wire [MC_W-1:0]      m_lim;                     // m_i clamped to M_MAX
+    wire [MC_W-1:0]      m_in    = (m_lim == {MC_W{1'b0}}) ? MONE : m_lim;
+    generate
+        if (M_MAX < (1 << MC_W) - 1) begin : g_clamp
+            assign m_lim = (m_i > MMAX) ? MMAX : m_i;
+        end else begin : g_noclamp
+            assign m_lim = m_i;                     // every MC_W-bit value is <= M_MAX
+        end
+    endgenerate
+    wire [MC_W-1:0]      last_q  = m_q - 1'b1;
     wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}});
     wire                 wrap    = !started_q || (wcnt_q == last_q);
-    wire [M_LOG2_MAX:0]  w_cur   = new_win ? (wrap ? {(M_LOG2_MAX+1){1'b0}} : wcnt_q + 1'b1) : wcnt_q;
-    wire [SH_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
-    wire [M_LOG2_MAX:0]  last_cur = (ONE << m_cur) - 1'b1;
-    wire                 w_first = (w_cur == {(M_LOG2_MAX+1){1'b0}});
+    wire [MC_W-1:0]      w_cur   = new_win ? (wrap ? {MC_W{1'b0}} : wcnt_q + 1'b1) : wcnt_q;
+    wire [MC_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
+    wire [MC_W-1:0]      last_cur = m_cur - 1'b1;
+    wire                 w_first = (w_cur == {MC_W{1'b0}});
     wire                 w_last  = (w_cur == last_cur);
 
     always @(posedge clk) begin
         if (rst) begin
             started_q <= 1'b0;
-            wcnt_q    <= {(M_LOG2_MAX+1){1'b0}};
-            m_q       <= {SH_W{1'b0}};
+            wcnt_q    <= {MC_W{1'b0}};
+            m_q       <= MONE;
         end else if (ce && new_win) begin
             started_q <= 1'b1;
             wcnt_q    <= w_cur;
@@ -123,7 +132,7 @@ module fmt_rx_pair_front #(
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_pair_split #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .W(W), .TAG_W(SH_W + 2), .ROW_W(ROW_W)
+        .W(W), .TAG_W(MC_W + 2), .ROW_W(ROW_W)
     ) u_split (
         .clk(clk), .rst(rst), .ce(post_ce),
         .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),

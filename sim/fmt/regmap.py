@@ -97,8 +97,9 @@ REGISTERS: list[Reg] = [
     R("PN_CHIP_LEN", 0x012, 10, "rw", 1, "Samples per PN chip (fmt_pn_gen chip_len_i; 0 is taken as 1)."),
     R("PN_RX_DELAY", 0x013, 6, "rw", 0, "Receive PN delay in samples (fmt_pn_gen rx_delay_i)."),
     R("WINDOWS_M", 0x014, 8, "rw", WINDOWS_M,
-      "FFT windows accumulated per frame. The RTL takes M = the largest power of two <= this "
-      "value and <= 2^M_LOG2_MAX (8 in the default build); 0 is taken as 1."),
+      "FFT windows accumulated per frame, any M from 1 to M_MAX (fmt_core parameter; 255 in "
+      "the default build, so every value); 0 is taken as 1, a value above M_MAX as M_MAX. "
+      "Read at the first window of each frame; heat-map cell = round half up of the mean over M."),
     R("TONE_SEL", 0x018, _ROW_W, "rw", 0, "Row selector of the tone-plan windows TONE_TW and TONE_AMP."),
     R("TONE_TW", 0x019, CFG.phase_bits, "window", 0,
       "Tuning word of row TONE_SEL (DDS phase increment; default bin k -> k << (PHASE_BITS - LOG2_N))."),

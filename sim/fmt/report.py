@@ -25,14 +25,14 @@ How a point is measured (the cheapest faithful path)
   Gaussian with the statistics of a DFT bin of the ADC noise plus its quantisation).  They
   are then quantised like the fixed receive chain (``quantise``): the magnitude word of
   ``fmt_magnitude`` is |2A| in FFT-output LSBs = 2 x cell, rounded half up, and the
-  M-window accumulation is ``rx_fixed.accum_fixed`` (the twin of ``fmt_accum``: sum, round
-  half up of sum / 2M, saturate).  What this omits: the FFT's own rounding and the CORDIC
+  M-window accumulation is ``rx_fixed.accum_fixed`` (the twin of ``fmt_rx_array``'s
+  accumulator: sum, round half up of sum / 2M, saturate, for any M = 1 .. 255).  What this omits: the FFT's own rounding and the CORDIC
   error (both ~1 count, against >= 100 counts of noise at 40 dB), clipping, PN.  The
   agreement with the full path (ADC -> ``rx_fixed.rx_heatmaps_fixed``) is checked in
   ``sim/tests/test_report.py`` (noise statistics within the stated tolerances).
-  M = 16 needs the fmt_accum parameter M_LOG2_MAX = 4 (default 3: M <= 8).  M = 40 is not
-  a power of two and fmt_accum divides by shifting only: it is modelled as an ideal
-  divider (round half up of sum / 2M), NOT an RTL mode.
+  Every swept M (16 and 40 included) is an RTL mode of the default build: fmt_rx_array
+  takes any M = 1 .. M_MAX = 255 and divides exactly (reciprocal multiply, bit-exact with
+  accum_fixed; tb/fmt_rx_array checks M = 3 and 5, tb/fmt_core M = 3).
 * Other widths HM_W: the rendered cells scale exactly with 2^(HM_W - 16) (hm_scale), so the
   same rendered noise is quantised at HM_W bits (also checked in the test); the touch
   threshold (2000 counts at 16 bits) and the calibration scale with it.  The fit's own
@@ -152,17 +152,11 @@ def window_cells(scene: _scene.Scene) -> np.ndarray:
 def quantise(cells: np.ndarray, m: int, hm_w: int, cells_w: int = 16):
     """Per-window float cells (at ``cells_w`` bits) -> (heat maps (frames, rows, cols) int64
     at ``hm_w`` bits, saturated flag), as the fixed receive chain: magnitude word
-    round_half_up(2 x cell) (|2A| in FFT LSBs), then ``rx_fixed.accum_fixed`` for
-    M = 2^k (fmt_accum), an ideal round-half-up divider sum / 2M otherwise."""
+    round_half_up(2 x cell) (|2A| in FFT LSBs), then ``rx_fixed.accum_fixed`` for any M
+    (fmt_rx_array's exact divider: round half up of sum / 2M)."""
     c = np.asarray(cells, dtype=np.float64) * 2.0 ** (hm_w - cells_w)
     mags = np.floor(2.0 * c + 0.5).astype(np.int64)
-    if m & (m - 1) == 0:
-        return _rx.accum_fixed(mags, m.bit_length() - 1, hm_w, _rx.HM_SHIFT)
-    frames = mags.shape[0] // m
-    s = mags[:frames * m].reshape((frames, m) + mags.shape[1:]).sum(axis=1)
-    cell = (s + m) // (2 * m)
-    top = (1 << hm_w) - 1
-    return np.minimum(cell, top), bool((cell > top).any())
+    return _rx.accum_fixed(mags, m=m, hm_w=hm_w, hm_shift=_rx.HM_SHIFT)
 
 
 # ---- latency --------------------------------------------------------------------------------
@@ -296,9 +290,7 @@ def run_sweep(spec: SweepSpec, touch_clk: int = TOUCH_CLK_DEFAULT, progress=True
             "false": int(sum(e["false"] for e in evl)),
             "contact_frames": len(evl) * spec.frames * (len(GRID_ROWS) * len(GRID_COLS) + 4),
             "accum_saturated": bool(sat_any[(m, snr, w, neigh, bias)]),
-            "accum_mode": ("fmt_accum (M_LOG2_MAX=3)" if m <= 8 else
-                           "fmt_accum with M_LOG2_MAX=4" if m & (m - 1) == 0 else
-                           "ideal divider (not an RTL mode)"),
+            "accum_mode": "fmt_rx_array (exact divider, M <= 255)",
         })
     points.sort(key=lambda p: (p["hm_w"] != spec.widths[0], p["hm_w"], p["snr_db"],
                                p["neighbourhood"], p["bias_correction"], p["m"]))
@@ -502,13 +494,14 @@ def render_md(res, plots, cmd: str) -> str:
          f"{sp['scenes'] * sp['edge_contacts_per_scene']} edge positions, the same at every point.",
          "* Heat maps: `chain.render_heatmaps` per window (default physics: SNR per window at a "
          "finger centred on a cell), quantised as the fixed receive chain (magnitude word = round(2 x "
-         "cell), `rx_fixed.accum_fixed` = `fmt_accum`); touch processing `touch.process_frames(fixed=True)` "
+         "cell), `rx_fixed.accum_fixed` = the accumulator of `fmt_rx_array`); touch processing `touch.process_frames(fixed=True)` "
          "= bit-exact twin of `rtl/fmt_touch.v` (`tb/fmt_touch` checks the RTL against it event for event on "
          "random and scene heat maps of the MEDIUM sensor: that is the RTL confirmation of this model; the "
          "sweep's own points are not re-run through the RTL); scoring "
          "`run_sim.evaluate`.",
-         "* M = 16 needs `fmt_accum` M_LOG2_MAX = 4 (default 3); M = 40 is modelled with an ideal "
-         "divider (round half up of sum / 2M): `fmt_accum` divides by 2^m only.",
+         "* Every M of the sweep (16 and 40 included) is an RTL mode: `fmt_rx_array` takes any "
+         "M = 1 .. 255 (WINDOWS_M) and divides exactly (round half up of sum / 2M by a reciprocal "
+         "multiply, bit-exact with `rx_fixed.accum_fixed`).",
          "* Position error: RMS over (contact, frame) of the distance to the true centre. Jitter: RMS "
          "distance about the contact's own mean over the scene's frames (x F/(F-1)), RMS over "
          "interior contacts. ± = 95 % confidence half-width from the spread between scenes.",

@@ -7,8 +7,10 @@ Chain per column pair (columns 2p, 2p+1; COLS must be even):
   FFT       Z = fft_fixed(x_a + j x_b) per window of N samples, Z = X * 2^-SHIFT, OUT_W bits
   split     2A[k] = Z[k] + conj(Z[N-k]),  2B[k] = (Z[k] - conj(Z[N-k])) / j   (exact, OUT_W+1)
   magnitude CORDIC vectoring, ITER = 12, GUARD = 3, gain compensated, round half up
-  accum     sum over M = 2^m windows, cell = (sum + 2^(s-1)) >> s, s = m + HM_SHIFT,
-            saturated to HM_W bits (sticky flag)
+  accum     sum over M windows (any M = 1..M_MAX; fmt_accum: M = 2^m), D = M * 2^HM_SHIFT,
+            cell = floor((sum + floor(D/2)) / D) (round half up), saturated to HM_W bits
+            (sticky flag); for M = 2^m exactly (sum + 2^(s-1)) >> s, s = m + HM_SHIFT.
+            fmt_rx_array divides by an exact reciprocal multiply (recip_divide, below).
 With HM_SHIFT = 1 a cell is |A[k]| * 2^-SHIFT (FFT output LSBs), averaged over M.
 
 Rounding: everything is exact except (1) the FFT's own rounding (``fft_fixed``), (2) the
@@ -17,8 +19,10 @@ CORDIC (arithmetic right shifts = floor inside the iterations, final round half 
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -27,7 +31,10 @@ from . import params as _params
 MAG_ITER = 12        # CORDIC iterations (fmt_magnitude ITER)
 MAG_GUARD = 3        # CORDIC guard bits (fmt_magnitude GUARD)
 MAG_GAIN_BITS = 20   # fractional bits of the gain-compensation constant
-M_LOG2_MAX = 3       # fmt_accum M_LOG2_MAX: M in 1, 2, 4, 8
+M_LOG2_MAX = 3       # fmt_accum / fmt_col_pair_rx M_LOG2_MAX: M in 1, 2, 4, 8
+M_MAX = 255          # fmt_rx_array / fmt_core M_MAX: M = 1 .. 255 (the 8-bit WINDOWS_M)
+RECIP_TR = 40        # precision of the reciprocal ROM rtl/fmt_recip.hex (see recip_rom)
+RECIP_HEX = "fmt_recip.hex"
 HM_SHIFT = 1         # fmt_accum HM_SHIFT: undo the factor 2 of the pair split
 
 
@@ -105,20 +112,89 @@ def row_order(cfg) -> np.ndarray:
 
 
 # ---- accumulation --------------------------------------------------------------------
-def accum_fixed(mags, m_log2: int, hm_w: int, hm_shift: int = HM_SHIFT):
+def _windows(m_log2, m):
+    """M from either the old m_log2 keyword or M itself (m wins when given)."""
+    if m is None:
+        return 1 << int(m_log2)
+    m = int(m)
+    if m < 1:
+        raise ValueError(f"M = {m}: at least one window per frame")
+    return m
+
+
+def accum_fixed(mags, m_log2: int = 0, hm_w: int = 16, hm_shift: int = HM_SHIFT, m=None):
     """mags (windows, ...) unsigned ints -> (cells (frames, ...), saturated flag).
 
-    Frames are consecutive groups of M = 2^m_log2 windows from window 0; a trailing
-    partial frame is dropped (the RTL never emits it)."""
+    M = m windows per frame (or 2^m_log2 when m is None).  Frames are consecutive groups
+    of M windows from window 0; a trailing partial frame is dropped (the RTL never emits
+    it).  cell = floor((sum + floor(D/2)) / D), D = M * 2^hm_shift (round half up; for
+    M = 2^m bit-identical with (sum + 2^(s-1)) >> s, s = m + hm_shift), then min(cell,
+    2^hm_w - 1) with the flag set when that clips.  fmt_rx_array computes the same
+    quotient by recip_divide (proved and tested equal)."""
     mags = np.asarray(mags, dtype=np.int64)
-    m = 1 << m_log2
-    frames = mags.shape[0] // m
-    s = mags[:frames * m].reshape((frames, m) + mags.shape[1:]).sum(axis=1)
-    sh = m_log2 + hm_shift
-    cell = (s + ((1 << sh) >> 1)) >> sh
+    mm = _windows(m_log2, m)
+    frames = mags.shape[0] // mm
+    s = mags[:frames * mm].reshape((frames, mm) + mags.shape[1:]).sum(axis=1)
+    d = mm << hm_shift
+    cell = (s + (d >> 1)) // d
     top = (1 << hm_w) - 1
     sat = bool((cell > top).any())
     return np.minimum(cell, top), sat
+
+
+def ceil_log2(m: int) -> int:
+    """l = ceil(log2 m), m >= 1 (fmt_rx_array: the reciprocal's shift)."""
+    return (int(m) - 1).bit_length()
+
+
+def recip(m: int, t_bits: int) -> int:
+    """R = ceil(2^(T + l) / m), l = ceil(log2 m): for every integer 0 <= t < 2^T,
+    floor(t R / 2^(T + l)) = floor(t / m) (Granlund-Montgomery): with e = R m - 2^(T+l),
+    0 <= e < m <= 2^l, t R / 2^(T+l) = t/m + t e / (m 2^(T+l)) and t e < 2^T 2^l, so the
+    error term is < 1/m, too small to reach the next multiple of 1/m above t/m.
+    2^T <= R <= 2^(T+1) (T + 1 bits)."""
+    l = ceil_log2(m)
+    return ((1 << (t_bits + l)) + m - 1) // m
+
+
+@functools.lru_cache(maxsize=None)
+def recip_rom(m_max: int = 255, tr: int = RECIP_TR) -> tuple:
+    """Contents of rtl/fmt_recip.hex: entry m = recip(m, tr) for m = 1 .. 255 (entry 0 =
+    entry 1: M = 0 is taken as 1).  The RTL derives its T-bit reciprocal as
+    ceil(entry / 2^(tr - T)) = recip(m, T) (ceil(ceil(x) / n) = ceil(x / n) for integer
+    n), so one file serves every width T <= tr."""
+    return tuple(recip(max(1, m), tr) for m in range(m_max + 1))
+
+
+RTL = Path(__file__).resolve().parents[2] / "rtl"
+
+
+def render_recip_hex() -> str:
+    digits = (RECIP_TR + 1 + 3) // 4
+    return "".join(f"{v:0{digits}x}\n" for v in recip_rom())
+
+
+def recip_from_rom(m: int, t_bits: int, tr: int = RECIP_TR) -> int:
+    """The RTL's T-bit reciprocal from the ROM entry: (entry + 2^(tr-T) - 1) >> (tr - T)."""
+    e = recip_rom()[m]
+    return (e + (1 << (tr - t_bits)) - 1) >> (tr - t_bits)
+
+
+def recip_divide(t, m: int, t_bits: int):
+    """fmt_rx_array's divider: floor(t / m) = (t * R) >> (T + l) for 0 <= t < 2^T."""
+    t = np.asarray(t, dtype=object)
+    r = recip_from_rom(m, t_bits)
+    return (t * r) >> (t_bits + ceil_log2(m))
+
+
+def rx_sum_width(cfg, m_max: int = M_MAX) -> int:
+    """SUM_W of fmt_rx_array: magnitude width MW + width of M, exact for M_MAX windows."""
+    return (fft_out_w(cfg) + 1) + int(m_max).bit_length()
+
+
+def rx_div_t_bits(cfg, m_max: int = M_MAX) -> int:
+    """T of fmt_rx_array's divider: SUM_W + 1 (the sum plus the rounding half M)."""
+    return rx_sum_width(cfg, m_max) + 1
 
 
 # ---- the whole receive path ----------------------------------------------------------
@@ -160,13 +236,13 @@ def fft_windows_fixed(x_re, x_im, cfg, fft_kw=None):
 
 
 def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHIFT,
-                      fft_kw=None, fft_fn=None):
+                      fft_kw=None, fft_fn=None, m=None):
     """Bit-exact twin of fmt_rx_array.
 
     adc (samples, cols) int (ADC_BITS two's complement values), rx_sign (samples,) 0/1
     (the receive PN sign of each sample, as fmt_pn_gen rx_sign_o).  Windows start at
-    sample 0 (the first ce after reset); only complete frames of M = 2^m_log2 windows are
-    returned.  Returns (heatmaps (frames, rows, cols) int64, row_order (rows,), RxFlags).
+    sample 0 (the first ce after reset); only complete frames of M windows are returned
+    (M = m, any 1 .. M_MAX, or 2^m_log2 when m is None).  Returns (heatmaps (frames, rows, cols) int64, row_order (rows,), RxFlags).
     ``fft_fn(x_re, x_im) -> (Z_re, Z_im, ovf)`` on (windows, N) arrays replaces the
     default fft_fixed (tests of the blocks without the FFT).
     """
@@ -189,11 +265,11 @@ def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHI
         a_re, a_im, b_re, b_im = pair_split_fixed(zr, zi, cfg)
         mags[:, :, 2 * p] = magnitude_fixed(a_re, a_im)
         mags[:, :, 2 * p + 1] = magnitude_fixed(b_re, b_im)
-    hm, sat = accum_fixed(mags, m_log2, cfg.hm_width, hm_shift)
+    hm, sat = accum_fixed(mags, m_log2, cfg.hm_width, hm_shift, m=m)
     return hm, row_order(cfg), RxFlags(fft_ovf=ovf, sat=sat)
 
 
-def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, shift: float | None = None):
+def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, shift: float | None = None, m=None):
     """Floating-point receiver of the same despread samples: numpy FFT per real column,
     exact magnitude at the comb bins, mean over M windows, in the fixed path's units
     (|X[k]| * 2^-S, S = fft_shift(cfg) unless given)."""
@@ -205,9 +281,9 @@ def rx_heatmaps_float(adc, rx_sign, cfg, m_log2: int = 0, shift: float | None = 
     x = x[:wins * n].reshape(wins, n, -1)
     X = np.fft.fft(x, axis=1)[:, comb_bins(cfg), :]          # (wins, rows, cols)
     mag = np.abs(X) * 2.0 ** (-shift)
-    m = 1 << m_log2
-    frames = wins // m
-    return mag[:frames * m].reshape(frames, m, cfg.rows, -1).mean(axis=1)
+    mm = _windows(m_log2, m)
+    frames = wins // mm
+    return mag[:frames * mm].reshape(frames, mm, cfg.rows, -1).mean(axis=1)
 
 
 def get_cfg(name: str):
@@ -215,9 +291,10 @@ def get_cfg(name: str):
 
 
 # ---- timing of fmt_rx_array's shared magnitude units (no arithmetic) -----------------
-RX_SHARE_BACK = MAG_ITER + 6   # steps from a row's last unit input to its beat, minus P:
+RX_SHARE_BACK = MAG_ITER + 8   # steps from a row's last unit input to its beat, minus P:
 #                                P unit input steps + MAG_ITER + 3 magnitude stages +
-#                                accumulator read, sum, round, row register
+#                                accumulator read, sum, rounding add, reciprocal multiply,
+#                                shift + saturate, row register
 
 
 def rx_share_schedule(cfg, units: int, step_per_slot: int):
@@ -311,3 +388,18 @@ def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None
     # split of slot 0 (the queue push), clk; the schedule counts from there
     base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1)
     return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}
+
+
+def write_recip_hex() -> Path:
+    path = RTL / RECIP_HEX
+    path.write_text(render_recip_hex())
+    return path
+
+
+if __name__ == "__main__":
+    import argparse
+    ap = argparse.ArgumentParser(description="receive back-end twin: generated files")
+    ap.add_argument("--write-hex", action="store_true", help=f"regenerate rtl/{RECIP_HEX}")
+    a = ap.parse_args()
+    if a.write_hex:
+        print(write_recip_hex())

@@ -80,8 +80,8 @@ def test_width_scaling_is_exact():
 
 
 def test_quantise_divider_agrees_with_accum():
-    """The ideal divider used for M not a power of two gives the fmt_accum result for
-    M = 2^k; for M = 40 it is round half up of the mean of the magnitude words / 2."""
+    """report.quantise uses fmt_rx_array's divider (accum_fixed with any M): round half up
+    of sum / 2M for M = 2^k and for M = 40 (the mean of the magnitude words / 2)."""
     rng = np.random.default_rng(4)
     cells = rng.uniform(0, 9000, size=(80, 3, 5))
     mags = np.floor(2 * cells + 0.5).astype(np.int64)
@@ -105,8 +105,8 @@ def test_pooled_statistics():
 
 
 def test_latency_figures():
-    """The receive-chain figure is tb/fmt_rx_array's schedule (808 clk at 3 x fs with the
-    shared magnitude units: 6.46 us); it must fit the 8 us budget and exceed the FFT's
+    """The receive-chain figure is tb/fmt_rx_array's schedule (810 clk at 3 x fs with the
+    shared magnitude units: 6.48 us); it must fit the 8 us budget and exceed the FFT's
     output time."""
     cfg = params.DEFAULT
     rx = report.rx_latency_clk(cfg)

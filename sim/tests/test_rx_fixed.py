@@ -103,6 +103,95 @@ def test_accum_drops_partial_frame():
     assert cell.shape[0] == 1 and np.all(cell == 5)
 
 
+@pytest.mark.parametrize("m", [3, 5, 40, 255])
+def test_accum_any_m(m):
+    """Any M: cell = round half up of sum / 2M (exact rationals), saturation flagged."""
+    rng = np.random.default_rng(m)
+    mags = rng.integers(0, 1 << 21, (3 * m, 4, 2))
+    cell, sat = R.accum_fixed(mags, m=m, hm_w=16)
+    s = mags.reshape(3, m, 4, 2).sum(1)
+    exact = (2 * s + 2 * m) // (4 * m)          # floor(s / 2M + 1/2)
+    assert np.array_equal(cell, np.minimum(exact, 65535))
+    assert sat == bool((exact > 65535).any())
+    # ties go up: sum = 2M k + M  ->  k + 1
+    tie = np.full((m, 1), 0, dtype=np.int64)
+    tie[0, 0] = 2 * m * 7 + m
+    assert R.accum_fixed(tie, m=m, hm_w=16)[0][0, 0] == 8
+
+
+@pytest.mark.parametrize("hm_shift", [0, 1, 2])
+def test_accum_pow2_equals_shift(hm_shift):
+    """For M = 2^m the divider form equals the shift-and-round of fmt_accum bit for bit."""
+    rng = np.random.default_rng(hm_shift)
+    for m_log2 in range(0, 8):
+        m = 1 << m_log2
+        mags = rng.integers(0, 1 << 21, (2 * m, 5))
+        got, _ = R.accum_fixed(mags, m=m, hm_w=40, hm_shift=hm_shift)
+        sh = m_log2 + hm_shift
+        s = mags.reshape(2, m, 5).sum(1)
+        assert np.array_equal(got, (s + ((1 << sh) >> 1)) >> sh)
+        assert np.array_equal(got, R.accum_fixed(mags, m_log2, 40, hm_shift)[0])
+
+
+def test_recip_hex_current():
+    """rtl/fmt_recip.hex (fmt_rx_array's reciprocal ROM) equals the model's table."""
+    path = RTL / R.RECIP_HEX
+    assert path.exists(), f"{path} missing: run python -m fmt.rx_fixed --write-hex"
+    assert path.read_text() == R.render_recip_hex(), \
+        f"{path} is stale: run python -m fmt.rx_fixed --write-hex"
+    src = (RTL / "fmt_rx_array.v").read_text()
+    assert re.search(r"localparam\s+TR\s*=\s*(\d+)", src).group(1) == str(R.RECIP_TR)
+
+
+def test_recip_divide_exhaustive_small_t():
+    """floor(t R / 2^(T+l)) == floor(t / M) for EVERY t < 2^T and every M = 1..255 at
+    T = 13, with R derived from the ROM as the RTL does."""
+    t_bits = 13
+    t = np.arange(1 << t_bits, dtype=np.int64)
+    for m in range(1, 256):
+        r = R.recip_from_rom(m, t_bits)
+        assert r == R.recip(m, t_bits)
+        got = (t * r) >> (t_bits + R.ceil_log2(m))
+        assert np.array_equal(got, t // m), f"M = {m}"
+
+
+@pytest.mark.parametrize("name", ["small", "medium", "default"])
+def test_recip_divide_exact_at_rtl_width(name):
+    """fmt_rx_array's divider at the build's T = SUM_W + 1: (1) the sum of M_MAX windows
+    of MW-bit magnitudes fits SUM_W bits and t = sum + M fits T bits; (2) for every
+    M = 1..255 the Granlund-Montgomery condition holds (e = R M - 2^(T+l) in [0, M) and
+    (2^T - 1) e < 2^(T+l): then t R / 2^(T+l) - t/M < 1/M for every t < 2^T, so the floor
+    is exact), R <= 2^T fits T + 1 bits and M = 2^m gives R = 2^T (a plain shift); (3) the
+    quotient equals integer division at the edges (multiples of M +- 1, 2^T - 1) and on
+    random t (Python integers)."""
+    cfg = params.get(name)
+    mw = R.fft_out_w(cfg) + 1
+    sum_w = R.rx_sum_width(cfg)
+    t_bits = R.rx_div_t_bits(cfg)
+    assert R.M_MAX * ((1 << mw) - 1) < (1 << sum_w)
+    assert R.M_MAX * ((1 << mw) - 1) + R.M_MAX < (1 << t_bits)
+    assert t_bits <= R.RECIP_TR
+    rng = np.random.default_rng(len(name))
+    for m in range(1, 256):
+        r = R.recip_from_rom(m, t_bits)
+        l = R.ceil_log2(m)
+        assert r == R.recip(m, t_bits)
+        e = r * m - (1 << (t_bits + l))
+        assert 0 <= e < m <= (1 << l)
+        assert ((1 << t_bits) - 1) * e < (1 << (t_bits + l))
+        assert (1 << t_bits) <= r < (1 << (t_bits + 1))
+        if m & (m - 1) == 0:
+            assert r == 1 << t_bits
+        top = (1 << t_bits) - 1
+        ts = [0, 1, m - 1, m, m + 1, top, top - 1, top - m]
+        k = top // m
+        ts += [k * m - 1, k * m, (k // 2) * m + m - 1]
+        ts += [int(x) for x in rng.integers(0, top + 1, 200)]
+        ts = [x for x in ts if 0 <= x <= top]
+        got = R.recip_divide(ts, m, t_bits)
+        assert [int(g) for g in got] == [x // m for x in ts], f"M = {m}"
+
+
 def test_float_receiver_tone():
     """The float reference sees a pure tone on bin k of column 0 as N/2 * amplitude."""
     cfg = params.SMALL
@@ -242,11 +331,11 @@ def test_split_clk_step_map(fft_ch, every):
 
 def test_row_beats_shared_engine_default():
     """30 x 40 at 3 x fs: the shared FFT engines (FFT_CH = 3, the default) move the last
-    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (852 clk)."""
+    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (854 clk)."""
     from fmt import fft_fixed as F
     cfg = params.DEFAULT
     lat0 = F.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
     one = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1, fft_ch=1).values())
     shared = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1).values())
     assert R.rx_fft_ch_default(1, 3) == 3 and R.rx_fft_ch_default(0, 1) == 1
-    assert one == 852 and shared == one - lat0 * 2
+    assert one == 854 and shared == one - lat0 * 2

@@ -2,7 +2,8 @@
 through fmt_rx_array and writes the heat maps it streams out.
 
 Environment: REPLAY_IN (.npy adc), REPLAY_SIGN (.npy rx sign, optional: PN off),
-REPLAY_OUT (.npy heat maps, frames x rows x cols), CFG, M_LOG2.
+REPLAY_OUT (.npy heat maps, frames x rows x cols), CFG, M (windows per frame, any) or
+M_LOG2 (M = 2^M_LOG2).
 """
 from __future__ import annotations
 
@@ -31,10 +32,11 @@ async def replay(dut):
         raise ValueError(f"capture outside the {cfg.adc_bits}-bit ADC range")
     sp = os.environ.get("REPLAY_SIGN", "")
     rx = np.load(sp).astype(np.uint8) if sp else np.zeros(len(adc), dtype=np.uint8)
-    m_log2 = int(os.environ.get("M_LOG2", "0"))
-    frames = (len(adc) // cfg.n_fft) >> m_log2
+    # windows per frame: M (any), else 2^M_LOG2 (scripts/replay_rx.py)
+    m = int(os.environ.get("M", "0")) or (1 << int(os.environ.get("M_LOG2", "0")))
+    frames = (len(adc) // cfg.n_fft) // m
     await tb.reset()
-    beats, eofs, _ = await tb.run(adc, rx, m_log2)
+    beats, eofs, _ = await tb.run(adc, rx, m)
     hm = tb.frames_from(beats, eofs, frames)
     np.save(os.environ["REPLAY_OUT"], hm.astype(np.uint32))
     info = {"frames": int(frames), "sat": int(dut.sat_o.value), "fft_ovf": int(dut.fft_ovf_o.value),

@@ -2,7 +2,8 @@
 receivers) against rx_heatmaps_fixed (sim/fmt/rx_fixed.py).
 
 Checks: heat maps bit-exact for touch-like stirred tones with random PN settings (on/off,
-chip length, delay) and M = 1, 2, 4; the heat-map stream protocol (each row once per
+chip length, delay) and M = 1, 2, 3, 5 windows per frame (any M: the exact reciprocal
+divider; M_LIST); the heat-map stream protocol (each row once per
 frame in rx_fixed.row_order, frame numbers from 0, hm_eof one cycle after the last row
 and never with a row); accuracy against a floating-point receiver (numpy FFT, exact
 split and magnitude, mean over M) within 2 LSB; the hard cases (palm = saturated column,
@@ -53,7 +54,7 @@ class TB(ClockedTB):
         dut.ce.value = 0
         dut.adc_i.value = 0
         dut.rx_sign_i.value = 0
-        dut.m_log2_i.value = 0
+        dut.m_i.value = 1
 
     async def reset(self, cycles: int = 4):
         """Reset with ce low, so that no sample is taken between the reset and run()."""
@@ -69,8 +70,8 @@ class TB(ClockedTB):
             v |= (int(x) & m) << (c * b)
         return v
 
-    async def run(self, adc, rx_sign, m_log2=0, ce_every=None, tail=None, stop_at=None):
-        """Feed the samples (one per ce; ce on every ce_every-th clk), then ``tail`` more
+    async def run(self, adc, rx_sign, m=1, ce_every=None, tail=None, stop_at=None):
+        """Feed the samples with m_i = m windows per frame (one per ce; ce on every ce_every-th clk), then ``tail`` more
         zero samples.  Returns (beats [(clk, row, frame, data)], eofs [(clk, frame)],
         clk cycle at which each sample was taken)."""
         dut, cfg = self.dut, self.cfg
@@ -80,7 +81,7 @@ class TB(ClockedTB):
         tail = n + 80 if tail is None else tail
         total = len(adc) + tail
         beats, eofs, taken = [], [], []
-        dut.m_log2_i.value = m_log2
+        dut.m_i.value = m
         i, clk_n, phase = 0, 0, 0
         packed = [self.pack(r) for r in adc]
         while i < total:
@@ -127,9 +128,10 @@ class TB(ClockedTB):
         return hm
 
 
-def check_exact(tb, adc, rx_sign, m_log2, beats, eofs, float_check=True):
+def check_exact(tb, adc, rx_sign, m, beats, eofs, float_check=True):
+    """m = windows per frame (any M)."""
     cfg = tb.cfg
-    exp, order, flags = R.rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2)
+    exp, order, flags = R.rx_heatmaps_fixed(adc, rx_sign, cfg, m=m)
     got = tb.frames_from(beats, eofs, exp.shape[0])
     for f in range(exp.shape[0]):
         if not np.array_equal(got[f], exp[f]):
@@ -141,7 +143,7 @@ def check_exact(tb, adc, rx_sign, m_log2, beats, eofs, float_check=True):
     assert int(tb.dut.fft_ovf_o.value) == int(flags.fft_ovf), "sticky FFT overflow flag"
     assert int(tb.dut.ovf_o.value) == int(flags.any)
     if float_check:
-        ref = R.rx_heatmaps_float(adc, rx_sign, cfg, m_log2)
+        ref = R.rx_heatmaps_float(adc, rx_sign, cfg, m=m)
         ok = exp < (1 << cfg.hm_width) - 1            # saturated cells are clipped, not errors
         err = np.abs(exp - ref)[ok]
         assert err.max() <= FLOAT_BOUND_LSB, f"fixed vs float {err.max():.2f} LSB"
@@ -151,19 +153,20 @@ def check_exact(tb, adc, rx_sign, m_log2, beats, eofs, float_check=True):
 
 @cocotb.test()
 async def exact_random_pn_and_m(dut):
-    """Touch-like stirred tones, random PN settings, M = 1, 2, 4: bit-exact + float bound."""
+    """Touch-like stirred tones, random PN settings, M = 1, 2, 3, 5 (M_LIST, windows per
+    frame): bit-exact + float bound."""
     tb = TB(dut)
     cfg = tb.cfg
     rng = np.random.default_rng(env_int("SEED", 11))
     worst = 0.0
-    for m_log2 in [int(x) for x in env_str("M_LIST", "0,1,2").split(",")]:
-        wins = env_int("FRAMES", 2) * (1 << m_log2)
+    for m in [int(x) for x in env_str("M_LIST", "1,2,3,5").split(",")]:
+        wins = env_int("FRAMES", 2) * m
         s = wins * cfg.n_fft
         tx, rx, _ = rx_stim.pn(cfg, s, rng)
         adc = rx_stim.tones(cfg, s, rng, tx=tx)
         await tb.reset()
-        beats, eofs, _ = await tb.run(adc, rx, m_log2)
-        worst = max(worst, check_exact(tb, adc, rx, m_log2, beats, eofs))
+        beats, eofs, _ = await tb.run(adc, rx, m)
+        worst = max(worst, check_exact(tb, adc, rx, m, beats, eofs))
     dut._log.info(f"max |fixed - float| = {worst:.3f} LSB")
 
 
@@ -175,9 +178,9 @@ async def hard_cases(dut):
     adc, names = rx_stim.hard_cases(cfg, np.random.default_rng(3))
     rx = np.zeros(len(adc), dtype=np.uint8)
     await tb.reset()
-    beats, eofs, _ = await tb.run(adc, rx, 0)
-    check_exact(tb, adc, rx, 0, beats, eofs)
-    exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, 0)
+    beats, eofs, _ = await tb.run(adc, rx, 1)
+    check_exact(tb, adc, rx, 1, beats, eofs)
+    exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, m=1)
     # the hard cases do what they should: palm column saturates nothing in the FFT,
     # the full-scale tone reaches the top of the cell range
     assert not flags.fft_ovf
@@ -194,15 +197,15 @@ async def reset_mid_window(dut):
     rng = np.random.default_rng(5)
     pre = rx_stim.uniform_random(cfg, 3 * n, rng)
     await tb.reset()
-    beats0, eofs0, _ = await tb.run(pre, np.zeros(len(pre), np.uint8), 0, tail=0, stop_at=3 * n // 2)
+    beats0, eofs0, _ = await tb.run(pre, np.zeros(len(pre), np.uint8), 1, tail=0, stop_at=3 * n // 2)
     # window 0's early rows may be out already (a cut frame, never with hm_eof): the
     # touch processing is reset with the receiver
     assert len(beats0) < cfg.rows and not eofs0 and all(b[2] == 0 for b in beats0)
     await tb.reset(cycles=1)
     tx, rx, _ = rx_stim.pn(cfg, 2 * n, rng, enable=True)
     adc = rx_stim.tones(cfg, 2 * n, rng, tx=tx)
-    beats, eofs, _ = await tb.run(adc, rx, 0)
-    check_exact(tb, adc, rx, 0, beats, eofs)
+    beats, eofs, _ = await tb.run(adc, rx, 1)
+    check_exact(tb, adc, rx, 1, beats, eofs)
 
 
 def row_beats_formula(cfg, every=1, post_clk=1, cps=None, fft_ch=None):
@@ -236,8 +239,8 @@ async def latency_and_slow_ce(dut):
         tx, rx, _ = rx_stim.pn(cfg, n, rng)
         adc = rx_stim.tones(cfg, n, rng, tx=tx)
         await tb.reset()
-        beats, eofs, taken = await tb.run(adc, rx, 0, ce_every=every)
-        check_exact(tb, adc, rx, 0, beats, eofs, float_check=False)
+        beats, eofs, taken = await tb.run(adc, rx, 1, ce_every=every)
+        check_exact(tb, adc, rx, 1, beats, eofs, float_check=False)
         last_in = taken[n - 1]                      # clk of the window's last sample
         exp = row_beats_formula(cfg, every, post_clk, cps, fch)
         got = {b[1]: b[0] - last_in for b in beats[:cfg.rows]}
@@ -275,11 +278,11 @@ async def overrun_flag(dut):
     adc = rx_stim.tones(cfg, 3 * cfg.n_fft, rng)
     rx = np.zeros(len(adc), np.uint8)
     await tb.reset()
-    beats, eofs, _ = await tb.run(adc, rx, 0, ce_every=3)
-    check_exact(tb, adc, rx, 0, beats, eofs, float_check=False)
+    beats, eofs, _ = await tb.run(adc, rx, 1, ce_every=3)
+    check_exact(tb, adc, rx, 1, beats, eofs, float_check=False)
     assert not int(dut.ovf_o.value), "overrun flagged at the rate the units are sized for"
     await tb.reset()
-    await tb.run(adc, rx, 0, ce_every=1)
+    await tb.run(adc, rx, 1, ce_every=1)
     assert int(dut.ovf_o.value) == 1, "queue overrun not flagged"
     assert not int(dut.sat_o.value) and not int(dut.fft_ovf_o.value)
 
@@ -338,8 +341,8 @@ def test_fmt_rx_array_post_on_ce(sim):
 @pytest.mark.verilator_only
 def test_fmt_rx_array_default(sim):
     """Full 30 x 40, N = 256 at the real clocking: ce = 1 in 3, CLK_PER_SAMPLE = 3
-    (MAG_UNITS 4): bit-exact (M = 1, 2), latency, hard cases."""
-    _run(sim, "default", {"M_LIST": "0,1", "FRAMES": 1, "CE_EVERY": 3, "EVERY_LIST": "3"})
+    (MAG_UNITS 4): bit-exact (M = 1, 3), latency, hard cases."""
+    _run(sim, "default", {"M_LIST": "1,3", "FRAMES": 1, "CE_EVERY": 3, "EVERY_LIST": "3"})
 
 
 
