@@ -189,10 +189,9 @@ module fmt_blob #(
                 combine[O_CMIN +: COL_IDX_W] = y[O_CMIN +: COL_IDX_W];
             if (y[O_CMAX +: COL_IDX_W] > x[O_CMAX +: COL_IDX_W])
                 combine[O_CMAX +: COL_IDX_W] = y[O_CMAX +: COL_IDX_W];
-            y_peak = (y[O_PEAK +: HM_W] > x[O_PEAK +: HM_W]) ||
-                     ((y[O_PEAK +: HM_W] == x[O_PEAK +: HM_W]) &&
-                      ({y[O_PR +: ROW_IDX_W], y[O_PC +: COL_IDX_W]} <
-                       {x[O_PR +: ROW_IDX_W], x[O_PC +: COL_IDX_W]}));
+            // larger peak, ties by raster index: one compare of {peak, ~index}
+            y_peak = ({y[O_PEAK +: HM_W], ~y[O_PR +: ROW_IDX_W], ~y[O_PC +: COL_IDX_W]} >
+                      {x[O_PEAK +: HM_W], ~x[O_PR +: ROW_IDX_W], ~x[O_PC +: COL_IDX_W]});
             if (y_peak) begin
                 combine[O_PEAK +: HM_W]    = y[O_PEAK +: HM_W];
                 combine[O_PR +: ROW_IDX_W] = y[O_PR +: ROW_IDX_W];
@@ -533,8 +532,8 @@ module fmt_blob #(
     reg [MB-1:0]  better;
     always @(*) begin
         for (i = 0; i < MB; i = i + 1)
-            better[i] = l_v_q[i] &&
-                ((l_area_q[i] > cl_area) || ((l_area_q[i] == cl_area) && (l_key_q[i] < cl_key)));
+            // area descending, ties by raster key ascending: one compare of {area, ~key}
+            better[i] = l_v_q[i] && ({l_area_q[i], ~l_key_q[i]} > {cl_area, ~cl_key});
     end
     reg [AREA_W-1:0] found_q;
     reg              lab_done_q;              // the last row's command has been applied
