@@ -3,7 +3,7 @@ fixed-point model in lockstep as the reference.
 
     python -m fmt.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
         [--frames F] [--cps 3] [--engine cpp|cocotb] [--sim verilator|icarus]
-        [--no-plot] [--quiet]
+        [--no-plot] [--quiet] [--serve PORT [--serve-seconds S] [--serve-once]]
 
 The simulation top ``tb/fmt_core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
 channel (DAC words x coupling matrix + file noise -> ADC words) + a coupling-update
@@ -39,6 +39,18 @@ player + loggers; nothing in Python is on the per-sample path:
    ``sim_frames_per_s`` = frames / wall time of the clocked run (the build, the model,
    loading the files and the analysis excluded); the C++ engine also reports the CPU
    time of that run (``sim_frames_per_cpu_s``, ``sim_clk_per_s``).
+
+Serve mode (``--serve PORT``, engine cpp): after the scene's frames the harness keeps
+clocking the core and bridges ``socket://127.0.0.1:PORT`` to the core's UART (8N1,
+UART_DIV = 4 clk per bit), so ``scripts/fmtctl --port socket://127.0.0.1:PORT ...``
+drives the running simulation as it drives the board.  It prints ``serving the RTL UART
+on socket://127.0.0.1:PORT`` when listening (PORT 0: any free port, the line names it)
+and serves one client at a time, any number of clients in turn, until Ctrl-C (SIGINT /
+SIGTERM: a clean end), ``--serve-seconds`` of wall time (default 600, 0 = none) or, with
+``--serve-once``, the first client's disconnect.  The coupling of the scene's last frame
+holds while serving (the noise keeps looping); only the scene's frames are compared with
+the model (the logs are cut at the cycle where serving started); ``serve.log`` in the job
+folder lists every UART byte with its cycle.
 
 Cycle conventions: cycle 0 = the first clk edge with rst low; channel sample k is formed
 at cycle k * CPS (the ce edges); the receiver takes ADC sample j (= channel sample j - 1)
@@ -267,12 +279,17 @@ def cal_writes(cfg, cal) -> list:
 
 
 # ---- logs ------------------------------------------------------------------------------
-def parse_logs(d: Path, cfg):
+def parse_logs(d: Path, cfg, max_cycle: int | None = None):
+    """Heat-map rows, ends of frame, events and receiver frame ends of the logs;
+    max_cycle: only lines logged before that cycle (serve mode: the scene's part)."""
     hm_rows, eof, evs, fend = {}, [], [], {}
+    keep = (lambda cyc: True) if max_cycle is None else (lambda cyc: cyc < max_cycle)
     w = cfg.hm_width
     mask = (1 << w) - 1
     for line in (d / "hm.log").read_text().splitlines():
         p = line.split()
+        if not keep(int(p[1])):
+            continue
         if p[0] == "R":
             word = int(p[4], 16)
             hm_rows.setdefault(int(p[3]), {})[int(p[2])] = (
@@ -281,7 +298,7 @@ def parse_logs(d: Path, cfg):
             eof.append((int(p[1]), int(p[2])))
     for line in (d / "ev.log").read_text().splitlines():
         p = line.split()
-        if p[0] == "V":
+        if p[0] == "V" and keep(int(p[1])):
             v = [int(x) for x in p[1:]]
             evs.append({"cycle": v[0], "frame": v[1], "id": v[2], "type_code": v[3], "x_q": v[4],
                         "y_q": v[5], "strength": v[6], "axis_major_q": v[7], "axis_minor_q": v[8],
@@ -289,7 +306,7 @@ def parse_logs(d: Path, cfg):
                         "type": TYPE_NAMES[v[3]]})
     for line in (d / "fe.log").read_text().splitlines():
         p = line.split()
-        if p[0] == "F":
+        if p[0] == "F" and keep(int(p[1])):
             fend[int(p[2])] = int(p[1])
     return hm_rows, eof, evs, fend
 
@@ -308,11 +325,11 @@ def _stats(v) -> dict:
 
 
 def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict, frames: int,
-            wall_s: float, out_dir: Path | None, plot: bool, cal) -> dict:
+            wall_s: float, out_dir: Path | None, plot: bool, cal, max_cycle: int | None = None) -> dict:
     from . import run_sim as _run_sim
     cfg = scene.cfg
     clk_hz = cfg.fs_hz * cps
-    hm_rows, eof, evs, fend = parse_logs(d, cfg)
+    hm_rows, eof, evs, fend = parse_logs(d, cfg, max_cycle)
     # heat maps, frame by frame
     n_rtl = len(eof)
     mism = {"heatmap_frames": 0, "event_frames": 0, "first": None}
@@ -536,8 +553,9 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
 
 
 def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
-                  verilog_channel: bool = False) -> None:
-    """The job of the C++ harness: the same phases as the cocotb run_scene."""
+                  verilog_channel: bool = False, serve: dict | None = None) -> None:
+    """The job of the C++ harness: the same phases as the cocotb run_scene; serve:
+    {"port", "seconds", "cycles", "once"} for serve mode (see the module doc)."""
     from . import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
@@ -551,14 +569,21 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
         lines += [f"{addr(n)} {int(v) & 0xFFFFFFFF}" for n, v in job[key]]
     lines.append(f"status {len(STATUS_REGS)}")
     lines += [f"{n} {addr(n)}" for n in STATUS_REGS]
+    if serve is not None:
+        lines += [f"serve_port {int(serve['port'])}", f"serve_div {sim_parameters(cfg, cps, d)['UART_DIV']}",
+                  f"serve_seconds {float(serve.get('seconds', 600.0))}",
+                  f"serve_cycles {int(serve.get('cycles', 0))}", f"serve_once {int(bool(serve.get('once')))}",
+                  f"serve_log {d / 'serve.log'}"]
     Path(path).write_text("\n".join(lines) + "\n")
 
 
 def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene",
                 tag: str = "cpp", quiet: bool = False, cflags: str = HARNESS_CFLAGS,
-                verilog_channel: bool = False):
+                verilog_channel: bool = False, serve: dict | None = None):
     """Build (cached) and run the C++ harness on a prepared job folder; returns
-    (job folder, reference, calibration, number of updates, result dict, build seconds)."""
+    (job folder, reference, calibration, number of updates, result dict, build seconds).
+    serve: serve mode (write_cpp_job); the harness's stdout (the "serving ..." line) is
+    this process's, and Ctrl-C ends the serving, not this wait."""
     import subprocess
     if verilog_channel:
         tag += "_vch"
@@ -567,12 +592,24 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
                                  verilog_channel=verilog_channel)
     job = json.loads((d / "job.json").read_text())
     write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d, progress=not quiet,
-                  verilog_channel=verilog_channel)
+                  verilog_channel=verilog_channel, serve=serve)
+    (d / "serve.log").unlink(missing_ok=True)
     t0 = time.perf_counter()
-    r = subprocess.run([str(exe), str(d / "job_cpp.txt")], cwd=d, stderr=None if not quiet else subprocess.PIPE)
+    sys.stdout.flush()
+    proc = subprocess.Popen([str(exe), str(d / "job_cpp.txt")], cwd=d,
+                            stderr=None if not quiet else subprocess.PIPE)
+    while True:
+        try:
+            _out, err = proc.communicate()
+            break
+        except KeyboardInterrupt:
+            if serve is None:           # a normal run: Ctrl-C stops it
+                proc.kill()
+                raise
+            # serve mode: the harness got the SIGINT too and ends its serving cleanly
     proc_s = time.perf_counter() - t0
-    if r.returncode != 0:
-        raise RuntimeError(f"harness failed ({r.returncode}): {r.stderr.decode()[-2000:] if r.stderr else ''}")
+    if proc.returncode != 0:
+        raise RuntimeError(f"harness failed ({proc.returncode}): {err.decode()[-2000:] if err else ''}")
     res = json.loads((d / "result.json").read_text())
     res["process_s"] = proc_s
     return d, ref, cal, n_upd, res, build_s
@@ -611,15 +648,24 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
 
 def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int = 3,
         sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None,
-        engine: str = "cpp") -> dict:
+        engine: str = "cpp", serve: dict | None = None, tag: str = "cpp",
+        cflags: str = HARNESS_CFLAGS) -> dict:
     """engine "cpp": the standalone C++ harness (Verilator only, the default of
-    ``make sim``); "cocotb": the cocotb test run_scene (Verilator or Icarus)."""
+    ``make sim``); "cocotb": the cocotb test run_scene (Verilator or Icarus).
+    serve (engine cpp only): serve the UART after the scene (write_cpp_job); tag and
+    cflags: the harness's job folder / build (tests use their own, at -O0)."""
+    if serve is not None and not (engine == "cpp" and sim == "verilator"):
+        raise ValueError("--serve needs the C++ harness (engine cpp, Verilator)")
     frames = frames or scene.frames
     scene = scene.replace(frames=frames)
     if engine == "cpp" and sim == "verilator":
         t0 = time.perf_counter()
-        d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet)
-        rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal)
+        d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet,
+                                                      tag=tag, cflags=cflags, serve=serve)
+        rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal,
+                      max_cycle=res.get("serve_start_cycle"))
+        if "serve" in res:
+            rep["serve"] = dict(res["serve"], start_cycle=res["serve_start_cycle"])
         rep.update({"engine": "cpp", "build_s": build_s, "sim_clk_per_s": res["clk_per_s"],
                     "sim_cpu_s": res["cpu_s"],
                     "sim_frames_per_cpu_s": rep["frames"] / max(res["cpu_s"], 1e-9),
@@ -679,11 +725,28 @@ def main(argv=None) -> int:
                          "cocotb: the cocotb test run_scene (Verilator or Icarus, ~40x slower)")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--serve", type=int, default=None, metavar="PORT",
+                    help="after the scene, keep the simulation running and serve the core's UART on "
+                         "socket://127.0.0.1:PORT for scripts/fmtctl (0: any free port); Ctrl-C ends it")
+    ap.add_argument("--serve-seconds", type=float, default=600.0,
+                    help="end serving after this wall time (default 600 s, 0 = no limit)")
+    ap.add_argument("--serve-once", action="store_true",
+                    help="end serving when the first client disconnects")
+    ap.add_argument("--tag", default="cpp", help="job folder / build tag of the C++ harness")
+    ap.add_argument("--cflags", default=HARNESS_CFLAGS,
+                    help=f"C++ flags of the harness build (default '{HARNESS_CFLAGS}'; tests: -O0)")
     a = ap.parse_args(argv)
     sc = _scene.load(a.scene)
+    serve = None
+    if a.serve is not None:
+        serve = {"port": a.serve, "seconds": a.serve_seconds, "once": a.serve_once}
     rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
-              engine=a.engine)
+              engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
     print(_summary(rep))
+    if "serve" in rep:
+        s = rep["serve"]
+        print(f"served the UART for {s['clk']} clk ({s['wall_s']:.1f} s, {s['clients']} clients, "
+              f"{s['bytes_in']} bytes in, {s['bytes_out']} out), end: {s['end']}")
     print(f"report: {rep['report']}")
     return 0 if rep["golden_mismatches"] == 0 else 1
 

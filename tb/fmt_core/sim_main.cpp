@@ -27,9 +27,35 @@
 // Job "ext_channel 0" (a build with EXT_CHANNEL = 0): the Verilog channel and player of
 // the top run instead (cross-check and speed comparison); the harness only clocks.
 //
+// Serve mode (job "serve_port P", P >= 0; 0 = any free port): after the status reads the
+// harness listens on 127.0.0.1:P (non-blocking), prints the line
+//   serving the RTL UART on socket://127.0.0.1:<port>
+// on stdout (flushed) and keeps clocking the core (ev_ready_i = 1 again, the last
+// coupling matrix held, the noise looping as always, the loggers running) while it
+// bridges one TCP client at a time to the core's UART: received bytes are sent
+// bit-serial (8N1, back to back, serve_div clk per bit = the top's UART_DIV) into
+// uart_rx_i; uart_tx_o is sampled every clk (mid-bit) and the decoded bytes are sent to
+// the client.  The socket is polled every SERVE_POLL clk only (the clock rate stays).
+// Serving ends on SIGINT/SIGTERM, after serve_cycles clk or serve_seconds of wall time
+// (0 = no limit), or, with serve_once 1, when the first client disconnects; then the
+// logs are flushed and the result is written as without serving (plus a "serve" record
+// and serve_start_cycle: the scene's part of the logs ends there).  serve_log (optional)
+// gets one line per byte: "H <cycle> <byte>" a host byte whose stop bit has been driven,
+// "D <cycle> <byte>" a core byte decoded (at its stop bit), "C <cycle>" / "X <cycle>"
+// client connected / gone; <cycle> = cycle_o, the loggers' time base.
+//
 // Usage: Vfmt_core_sim_top <job.txt>   (written by sim/fmt/run_sim_rtl.py, write_cpp_job)
 // Progress on stderr when the job says so; result JSON to the job's out path.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <deque>
 
 #include <algorithm>
 #include <chrono>
@@ -75,6 +101,11 @@ struct Job {
     std::vector<std::pair<uint32_t, uint32_t>> cal, regs;
     std::vector<std::pair<std::string, uint32_t>> status;
     long long reset_cycles = 16, run_cycles = 0;
+    // serve mode (serve_port < 0: off)
+    int serve_port = -1, serve_div = 4, serve_once = 0;
+    double serve_seconds = 0.0;
+    long long serve_cycles = 0;
+    std::string serve_log;
 };
 
 double cpu_seconds() {   // user + system CPU time of this process
@@ -114,6 +145,12 @@ Job read_job(const char* path) {
         else if (k == "noise_len") { if (std::fscanf(f, "%d", &j.noise_len) != 1) die(k); }
         else if (k == "reset_cycles") { if (std::fscanf(f, "%lld", &j.reset_cycles) != 1) die(k); }
         else if (k == "run_cycles") { if (std::fscanf(f, "%lld", &j.run_cycles) != 1) die(k); }
+        else if (k == "serve_port") { if (std::fscanf(f, "%d", &j.serve_port) != 1) die(k); }
+        else if (k == "serve_div") { if (std::fscanf(f, "%d", &j.serve_div) != 1 || j.serve_div < 2) die(k); }
+        else if (k == "serve_once") { if (std::fscanf(f, "%d", &j.serve_once) != 1) die(k); }
+        else if (k == "serve_seconds") { if (std::fscanf(f, "%lf", &j.serve_seconds) != 1) die(k); }
+        else if (k == "serve_cycles") { if (std::fscanf(f, "%lld", &j.serve_cycles) != 1) die(k); }
+        else if (k == "serve_log") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.serve_log = sval; }
         else if (k == "noise_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.noise_file = sval; }
         else if (k == "upd_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.upd_file = sval; }
         else if (k == "out") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.out = sval; }
@@ -257,6 +294,69 @@ struct Channel {
     }
 };
 
+// Host -> core: 8N1 bit-serial, bytes back to back, div clk per bit.
+struct UartTx {
+    int div;
+    std::deque<uint8_t> q;
+    uint32_t frame = 0;     // bits still to send, LSB first (start, data, stop)
+    int nbits = 0, cnt = 0;
+    bool done = false;      // the clk just driven was the last of a stop bit
+    uint8_t byte = 0;       // the byte being (or just) sent
+    explicit UartTx(int d) : div(d) {}
+    int next_level() {      // pin level for the coming clk cycle
+        done = false;
+        if (cnt == 0) {
+            if (nbits == 0) {
+                if (q.empty()) return 1;
+                byte = q.front();
+                q.pop_front();
+                frame = (1u << 9) | (static_cast<uint32_t>(byte) << 1);
+                nbits = 10;
+            }
+            cnt = div;
+        }
+        const int lvl = static_cast<int>(frame & 1u);
+        if (--cnt == 0) {
+            frame >>= 1;
+            if (--nbits == 0) done = true;
+        }
+        return lvl;
+    }
+};
+
+// Core -> host: the pin sampled once per clk; a byte is taken at the middle of its
+// stop bit (start bit checked at its middle too; a low stop bit counts as framing error).
+struct UartRx {
+    int div, state = 0, wait = 0, bit = 0;
+    uint32_t sh = 0;
+    long long framing_errors = 0;
+    explicit UartRx(int d) : div(d) {}
+    int sample(int lvl) {   // returns the byte completed at this clk or -1
+        if (state == 0) {
+            if (!lvl) { state = 1; wait = div / 2; bit = 0; sh = 0; }
+            return -1;
+        }
+        if (--wait > 0) return -1;
+        wait = div;
+        if (bit == 0) {
+            if (lvl) state = 0;              // glitch, not a start bit
+            bit = 1;
+            return -1;
+        }
+        if (bit <= 8) {
+            sh |= static_cast<uint32_t>(lvl & 1) << (bit - 1);
+            ++bit;
+            return -1;
+        }
+        state = 0;
+        if (!lvl) { ++framing_errors; return -1; }
+        return static_cast<int>(sh & 0xFF);
+    }
+};
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int) { g_stop = 1; }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -349,6 +449,108 @@ int main(int argc, char** argv) {
         st += (st.empty() ? "" : ", ") + ("\"" + s.first + "\": " + std::to_string(v));
     }
     const unsigned frames_at = top->frames_o;
+
+    // ---- serve mode: the core's UART on a TCP port (see the header) ----
+    std::string serve_json;
+    if (job.serve_port >= 0) {
+        constexpr long long SERVE_POLL = 256;      // clk between socket polls
+        const unsigned serve_start = top->cycle_o;
+        top->ev_ready_i = 1;
+        const int lfd = socket(AF_INET, SOCK_STREAM, 0);
+        if (lfd < 0) die(std::string("socket: ") + std::strerror(errno));
+        const int one = 1;
+        setsockopt(lfd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+        sockaddr_in sa{};
+        sa.sin_family = AF_INET;
+        sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        sa.sin_port = htons(static_cast<uint16_t>(job.serve_port));
+        if (bind(lfd, reinterpret_cast<sockaddr*>(&sa), sizeof sa) != 0)
+            die("cannot listen on 127.0.0.1:" + std::to_string(job.serve_port) + ": " + std::strerror(errno));
+        if (listen(lfd, 4) != 0) die(std::string("listen: ") + std::strerror(errno));
+        fcntl(lfd, F_SETFL, fcntl(lfd, F_GETFL) | O_NONBLOCK);
+        socklen_t sl = sizeof sa;
+        getsockname(lfd, reinterpret_cast<sockaddr*>(&sa), &sl);
+        const int port = ntohs(sa.sin_port);
+        std::signal(SIGINT, on_stop_signal);
+        std::signal(SIGTERM, on_stop_signal);
+        FILE* slog = job.serve_log.empty() ? nullptr : std::fopen(job.serve_log.c_str(), "w");
+        if (!job.serve_log.empty() && !slog) die("cannot write " + job.serve_log);
+        std::printf("serving the RTL UART on socket://127.0.0.1:%d\n", port);
+        std::fflush(stdout);
+        UartTx utx(job.serve_div);
+        UartRx urx(job.serve_div);
+        std::vector<uint8_t> out;
+        int cfd = -1;
+        long long clients = 0, bytes_in = 0, bytes_out = 0, serve_clk = 0;
+        const char* why = "signal";
+        const auto s0 = std::chrono::steady_clock::now();
+        for (;;) {
+            for (long long i = 0; i < SERVE_POLL; ++i) {
+                top->uart_rx_i = utx.next_level();
+                tick();
+                if (utx.done && slog) std::fprintf(slog, "H %u %u\n", top->cycle_o, utx.byte);
+                const int b = urx.sample(top->uart_tx_o);
+                if (b >= 0) {
+                    if (slog) std::fprintf(slog, "D %u %d\n", top->cycle_o, b);
+                    if (cfd >= 0) out.push_back(static_cast<uint8_t>(b));
+                }
+            }
+            serve_clk += SERVE_POLL;
+            if (cfd < 0) {
+                cfd = accept(lfd, nullptr, nullptr);
+                if (cfd >= 0) {
+                    fcntl(cfd, F_SETFL, fcntl(cfd, F_GETFL) | O_NONBLOCK);
+                    ++clients;
+                    if (slog) std::fprintf(slog, "C %u\n", top->cycle_o);
+                }
+            }
+            bool gone = false;
+            if (cfd >= 0) {
+                uint8_t buf[4096];
+                for (;;) {
+                    const ssize_t n = recv(cfd, buf, sizeof buf, 0);
+                    if (n > 0) { utx.q.insert(utx.q.end(), buf, buf + n); bytes_in += n; continue; }
+                    if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) gone = true;
+                    break;
+                }
+                while (!gone && !out.empty()) {
+                    const ssize_t n = send(cfd, out.data(), out.size(), MSG_NOSIGNAL);
+                    if (n > 0) { out.erase(out.begin(), out.begin() + n); bytes_out += n; continue; }
+                    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) break;
+                    gone = true;
+                }
+                if (gone) {
+                    close(cfd);
+                    cfd = -1;
+                    out.clear();
+                    if (slog) std::fprintf(slog, "X %u\n", top->cycle_o);
+                }
+            }
+            if (g_stop) { why = "signal"; break; }
+            if (gone && job.serve_once) { why = "client"; break; }
+            if (job.serve_cycles > 0 && serve_clk >= job.serve_cycles) { why = "cycles"; break; }
+            if (job.serve_seconds > 0.0 &&
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count() >= job.serve_seconds) {
+                why = "seconds";
+                break;
+            }
+        }
+        if (cfd >= 0) close(cfd);
+        close(lfd);
+        if (slog) std::fclose(slog);
+        const double sw = std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
+        if (job.progress)
+            std::fprintf(stderr, "served %lld clk in %.1f s (%lld clients, %lld bytes in, %lld out), end: %s\n",
+                         serve_clk, sw, clients, bytes_in, bytes_out, why);
+        char tmp[512];
+        std::snprintf(tmp, sizeof tmp,
+                      ", \"serve_start_cycle\": %u, \"serve\": {\"port\": %d, \"clk\": %lld, \"wall_s\": %.3f, "
+                      "\"clients\": %lld, \"bytes_in\": %lld, \"bytes_out\": %lld, \"framing_errors\": %lld, "
+                      "\"end\": \"%s\", \"end_cycle\": %u}",
+                      serve_start, port, serve_clk, sw, clients, bytes_in, bytes_out, urx.framing_errors, why,
+                      static_cast<unsigned>(top->cycle_o));
+        serve_json = tmp;
+    }
     top->flush_i = 1; tick(); top->flush_i = 0; ticks(2);
     top->final();
 
@@ -358,12 +560,13 @@ int main(int argc, char** argv) {
                  "{\"engine\": \"cpp\", \"wall_s\": %.6f, \"cpu_s\": %.6f, \"run_clk\": %lld, \"clk_per_s\": %.1f, "
                  "\"frames\": %u, \"events\": %u, \"upd_late\": %lld, \"upd_done\": %d, \"upd_copies\": %lld, "
                  "\"clip\": %d, \"clip_samples\": %lld, \"status_cycle\": %u, \"frames_before_status\": %u, "
-                 "\"status\": {%s}, \"frames_at_status\": %u}\n",
+                 "\"status\": {%s}, \"frames_at_status\": %u%s}\n",
                  wall, cpu, run_clk, run_clk / std::max(wall, 1e-9), frames, events,
                  cpp_channel ? ch.late : static_cast<long long>(top->upd_late_o),
                  cpp_channel ? ((ch.next_upd == ch.updates.size() && !ch.armed) ? 1 : 0) : static_cast<int>(top->upd_done_o),
                  cpp_channel ? ch.copies : -1LL,
-                 cpp_channel ? (ch.clip_sticky ? 1 : 0) : static_cast<int>(top->clip_o), ch.clip_samples, status_cycle, frames_before, st.c_str(), frames_at);
+                 cpp_channel ? (ch.clip_sticky ? 1 : 0) : static_cast<int>(top->clip_o), ch.clip_samples, status_cycle, frames_before, st.c_str(), frames_at,
+                 serve_json.c_str());
     std::fclose(o);
     return 0;
 }
