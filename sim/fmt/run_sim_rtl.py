@@ -47,10 +47,11 @@ drives the running simulation as it drives the board.  It prints ``serving the R
 on socket://127.0.0.1:PORT`` when listening (PORT 0: any free port, the line names it)
 and serves one client at a time, any number of clients in turn, until Ctrl-C (SIGINT /
 SIGTERM: a clean end), ``--serve-seconds`` of wall time (default 600, 0 = none) or, with
-``--serve-once``, the first client's disconnect.  The coupling of the scene's last frame
-holds while serving (the noise keeps looping); only the scene's frames are compared with
-the model (the logs are cut at the cycle where serving started); ``serve.log`` in the job
-folder lists every UART byte with its cycle.
+``--serve-once``, the first client's disconnect.  The loggers stay on for the first
+``--serve-log-frames`` frames of serving (default 2000, -1 = all).  The coupling of the
+scene's last frame holds while serving (the noise keeps looping); only the scene's
+frames are compared with the model (the logs are cut at the cycle where serving
+started); ``serve.log`` in the job folder lists every UART byte with its cycle.
 
 Cycle conventions: cycle 0 = the first clk edge with rst low; channel sample k is formed
 at cycle k * CPS (the ce edges); the receiver takes ADC sample j (= channel sample j - 1)
@@ -555,7 +556,8 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
 def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
                   verilog_channel: bool = False, serve: dict | None = None) -> None:
     """The job of the C++ harness: the same phases as the cocotb run_scene; serve:
-    {"port", "seconds", "cycles", "once"} for serve mode (see the module doc)."""
+    {"port", "seconds", "cycles", "once", "log_clk"} for serve mode (see the module doc;
+    log_clk: clk of serving with the loggers on, -1 = all)."""
     from . import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
@@ -573,7 +575,7 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
         lines += [f"serve_port {int(serve['port'])}", f"serve_div {sim_parameters(cfg, cps, d)['UART_DIV']}",
                   f"serve_seconds {float(serve.get('seconds', 600.0))}",
                   f"serve_cycles {int(serve.get('cycles', 0))}", f"serve_once {int(bool(serve.get('once')))}",
-                  f"serve_log {d / 'serve.log'}"]
+                  f"serve_log_clk {int(serve.get('log_clk', -1))}", f"serve_log {d / 'serve.log'}"]
     Path(path).write_text("\n".join(lines) + "\n")
 
 
@@ -732,6 +734,9 @@ def main(argv=None) -> int:
                     help="end serving after this wall time (default 600 s, 0 = no limit)")
     ap.add_argument("--serve-once", action="store_true",
                     help="end serving when the first client disconnects")
+    ap.add_argument("--serve-log-frames", type=int, default=2000,
+                    help="keep the heat-map/event loggers on for this many frames of serving "
+                         "(default 2000; -1 = all: the logs of a long full-size session grow by MB/s)")
     ap.add_argument("--tag", default="cpp", help="job folder / build tag of the C++ harness")
     ap.add_argument("--cflags", default=HARNESS_CFLAGS,
                     help=f"C++ flags of the harness build (default '{HARNESS_CFLAGS}'; tests: -O0)")
@@ -739,7 +744,9 @@ def main(argv=None) -> int:
     sc = _scene.load(a.scene)
     serve = None
     if a.serve is not None:
-        serve = {"port": a.serve, "seconds": a.serve_seconds, "once": a.serve_once}
+        spf_clk = sc.samples_per_frame * a.cps
+        serve = {"port": a.serve, "seconds": a.serve_seconds, "once": a.serve_once,
+                 "log_clk": -1 if a.serve_log_frames < 0 else a.serve_log_frames * spf_clk}
     rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
               engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
     print(_summary(rep))

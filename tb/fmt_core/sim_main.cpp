@@ -42,7 +42,9 @@
 // and serve_start_cycle: the scene's part of the logs ends there).  serve_log (optional)
 // gets one line per byte: "H <cycle> <byte>" a host byte whose stop bit has been driven,
 // "D <cycle> <byte>" a core byte decoded (at its stop bit), "C <cycle>" / "X <cycle>"
-// client connected / gone; <cycle> = cycle_o, the loggers' time base.
+// client connected / gone; <cycle> = cycle_o, the loggers' time base (counted on here
+// when the loggers stop).  serve_log_clk >= 0: the loggers (play_i) stop after that many
+// clk of serving (the logs of a long session at full size would grow by MB/s); -1: on.
 //
 // Usage: Vfmt_core_sim_top <job.txt>   (written by sim/fmt/run_sim_rtl.py, write_cpp_job)
 // Progress on stderr when the job says so; result JSON to the job's out path.
@@ -104,7 +106,7 @@ struct Job {
     // serve mode (serve_port < 0: off)
     int serve_port = -1, serve_div = 4, serve_once = 0;
     double serve_seconds = 0.0;
-    long long serve_cycles = 0;
+    long long serve_cycles = 0, serve_log_clk = -1;
     std::string serve_log;
 };
 
@@ -150,6 +152,7 @@ Job read_job(const char* path) {
         else if (k == "serve_once") { if (std::fscanf(f, "%d", &j.serve_once) != 1) die(k); }
         else if (k == "serve_seconds") { if (std::fscanf(f, "%lf", &j.serve_seconds) != 1) die(k); }
         else if (k == "serve_cycles") { if (std::fscanf(f, "%lld", &j.serve_cycles) != 1) die(k); }
+        else if (k == "serve_log_clk") { if (std::fscanf(f, "%lld", &j.serve_log_clk) != 1) die(k); }
         else if (k == "serve_log") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.serve_log = sval; }
         else if (k == "noise_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.noise_file = sval; }
         else if (k == "upd_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.upd_file = sval; }
@@ -482,26 +485,29 @@ int main(int argc, char** argv) {
         std::vector<uint8_t> out;
         int cfd = -1;
         long long clients = 0, bytes_in = 0, bytes_out = 0, serve_clk = 0;
+        unsigned cyc = serve_start;                // = cycle_o while the loggers run
         const char* why = "signal";
         const auto s0 = std::chrono::steady_clock::now();
         for (;;) {
             for (long long i = 0; i < SERVE_POLL; ++i) {
                 top->uart_rx_i = utx.next_level();
                 tick();
-                if (utx.done && slog) std::fprintf(slog, "H %u %u\n", top->cycle_o, utx.byte);
+                ++cyc;
+                if (utx.done && slog) std::fprintf(slog, "H %u %u\n", cyc, utx.byte);
                 const int b = urx.sample(top->uart_tx_o);
                 if (b >= 0) {
-                    if (slog) std::fprintf(slog, "D %u %d\n", top->cycle_o, b);
+                    if (slog) std::fprintf(slog, "D %u %d\n", cyc, b);
                     if (cfd >= 0) out.push_back(static_cast<uint8_t>(b));
                 }
             }
             serve_clk += SERVE_POLL;
+            if (job.serve_log_clk >= 0 && serve_clk >= job.serve_log_clk) top->play_i = 0;   // loggers off
             if (cfd < 0) {
                 cfd = accept(lfd, nullptr, nullptr);
                 if (cfd >= 0) {
                     fcntl(cfd, F_SETFL, fcntl(cfd, F_GETFL) | O_NONBLOCK);
                     ++clients;
-                    if (slog) std::fprintf(slog, "C %u\n", top->cycle_o);
+                    if (slog) std::fprintf(slog, "C %u\n", cyc);
                 }
             }
             bool gone = false;
@@ -523,7 +529,7 @@ int main(int argc, char** argv) {
                     close(cfd);
                     cfd = -1;
                     out.clear();
-                    if (slog) std::fprintf(slog, "X %u\n", top->cycle_o);
+                    if (slog) std::fprintf(slog, "X %u\n", cyc);
                 }
             }
             if (g_stop) { why = "signal"; break; }
@@ -548,7 +554,7 @@ int main(int argc, char** argv) {
                       "\"clients\": %lld, \"bytes_in\": %lld, \"bytes_out\": %lld, \"framing_errors\": %lld, "
                       "\"end\": \"%s\", \"end_cycle\": %u}",
                       serve_start, port, serve_clk, sw, clients, bytes_in, bytes_out, urx.framing_errors, why,
-                      static_cast<unsigned>(top->cycle_o));
+                      cyc);
         serve_json = tmp;
     }
     top->flush_i = 1; tick(); top->flush_i = 0; ticks(2);

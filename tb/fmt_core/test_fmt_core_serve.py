@@ -29,7 +29,8 @@ A. small.json with both contacts lifting before frame 10 (no event after the tra
 B. small.json (a finger stays: events every frame), ``--serve-once``: fmtctl touches
    --count 5; each streamed event equals the logged event of the same frame and ID
    (every field, time stamp included); serving ends when the client disconnects.
-C. ``--serve-seconds 1`` and no client: serving ends by itself.
+C. ``--serve-seconds 1`` and no client: serving ends by itself; with
+   ``--serve-log-frames 5`` the loggers stop after about 5 frames of serving.
 Verilator only (a C++ Verilator harness).
 """
 from __future__ import annotations
@@ -72,8 +73,8 @@ class Server:
         self.err = open(out_dir / "serve_stderr.txt", "w+")
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "fmt.run_sim_rtl", "--scene", str(SCENE), "--frames", str(FRAMES),
-             "--cps", str(CPS), "--serve", "0", "--no-plot", "--quiet", "--cflags=-O0", "--tag", TAG,
-             "--out", str(out_dir), *extra],
+             "--cps", str(CPS), "--serve", "0", "--serve-log-frames", "-1", "--no-plot", "--quiet",
+             "--cflags=-O0", "--tag", TAG, "--out", str(out_dir), *extra],
             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=self.err, text=True, start_new_session=True)
         self.lines: queue.Queue = queue.Queue()
         self.out: list[str] = []
@@ -294,14 +295,19 @@ def test_fmt_core_serve(sim, tmp_path):
     assert [s["frame"] for s in streamed] == sorted(s["frame"] for s in streamed)
     summary["events"] = [(s["frame"], s["id"]) for s in streamed]
 
-    # ---- run C: the wall-clock limit ends serving with no client at all
-    srv = Server(tmp_path, "--serve-seconds", "1")
+    # ---- run C: the wall-clock limit ends serving with no client at all; the loggers
+    # stop after 5 frames of serving
+    srv = Server(tmp_path, "--serve-seconds", "1", "--serve-log-frames", "5")
     try:
         srv.wait_serving()
         rc, text = srv.finish()
     finally:
         srv.kill()
     assert rc == 0 and "end: seconds" in text and "0 clients" in text and "golden mismatches 0" in text, text
+    start = json.loads((tmp_path / "small" / "report.json").read_text())["serve"]["start_cycle"]
+    _hm, eof, _evs, _fend = rsr.parse_logs(d, cfg)
+    n_after = sum(1 for c, _f in eof if c >= start)
+    assert 4 <= n_after <= 7, f"{n_after} frames logged while serving, the loggers were to stop after 5"
     print(json.dumps(summary))
 
 
