@@ -610,6 +610,8 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
                 raise
             # serve mode: the harness got the SIGINT too and ends its serving cleanly
     proc_s = time.perf_counter() - t0
+    if serve is not None and proc.returncode == -2:      # SIGINT before the serving began
+        raise KeyboardInterrupt
     if proc.returncode != 0:
         raise RuntimeError(f"harness failed ({proc.returncode}): {err.decode()[-2000:] if err else ''}")
     res = json.loads((d / "result.json").read_text())
@@ -747,8 +749,12 @@ def main(argv=None) -> int:
         spf_clk = sc.samples_per_frame * a.cps
         serve = {"port": a.serve, "seconds": a.serve_seconds, "once": a.serve_once,
                  "log_clk": -1 if a.serve_log_frames < 0 else a.serve_log_frames * spf_clk}
-    rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
-              engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
+    try:
+        rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
+                  engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
     print(_summary(rep))
     if "serve" in rep:
         s = rep["serve"]
