@@ -16,8 +16,8 @@ cycles [request received, reply sent]):
 
 A. small.json with both contacts lifting before frame 10 (no event after the tracker's
    hold-off, ~130 frames: the latency counters then hold still), fmtctl info, get
-   FRAME_COUNT twice, latency, heatmap --out x.npy, then Ctrl-C (SIGINT to the process
-   group: a clean end, exit 0):
+   FRAME_COUNT (twice or more, until frame 400), latency, heatmap --out x.npy, then
+   Ctrl-C (SIGINT to the process group: a clean end, exit 0):
    * INFO: version 1.0 and the sensor's sizes; every request got its reply (no error
      frame, no byte outside a valid frame on either side, no UART framing error);
    * FRAME_COUNT: > 0, increasing, and between the frame ends logged at the two ends
@@ -62,6 +62,7 @@ SCENE = ROOT / "sim" / "scenes" / "small.json"
 TAG = "tb_serve"
 CPS = 3
 FRAMES = 12
+QUIET_FRAME = 400   # run A: no event after this frame (the lifts' hold-off ends near 140)
 SLACK = 16          # clk: register pipeline between an event leaving and its counters
 
 
@@ -130,6 +131,12 @@ def fmtctl(port: str, *args: str) -> str:
                        text=True, timeout=90)
     assert r.returncode == 0 and "Traceback" not in r.stderr, (args, r.stdout, r.stderr)
     return r.stdout
+
+
+def frame_count(text: str) -> int:
+    m = re.match(r"FRAME_COUNT = (\d+) \(0x[0-9A-F]+\)$", text.strip())
+    assert m, text
+    return int(m.group(1))
 
 
 # ---- logs --------------------------------------------------------------------------------
@@ -207,8 +214,13 @@ def test_fmt_core_serve(sim, tmp_path):
         port = srv.wait_serving()
         outs = {}
         outs["info"] = fmtctl(port, "info")
-        outs["fc1"] = fmtctl(port, "get", "FRAME_COUNT")
-        outs["fc2"] = fmtctl(port, "get", "FRAME_COUNT")
+        # FRAME_COUNT until the lift events are surely out (hold-off ~130 frames after the
+        # lifts near frame 9): then the latency counters hold still
+        outs["fc"] = []
+        t0 = time.monotonic()
+        while len(outs["fc"]) < 2 or frame_count(outs["fc"][-1]) < QUIET_FRAME:
+            assert time.monotonic() - t0 < 90, outs["fc"]
+            outs["fc"].append(fmtctl(port, "get", "FRAME_COUNT"))
         outs["latency"] = fmtctl(port, "latency")
         npy = tmp_path / "hm.npy"
         outs["heatmap"] = fmtctl(port, "heatmap", "--out", str(npy))
@@ -220,7 +232,7 @@ def test_fmt_core_serve(sim, tmp_path):
     assert "golden mismatches 0" in text and "end: signal" in text, text
     rep = json.loads((tmp_path / "small_lift" / "report.json").read_text())
     assert rep["golden_mismatches"] == 0 and rep["frames_dropped"] == 0 and rep["frames"] >= FRAMES, rep
-    assert rep["serve"]["clients"] == 5 and rep["serve"]["framing_errors"] == 0, rep["serve"]
+    assert rep["serve"]["clients"] == 3 + len(outs["fc"]) and rep["serve"]["framing_errors"] == 0, rep["serve"]
 
     # INFO
     info = dict(line.split(": ", 1) for line in outs["info"].strip().splitlines())
@@ -240,10 +252,10 @@ def test_fmt_core_serve(sim, tmp_path):
     # (the lift events come after the tracker's hold-off, ~130 frames: early while serving)
 
     # FRAME_COUNT: > 0, increasing, between the frame ends logged around the transaction
-    fc = [int(re.match(r"FRAME_COUNT = (\d+) ", outs[k]).group(1)) for k in ("fc1", "fc2")]
-    assert 0 < fc[0] < fc[1], fc
+    fc = [frame_count(x) for x in outs["fc"]]
+    assert 0 < fc[0] and all(a < b for a, b in zip(fc, fc[1:])), fc
     rd = reads_of(trans, "FRAME_COUNT")
-    assert [w[0] for _a, _b, w in rd][:2] == fc, (rd, fc)     # (the third: fmtctl latency)
+    assert [w[0] for _a, _b, w in rd][:len(fc)] == fc, (rd, fc)     # (the last one: fmtctl latency)
     for t1, t2, (v,) in rd:
         lo = min(np.count_nonzero(eof_cycles <= t1 - SLACK), np.count_nonzero(fend_cycles <= t1 - SLACK))
         hi = max(np.count_nonzero(eof_cycles <= t2), np.count_nonzero(fend_cycles <= t2))
