@@ -37,19 +37,22 @@
 // then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the label
-// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
-// of row r, whether it continued into row r+1 and as which label (after the merges of
-// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
-// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
-// the last row up gives, one row per cycle, the status of every label of row r: the
-// status of its continuation in row r+1 (known from the previous step) or, when it did
-// not continue, its close record; each cell takes its label's status.  The result
-// (every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed) is a ROWS x COLS
-// bit RAM read by row: mask_rd_row_i ->
-// mask_rd_data_o one cycle later.  mask_ready_o (with mask_frame_o) marks it written;
-// it stays readable until the next frame's pass starts (that frame is labelled; never
-// before its last row), reads in between return 0.  An incomplete frame gives
-// mask_ready_o with an all-zero mask.
+// of every cell at the end of its row (lr_mem, two frame banks like the heat map, so
+// the next frame's labelling never overwrites a mask still being queried); at the end
+// of row r+1, for each label of row r, whether it continued into row r+1 and as which
+// label (after the merges of row r+1) (fr_mem); and the close engine stores, per label
+// and row r, whether the label closed at the end of row r was a blob (cf_mem).  After
+// the frame a pass from the last row up gives, one row per cycle, the status of every
+// label of row r: the status of its continuation in row r+1 (known from the previous
+// step) or, when it did not continue, its close record.  The pass stores it as a status
+// word per row, indexed by label (st_mem, ROWS x NL bits).  The mask (every blob, also
+// those beyond MAX_BLOBS: blobs.blob_mask_fixed) is read one cell at a time through a
+// query port: (mask_q_row_i, mask_q_col_i) -> the cell's label (lr_mem) and its row's
+// status word (st_mem) one cycle later -> mask_q_data_o = the label's status bit two
+// cycles after the address; one query per cycle, pipelined.  mask_ready_o (with
+// mask_frame_o) marks the mask written; it stays readable until the next frame's pass
+// starts (that frame is labelled; never before its last row), queries in between
+// return 0.  An incomplete frame gives mask_ready_o with an all-zero mask.
 //
 // Fixed point: blob_cx_o, blob_cy_o are unsigned Q8.8 cells from the centre of cell
 // (0, 0), zero-extended to 16 bits; exact (round half up of the exact rational).
@@ -116,8 +119,9 @@ module fmt_blob #(
     // blob membership of the cells (all blobs, also those beyond MAX_BLOBS)
     output reg                    mask_ready_o,      // the frame's mask is written (one cycle)
     output reg  [FRAME_W-1:0]     mask_frame_o,      // its frame number (with mask_ready_o)
-    input  wire [ROW_IDX_W-1:0]   mask_rd_row_i,     // row to read
-    output wire [COLS-1:0]        mask_rd_data_o,    // next cycle: bit c = cell (row, c) in a blob
+    input  wire [ROW_IDX_W-1:0]   mask_q_row_i,      // cell to query: row
+    input  wire [COL_IDX_W-1:0]   mask_q_col_i,      // cell to query: column
+    output reg                    mask_q_data_o,     // 2 cycles later: the cell lies in a blob
     // monitor
     output reg                    overflow_flag_o,   // sticky: some frame had > MAX_BLOBS blobs
     output reg                    overrun_o          // sticky: frames arrived faster than processed
@@ -331,11 +335,13 @@ module fmt_blob #(
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
     (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
+    reg [COLS*LBL_W-1:0]     lr_mem [0:2*ROWS-1];   // two banks, as mem
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
+    wire [ADDR_W-1:0] lr_wa = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
+                            + {{(ADDR_W-ROW_IDX_W){1'b0}}, cur_row_q};
     always @(posedge clk) begin
-        if (row_done) lr_mem[cur_row_q] <= c_nx;
+        if (row_done) lr_mem[lr_wa] <= c_nx;
         if (row_done && cur_row_q != {ROW_IDX_W{1'b0}})
             fr_mem[cur_row_q - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -587,22 +593,16 @@ module fmt_blob #(
     // (per label, by row) holds whether it was a blob.
     reg                  bw_run_q;            // reading rows
     reg [ROW_IDX_W-1:0]  bw_r_q;              // next row to read
-    reg                  bw_v_q;              // lr_rd_q, fr_rd_q hold row bw_row_q
+    reg                  bw_v_q;              // fr_rd_q holds row bw_row_q
     reg [ROW_IDX_W-1:0]  bw_row_q;
-    reg [COLS*LBL_W-1:0] lr_rd_q;             // labels of row r
     reg [NL*(LBL_W+1)-1:0] fr_rd_q;           // continuation record of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
-    (* ram_style = "block" *)
-    reg [COLS-1:0]       mask_mem [0:ROWS-1];
-    reg [COLS-1:0]       mask_rd_q;
     reg                  mask_ok_q;           // the mask holds a complete frame
+    reg                  qb_q;                // lr_mem bank of the mask's frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) begin
-            lr_rd_q <= lr_mem[bw_r_q];
-            fr_rd_q <= fr_mem[bw_r_q];
-        end
+        if (bw_run_q) fr_rd_q <= fr_mem[bw_r_q];
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
     wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
@@ -620,17 +620,15 @@ module fmt_blob #(
             assign cfr[gl] = cf_mem[cf_row];
         end
     endgenerate
-    // status of the labels of row r, then of its cells
-    // Indexed selects (one 2^LBL_W : 1 multiplexer per label and per column); the
-    // padded vectors return 0 for label 0 and for codes above NL, and bw_s keeps the
-    // close record when a code is outside 1..NL.
+    // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
+    // per label; the padded vector returns 0 for label 0 and for codes above NL, and
+    // bw_s keeps the close record when a code is outside 1..NL.
     localparam NLP = 1 << LBL_W;
     localparam integer NL_I = NL;
     localparam [LBL_W-1:0] NL_L = NL_I[LBL_W-1:0];
     reg [NL:1]      bw_s;
-    reg [COLS-1:0]  bw_m;
-    reg [LBL_W-1:0] la_r, lc;
-    reg [NLP-1:0]   sn_pad, bs_pad;
+    reg [LBL_W-1:0] la_r;
+    reg [NLP-1:0]   sn_pad;
     always @(*) begin
         sn_pad = {NLP{1'b0}};
         sn_pad[NL:1] = sn_q;
@@ -642,18 +640,37 @@ module fmt_blob #(
             else
                 bw_s[g] = cfr[g];
         end
-        bs_pad = {NLP{1'b0}};
-        bs_pad[NL:1] = bw_s;
-        for (i = 0; i < COLS; i = i + 1) begin
-            lc = lr_rd_q[i*LBL_W +: LBL_W];
-            bw_m[i] = bs_pad[lc];
-        end
     end
+    // the status words, one per row, indexed by label
+    (* ram_style = "block" *)
+    reg [NL:1]      st_mem [0:ROWS-1];
     always @(posedge clk) begin
-        if (bw_v_q) mask_mem[bw_row_q] <= bw_m;
-        mask_rd_q <= mask_mem[mask_rd_row_i];
+        if (bw_v_q) st_mem[bw_row_q] <= bw_s;
     end
-    assign mask_rd_data_o = mask_rd_q & {COLS{mask_ok_q}};
+
+    // ---- Q: cell query: label of the cell, then its status in the cell's row ---------
+    reg [COLS*LBL_W-1:0] q_lr_q;              // labels of the queried row
+    reg [NL:1]           q_st_q;              // status word of the queried row
+    reg [COL_IDX_W-1:0]  q_col_q;
+    wire [ADDR_W-1:0] q_addr = (qb_q ? ROWS_A : {ADDR_W{1'b0}})
+                             + {{(ADDR_W-ROW_IDX_W){1'b0}}, mask_q_row_i};
+    always @(posedge clk) begin
+        q_lr_q  <= lr_mem[q_addr];
+        q_st_q  <= st_mem[mask_q_row_i];
+        q_col_q <= mask_q_col_i;
+    end
+    // columns >= COLS and label 0 (background) read 0
+    localparam NCP = 1 << COL_IDX_W;
+    reg [NCP*LBL_W-1:0] q_lr_pad;
+    reg [NLP-1:0]       q_st_pad;
+    reg [LBL_W-1:0]     q_lbl;
+    always @(*) begin
+        q_lr_pad = {(NCP*LBL_W){1'b0}};
+        q_lr_pad[COLS*LBL_W-1:0] = q_lr_q;
+        q_lbl = q_lr_pad[q_col_q*LBL_W +: LBL_W];
+        q_st_pad = {NLP{1'b0}};
+        q_st_pad[NL:1] = q_st_q;
+    end
 
     wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
                    || cl_v_q || cl_go;
@@ -770,6 +787,8 @@ module fmt_blob #(
             bw_busy_q <= 1'b0;
             tok_q     <= 1'b0;
             mask_ok_q <= 1'b0;
+            qb_q      <= 1'b0;
+            mask_q_data_o <= 1'b0;
             mask_ready_o <= 1'b0;
             mask_frame_o <= {FRAME_W{1'b0}};
             blob_valid_o      <= 1'b0;
@@ -868,7 +887,9 @@ module fmt_blob #(
                 bw_r_q    <= LAST_ROW;
                 bw_busy_q <= 1'b1;
                 mask_ok_q <= 1'b0;
+                qb_q      <= pb_q;
             end
+            mask_q_data_o <= q_st_pad[q_lbl] && mask_ok_q;
             if (fin_abort) begin
                 mask_ready_o <= 1'b1;
                 mask_frame_o <= frm_q[pb_q];

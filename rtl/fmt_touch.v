@@ -8,9 +8,10 @@
 // stream beside fmt_localmax.  The frame's fine touches (fmt_interp keeps the order of
 // the candidates, so the candidate cells are kept in a buffer of MAX_TOUCHES entries
 // beside the touch beats) are held until the blob mask of the frame is written
-// (mask_ready), then replayed one per cycle: the cell's mask row is read, one cycle
-// later the touch goes to the tracker unless its candidate cell lies in a blob (all
-// blobs, also beyond the 8 reported); tp_eof follows on the next cycle.  Up to 8 blob
+// (mask_ready), then replayed one per cycle: the candidate cell is queried (fmt_blob's
+// cell query port, 2 cycles), then the touch goes to the tracker unless its candidate
+// cell lies in a blob (all blobs, also beyond the 8 reported); tp_eof follows on the
+// next cycle.  Up to 8 blob
 // records are buffered and emitted after the tracker's events of the frame (when the
 // tracker is idle again) as type 3: id 0xFF, x/y = centroid (Q8.8), strength = peak,
 // axes/angle/flags 0, ev_last on the last blob.  blob_threshold_i must be >= 1.
@@ -20,7 +21,7 @@
 // frame period, ~100 cycles against >= 384).  The event port reserves room for
 // 2 * MAX_TOUCHES + 8 events per frame.
 // Extra latency with blobs on: the wait for the mask (~56..61 cycles after the last
-// row beat at 30 x 40), n + 2 cycles of replay, then one cycle per blob event.
+// row beat at 30 x 40), n + 3 cycles of replay, then one cycle per blob event.
 // Measured (tb/fmt_touch, 8 x 10, test blobs): last row beat -> last event 56..65 cycles
 // on palm scenes (1..4 events), worst 93 on random maps with many blobs.
 //
@@ -202,7 +203,7 @@ module fmt_touch #(
     wire [FRAME_W-1:0]     b_frame;
     wire [15:0]            b_cx, b_cy;
     wire [HM_W-1:0]        b_peak;
-    wire [COLS-1:0]        m_data;
+    wire                   m_data;
     /* verilator lint_off UNUSEDSIGNAL */   // blob fields and monitors not used by the events
     wire [FRAME_W-1:0]     m_frame;
     wire [BAREA_W-1:0]     b_area, b_found;
@@ -211,7 +212,8 @@ module fmt_touch #(
     wire [BCNT_W-1:0]      b_count;
     wire                   b_ovf, b_inc, b_ovf_flag, b_overrun;
     /* verilator lint_on UNUSEDSIGNAL */
-    wire [ROW_IDX_W-1:0]   m_rd_row;
+    wire [ROW_IDX_W-1:0]   m_q_row;
+    wire [COL_IDX_W-1:0]   m_q_col;
 
     fmt_blob #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_BLOBS(MAX_BLOBS),
                .FRAME_W(FRAME_W), .ROW_IDX_W(ROW_IDX_W), .COL_IDX_W(COL_IDX_W),
@@ -226,8 +228,8 @@ module fmt_touch #(
         .blob_peak_row_o(b_prow), .blob_peak_col_o(b_pcol), .blob_eof_o(b_eof),
         .blob_count_o(b_count), .blob_found_o(b_found), .blob_overflow_o(b_ovf),
         .blob_incomplete_o(b_inc),
-        .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_rd_row_i(m_rd_row),
-        .mask_rd_data_o(m_data),
+        .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_q_row_i(m_q_row),
+        .mask_q_col_i(m_q_col), .mask_q_data_o(m_data),
         .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
     assign blob_flag_o = b_ovf_flag | b_overrun;
 
@@ -235,8 +237,9 @@ module fmt_touch #(
     reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index
     reg  [COL_IDX_W-1:0]   cc_mem [0:(1<<TI_W)-1];
     reg  [TPD_W-1:0]       tp_mem [0:(1<<TI_W)-1];   // touch beats of the frame
-    reg  [TI_W-1:0]        ci_q, ti_q, tn_q, rj_q, s1_idx_q;
-    reg                    have_tp_q, have_mask_q, have_blob_q, rp_q, s1_valid_q, s1_eof_q;
+    reg  [TI_W-1:0]        ci_q, ti_q, tn_q, rj_q, s0_idx_q, s1_idx_q;
+    reg                    have_tp_q, have_mask_q, have_blob_q, rp_q;
+    reg                    s0_valid_q, s0_eof_q, s1_valid_q, s1_eof_q;
 
     always @(posedge clk) begin
         if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) begin
@@ -254,16 +257,22 @@ module fmt_touch #(
             ti_q <= {TI_W{1'b0}};
             tn_q <= {TI_W{1'b0}};
             rj_q <= {TI_W{1'b0}};
+            s0_idx_q <= {TI_W{1'b0}};
             s1_idx_q <= {TI_W{1'b0}};
             have_tp_q <= 1'b0;
             have_mask_q <= 1'b0;
             have_blob_q <= 1'b0;
             rp_q <= 1'b0;
+            s0_valid_q <= 1'b0;
+            s0_eof_q <= 1'b0;
             s1_valid_q <= 1'b0;
             s1_eof_q <= 1'b0;
         end else begin
-            s1_valid_q <= 1'b0;
-            s1_eof_q   <= 1'b0;
+            s0_valid_q <= 1'b0;
+            s0_eof_q   <= 1'b0;
+            s1_valid_q <= s0_valid_q;             // the query's answer comes now
+            s1_eof_q   <= s0_eof_q;
+            s1_idx_q   <= s0_idx_q;
             if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
             if (c_eof) ci_q <= {TI_W{1'b0}};
             if (t_valid && blob_en_i && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
@@ -285,21 +294,21 @@ module fmt_touch #(
             end
             if (rp_q) begin
                 if (rj_q < tn_q) begin
-                    s1_valid_q <= 1'b1;               // mask row read this cycle
-                    s1_idx_q   <= rj_q;
+                    s0_valid_q <= 1'b1;               // the cell is queried this cycle
+                    s0_idx_q   <= rj_q;
                     rj_q       <= rj_q + 1'b1;
                 end else begin
-                    s1_eof_q <= 1'b1;
+                    s0_eof_q <= 1'b1;
                     rp_q     <= 1'b0;
                 end
             end
         end
     end
 
-    assign m_rd_row = cr_mem[rj_q];
-    wire [COL_IDX_W-1:0] s1_col  = cc_mem[s1_idx_q];
+    assign m_q_row = cr_mem[rj_q];
+    assign m_q_col = cc_mem[rj_q];
     wire [TPD_W-1:0]     s1_beat = tp_mem[s1_idx_q];
-    wire                 s1_keep = s1_valid_q && !m_data[s1_col];
+    wire                 s1_keep = s1_valid_q && !m_data;
 
     // tracker input: the chain (blobs off) or the replayed touches (blobs on)
     wire                   g_valid = blob_en_i ? s1_keep  : t_valid;

@@ -10,6 +10,13 @@ fmt.sensor.contact_map with fingers next to the palm, frames without blobs, rows
 random orders with and without gaps, back-to-back frames, a reset in the middle of a
 frame (that frame comes out as incomplete).  The latency from the last row beat (and
 from hm_eof) to blob_eof is measured and bounded.
+
+The membership mask (blob_mask_fixed) is checked through the cell query port
+(mask_q_row_i, mask_q_col_i -> mask_q_data_o two cycles later), one query per cycle
+after mask_ready_o: every cell of the frame when the sensor has at most QMAX cells or
+the frame is run alone (test full_masks: every cell, in random order), else QMAX cells
+(on-cells first, then random cells) -- frames back to back leave the mask readable only
+until the next frame's membership pass starts.
 """
 from __future__ import annotations
 
@@ -28,6 +35,7 @@ from fmt import params
 from fmt.blobs import blob_mask_fixed, blob_stream_fixed, label_regions
 
 MAX_BLOBS = 8
+QMAX = 40                     # mask queries per frame when frames come back to back
 
 
 class TB(ClockedTB):
@@ -42,10 +50,11 @@ class TB(ClockedTB):
         self.cycle = 0
         self.frames = []
         self.masks = []            # (frame, mask, cycle of mask_ready) per frame
+        self.plans = {}            # frame -> cells to query (default: every cell)
         self.cur = []
         self.set(1000, 3)
         for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i",
-                  "mask_rd_row_i"):
+                  "mask_q_row_i", "mask_q_col_i"):
             getattr(dut, s).value = 0
         self.mon = None
 
@@ -86,27 +95,46 @@ class TB(ClockedTB):
                 self.cur = []
 
     async def mask_reader(self):
-        """On mask_ready_o read the whole mask back through the read port, one row per
-        cycle (data one cycle after the address)."""
+        """On mask_ready_o query the frame's planned cells (every cell by default)
+        through the query port, one per cycle (data two cycles after the address).
+        The mask records 1 / 0 for a queried cell, -1 for a cell not queried."""
         d = self.dut
+        every = [(r, c) for r in range(self.rows) for c in range(self.cols)]
         while True:
             await RisingEdge(self.clk)
             await ReadOnly()
             if int(d.rst.value) or not int(d.mask_ready_o.value):
                 continue
             frame, cyc = int(d.mask_frame_o.value), self.cycle
-            m = np.zeros((self.rows, self.cols), dtype=bool)
+            cells = self.plans.pop(frame, None) or every
+            m = np.full((self.rows, self.cols), -1, dtype=np.int8)
             hit_reset = False
-            for r in range(self.rows):
+            for k in range(len(cells) + 1):
                 await self.writable()
-                d.mask_rd_row_i.value = r
+                if k < len(cells):
+                    d.mask_q_row_i.value, d.mask_q_col_i.value = cells[k]
                 await RisingEdge(self.clk)
                 await ReadOnly()
-                hit_reset |= bool(int(d.rst.value))
-                v = int(d.mask_rd_data_o.value)
-                m[r] = [(v >> c) & 1 for c in range(self.cols)]
-            if not hit_reset:                   # a read cut by a reset is not a record
+                if int(d.rst.value):
+                    hit_reset = True          # a read cut by a reset is not a record
+                    break
+                if k >= 1:                    # address at edge k-1, data after edge k
+                    m[cells[k - 1]] = int(d.mask_q_data_o.value)
+            if not hit_reset:
                 self.masks.append((frame, m, cyc))
+
+    def plan(self, rng, hm, full=False):
+        """Cells to query for a frame: every cell (random order) when full or the
+        sensor is small, else QMAX cells: on-cells (shuffled) first, then random cells."""
+        every = [(r, c) for r in range(self.rows) for c in range(self.cols)]
+        if full or len(every) <= QMAX:
+            rng.shuffle(every)
+            return every
+        on = [(r, c) for r, c in every if hm[r][c] >= self.thr]
+        rng.shuffle(on)
+        cells = on[:QMAX - 8]
+        rest = sorted(set(every) - set(cells))
+        return cells + rng.sample(rest, QMAX - len(cells))
 
     def pack(self, row) -> int:
         v = 0
@@ -175,10 +203,13 @@ class TB(ClockedTB):
         assert rec["cycle"] == (cyc[-1] + 1 if cyc else rec["cycle"])
         return found
 
-    async def run_frames(self, rng, hms, first_frame=0, gap_p=0.0, order=None):
-        """Drive, check the blob streams and the membership masks; returns per frame
-        (last row -> blob_eof, hm_eof -> blob_eof, blobs found, last row -> mask_ready)."""
+    async def run_frames(self, rng, hms, first_frame=0, gap_p=0.0, order=None, full=False):
+        """Drive, check the blob streams and the membership masks (queried cells, see
+        plan); returns per frame (last row -> blob_eof, hm_eof -> blob_eof, blobs found,
+        last row -> mask_ready)."""
         n0, m0 = len(self.frames), len(self.masks)
+        for i, hm in enumerate(hms):
+            self.plans[(first_frame + i) & 0xFFFF] = self.plan(rng, hm, full)
         marks = await self.drive(self.schedule(rng, hms, first_frame, gap_p, order))
         await self.drain(n0 + len(hms))
         await self.drain_masks(m0 + len(hms))
@@ -190,7 +221,10 @@ class TB(ClockedTB):
             mframe, mask, mcyc = self.masks[m0 + i]
             want = blob_mask_fixed(hm, self.thr, self.minc)
             assert mframe == frame
-            assert np.array_equal(mask, want), f"frame {frame}: mask\n{mask.astype(int)}\nwant\n{want.astype(int)}"
+            asked = mask >= 0
+            assert asked.sum() == min(len(mask.flat), QMAX) or asked.all()
+            assert np.array_equal(mask[asked] == 1, want[asked]), \
+                f"frame {frame}: mask (-1 not queried)\n{mask.astype(int)}\nwant\n{want.astype(int)}"
             out.append((rec["cycle"] - marks[i][0], rec["cycle"] - marks[i][1], found,
                         mcyc - marks[i][0]))
         return out
@@ -349,6 +383,25 @@ async def palms(dut):
 
 
 @cocotb.test()
+async def full_masks(dut):
+    """Frames one at a time, every cell of the mask queried (random order): random
+    bitmaps, comb, stairs, checkerboard, a palm scene; min-cells 1 and 5."""
+    tb = TB(dut)
+    await tb.reset()
+    rng, nrng = random.Random(17), np.random.default_rng(17)
+    maps = shape_maps(tb.rows, tb.cols)
+    frame = 500
+    for minc in (1, 5):
+        tb.set(1000, minc)
+        hms = [bitmap_hm(nrng, random_on(nrng, tb.rows, tb.cols, d), 1000) for d in (0.45, 0.6)]
+        hms += [bitmap_hm(nrng, maps[k], 1000) for k in ("comb", "stairs", "checker")]
+        hms.append(palm_scene(tb.cfg, nrng))
+        for hm in hms:
+            await tb.run_frames(rng, [hm], frame, full=True)
+            frame += 1
+
+
+@cocotb.test()
 async def reset_mid_frame(dut):
     """A reset in the middle of a frame: the rest of that frame comes out as an
     incomplete frame without blobs, the following frames are exact."""
@@ -367,7 +420,7 @@ async def reset_mid_frame(dut):
     rec = tb.frames[n0]
     assert rec["incomplete"] == 1 and rec["count"] == 0 and rec["blobs"] == []
     await tb.drain_masks(1)
-    assert tb.masks[-1][0] == 3 and not tb.masks[-1][1].any()
+    assert tb.masks[-1][0] == 3 and (tb.masks[-1][1] == 0).all()
     hms = [bitmap_hm(nrng, random_on(nrng, tb.rows, tb.cols, 0.5), 1000) for _ in range(2)]
     await tb.run_frames(rng, hms, 4)
 
