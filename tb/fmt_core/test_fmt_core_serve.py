@@ -115,7 +115,9 @@ class Server:
                 break
             self.out.append(line)
         self.err.seek(0)
-        return rc, "".join(self.out) + self.err.read()
+        text = "".join(self.out) + self.err.read()
+        self.err.close()
+        return rc, text
 
     def interrupt(self):                    # Ctrl-C: SIGINT to the whole process group
         os.killpg(self.proc.pid, signal.SIGINT)
