@@ -1,8 +1,10 @@
 # Fast Multi-Touch (FMT) controller -- top-level commands.
 #   make sim     the main job: the default scene (or SCENE=path) through the RTL core
+#   make sim-serve  make sim, then serve the core's UART to scripts/fmtctl (PORT=5555)
 #   make test    the whole suite (model tests + cocotb under Icarus and Verilator)
 #   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
+#   make synth-core  the whole default core in one Yosys run -> build/synth/core_default.json
 # Every target installs what it needs the first time (iverilog from Debian, a pinned
 # Python environment in .venv); a second run reinstalls nothing.
 
@@ -21,10 +23,11 @@ export CCACHE_DIR := $(abspath build/ccache)
 # pytest-xdist workers (2 cores here); JOBS=1 for a serial run.
 JOBS         ?= 2
 SCENE        ?= sim/scenes/default.json
+PORT         ?= 5555
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
+.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
 
 all: test
 
@@ -98,6 +101,11 @@ regmap: setup
 
 dds-purity: setup
 	$(VPY) scripts/dds_purity.py
+
+# the scene (SCENE=...) through the RTL core, then its UART on socket://127.0.0.1:$(PORT)
+# for scripts/fmtctl until Ctrl-C (or 1 h)
+sim-serve: setup
+	$(VPY) -m fmt.run_sim_rtl --scene $(SCENE) --serve $(PORT) --serve-seconds 3600
 
 synth: setup
 	$(VPY) scripts/synth.py

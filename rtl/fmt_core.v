@@ -54,6 +54,7 @@
 // status_o mirrors them for LEDs.  FRAME_COUNT counts heat-map frames (hm_eof).
 `default_nettype none
 `include "fmt_defaults.vh"
+`include "fmt_regmap.vh"
 
 module fmt_core #(
     parameter ROWS           = `FMT_ROWS,         // transmit rows
@@ -75,7 +76,7 @@ module fmt_core #(
     parameter UART_DIV       = 1085,              // clk cycles per UART bit (125 MHz: 115200 baud)
     parameter UART_TIMEOUT   = 40,                // control-port inter-byte timeout, bit times
     parameter TW_DIR         = "rtl/",            // directory of the FFT twiddle hex files
-    parameter REGMAP_ID      = 0,                 // register-map id reported by INFO
+    parameter REGMAP_ID      = `FMT_REGMAP_ID,    // register-map id reported by INFO (generated)
     parameter ROW_W          = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
     parameter COL_W          = (COLS > 1) ? $clog2(COLS) : 1    // column index width
 ) (

@@ -241,6 +241,7 @@ def test_fmt_core_serve(sim, tmp_path):
     assert info["version"] == "1.0", info
     assert (int(info["rows"]), int(info["cols"]), int(info["n_fft"]), int(info["hm_width"]),
             int(info["bin_lo"])) == (cfg.rows, cfg.cols, cfg.n_fft, cfg.hm_width, cfg.bin_lo), info
+    assert info["regmap_id"] == info["host_regmap_id"], info   # rtl/fmt_regmap.vh is current
 
     host, core, bad = uart_frames(d / "serve.log")
     assert bad == 0, f"{bad} bytes outside valid frames on the UART"
