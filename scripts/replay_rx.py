@@ -36,7 +36,8 @@ def main(argv=None) -> int:
     ap.add_argument("--in", dest="inp", required=True, help="ADC capture .npy (samples x columns)")
     ap.add_argument("--out", required=True, help="heat maps .npy (frames x rows x cols)")
     ap.add_argument("--config", default="default", choices=["default", "small", "medium"])
-    ap.add_argument("--m", type=int, default=1, choices=[1, 2, 4, 8], help="windows per frame")
+    ap.add_argument("--m", type=int, default=1, choices=range(1, 256), metavar="M",
+                    help="windows per frame, 1..255")
     ap.add_argument("--sign", default="", help="receive PN signs .npy (samples,), default PN off")
     ap.add_argument("--cps", type=int, default=1, choices=[1, 2, 3, 4],
                     help="CLK_PER_SAMPLE of the build (clk per sample of the replay)")
@@ -49,10 +50,9 @@ def main(argv=None) -> int:
     from test_fmt_rx_array import RTL_FILES, VERILATOR_ARGS
 
     cfg = params.get(a.config)
-    m_log2 = a.m.bit_length() - 1
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
     fft_ch = rx_fixed.rx_fft_ch_default(1, a.cps)
-    env = {"CFG": a.config, "M_LOG2": m_log2, "REPLAY_IN": inp, "REPLAY_OUT": out,
+    env = {"CFG": a.config, "M": a.m, "REPLAY_IN": inp, "REPLAY_OUT": out,
            "REPLAY_SIGN": Path(a.sign).resolve() if a.sign else "",
            "FFT_CH": fft_ch, "CE_EVERY": a.cps}
     run_cocotb(
@@ -75,7 +75,7 @@ def main(argv=None) -> int:
     if a.check:
         adc = np.load(inp)
         sign = np.load(a.sign) if a.sign else np.zeros(len(adc), dtype=np.uint8)
-        exp, _, _ = rx_fixed.rx_heatmaps_fixed(adc, sign, cfg, m_log2)
+        exp, _, _ = rx_fixed.rx_heatmaps_fixed(adc, sign, cfg, m=a.m)
         if not np.array_equal(hm, exp):
             print(f"MISMATCH: {int(np.sum(hm != exp))} cells differ from rx_fixed")
             return 1

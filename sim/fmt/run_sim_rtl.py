@@ -238,8 +238,7 @@ def model_reference(scene: _scene.Scene, g0, updates, noise, frames: int, settin
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
     _tx, rx = _pn.pn_signs(n, chip_len=chip_len, enable=enable, rx_delay=PN_RX_DELAY, bits=cfg.pn_bits)
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
-    m_log2 = int(round(math.log2(scene.m)))
-    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m_log2=m_log2)
+    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m=scene.m)
     evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
                                 frame_period_s=scene.frame_period_s)
     return Reference(hm, evs, clipped)

@@ -5,9 +5,8 @@ reciprocal divider), the core's own frame-end counter (fmt_latency) one frame = 
 windows apart, the latency counters equal to the cycles measured from the logs.
 
 The cocotb side is ``run_scene`` of test_fmt_core.py (the job-file engine of
-``python -m fmt.run_sim_rtl``).  The reference is computed by run_sim_rtl.prepare; until
-that passes the scene's M itself (not 2^round(log2 M)) to rx_heatmaps_fixed, this test
-makes it do so for the duration of the test (monkeypatch, harmless afterwards).
+``python -m fmt.run_sim_rtl``); the reference is computed by run_sim_rtl.prepare, which
+passes the scene's M to rx_heatmaps_fixed.
 """
 from __future__ import annotations
 
@@ -29,17 +28,11 @@ from fmt.settings import TouchSettings  # noqa: E402
 M = 3
 
 
-def test_fmt_core_m3(sim, monkeypatch):
+def test_fmt_core_m3(sim):
     frames, cps = 5, 3
     scene = _scene.small_scene().replace(frames=frames, m=M)
     cfg = scene.cfg
     assert scene.samples_per_frame == M * cfg.n_fft
-    orig = rsr._rx.rx_heatmaps_fixed
-
-    def fixed(adc, rx_sign, cfg_, m_log2=0, m=None, **kw):
-        return orig(adc, rx_sign, cfg_, m=scene.m if m is None else m, **kw)
-
-    monkeypatch.setattr(rsr._rx, "rx_heatmaps_fixed", fixed)
     st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
     d, ref, cal, _n_upd = rsr.prepare(scene, frames, cps, st, cal=None, tag=f"tbm{M}_{sim}")
     assert ref.heatmaps.shape[0] == frames
