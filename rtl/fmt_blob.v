@@ -469,6 +469,9 @@ module fmt_blob #(
     reg [ROW_IDX_W-1:0] x4_row_q;
     reg [E_W-1:0]       x4_e_q;               // the run as an entry
     reg [E_W-1:0]       run_e;
+    // the second operand of an update: the run (ADD) or label B's entry (MERGE); one
+    // combine() serves both
+    wire [E_W-1:0]      acc_y;
     always @(*) begin
         run_e = {E_W{1'b0}};
         run_e[O_AREA +: AREA_W]   = x3_cnt_q;
@@ -487,6 +490,7 @@ module fmt_blob #(
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
     reg [E_W-1:0] acc_q [1:NL];
+    assign acc_y = (x4_op_q == OP_MERGE) ? acc_q[x4_b_q] : x4_e_q;
     reg [LBL_W-1:0] cpick;
     reg [NL:1]      cpick_bit;
     always @(*) begin
@@ -713,8 +717,8 @@ module fmt_blob #(
         if (x4_v_q) begin
             case (x4_op_q)
                 OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
-                OP_ADD:   acc_q[x4_a_q] <= combine(acc_q[x4_a_q], x4_e_q);
-                OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_q[x4_b_q]);
+                OP_ADD,
+                OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_y);
                 default:  ;
             endcase
         end
