@@ -489,8 +489,13 @@ module fmt_blob #(
     end
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
+    // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
+    // or else the close engine's label (a closed label waits while a MERGE is applied)
     reg [E_W-1:0] acc_q [1:NL];
-    assign acc_y = (x4_op_q == OP_MERGE) ? acc_q[x4_b_q] : x4_e_q;
+    wire            b_merge = x4_v_q && (x4_op_q == OP_MERGE);
+    wire [LBL_W-1:0] acc_b_lbl;
+    wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
+    assign acc_y = (x4_op_q == OP_MERGE) ? acc_b : x4_e_q;
     reg [LBL_W-1:0] cpick;
     reg [NL:1]      cpick_bit;
     always @(*) begin
@@ -498,9 +503,10 @@ module fmt_blob #(
         for (i = NL; i >= 1; i = i - 1)
             if (pend_q[i]) cpick = i[LBL_W-1:0];
         for (i = 1; i <= NL; i = i + 1)
-            cpick_bit[i] = (cpick == i[LBL_W-1:0]) && pend_q[i];
+            cpick_bit[i] = (cpick == i[LBL_W-1:0]) && pend_q[i] && !b_merge;
     end
-    wire cl_go = |pend_q;
+    wire cl_go = (|pend_q) && !b_merge;
+    assign acc_b_lbl = b_merge ? x4_b_q : cpick;
     reg           cl_v_q;
     reg [E_W-1:0] cl_e_q;
     reg [ROW_IDX_W-1:0] crow_q [1:NL];        // row at whose end the label was closed
@@ -677,7 +683,7 @@ module fmt_blob #(
     end
 
     wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
-                   || cl_v_q || cl_go;
+                   || cl_v_q || (|pend_q);
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
     wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
@@ -723,7 +729,7 @@ module fmt_blob #(
             endcase
         end
         if (cl_go) begin
-            cl_e_q   <= acc_q[cpick];
+            cl_e_q   <= acc_b;
             cl_row_q <= crow_q[cpick];
             cl_lbl_q <= cpick;
         end

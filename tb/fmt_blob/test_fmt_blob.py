@@ -296,6 +296,11 @@ def shape_maps(rows, cols):
         for c in range(cols):
             stairs[r, c] = ((c + r) % 4 == 0) or (r == rows - 1)
     out["stairs"] = stairs
+    weave = np.zeros((rows, cols), bool)         # even cells, odd cells (all new labels),
+    weave[0::3, 0::2] = True                     # a full row (merges them all): the most
+    weave[1::3, 1::2] = True                     # merges with the most runs
+    weave[2::3, :] = True
+    out["weave"] = weave
     return out
 
 
@@ -472,7 +477,7 @@ async def latency(dut):
     period = 3 * (1 << bits)
     maps = shape_maps(tb.rows, tb.cols)
     tb.set(1000, 1)
-    for name in ("checker", "comb", "comb2", "stairs"):
+    for name in ("checker", "comb", "comb2", "stairs", "weave"):
         hm = bitmap_hm(nrng, maps[name], 1000)
         (from_row, from_eof, n, mlat), = await tb.run_frames(rng, [hm], 200, order=list(range(tb.rows)))
         total = max(from_row, mlat) + tb.rows
