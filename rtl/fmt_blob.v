@@ -19,13 +19,15 @@
 //       After the last row every live label is closed.  Labels are slots 1..NL,
 //       NL = 2*ceil(COLS/2) + 6: every label that can be live in two rows (P and C,
 //       ceil(COLS/2) runs each) plus the closed labels still in the pipeline to the close
-//       engine, so the labelling never runs out of labels and never waits (a NEW waits
-//       for a free slot only if that bound were wrong; nothing is ever dropped).
+//       engine, so the labelling does not run out of labels (a NEW waits for a free
+//       slot if it ever did -- the close engine pauses while a MERGE is applied, and a
+//       MERGE frees a label itself; nothing is ever dropped).
 //   X2..X4: masked sums of the run (area, sum z, sum z*c, sum z*r = r * sum z, peak and
 //       its first column, first/last column), 8-column groups then totals
 //   A : the command updates the per-label accumulators (a distributed RAM, one write
-//       and three asynchronous reads): NEW writes the run, ADD combines the run, MERGE
-//       combines label B into A (B is free again).
+//       and two asynchronous reads, one of them shared with the close engine): NEW
+//       writes the run, ADD combines the run, MERGE combines label B into A (B is free
+//       again).
 //   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
 //       inserted into a sorted list of MAX_BLOBS entries (area descending, ties by the
 //       raster index of the region's first cell ascending); the smallest falls off.  The

@@ -22,8 +22,9 @@
 // 2 * MAX_TOUCHES + 8 events per frame.
 // Extra latency with blobs on: the wait for the mask (~56..61 cycles after the last
 // row beat at 30 x 40), n + 3 cycles of replay, then one cycle per blob event.
-// Measured (tb/fmt_touch, 8 x 10, test blobs): last row beat -> last event 56..65 cycles
-// on palm scenes (1..4 events), worst 93 on random maps with many blobs.
+// Measured (tb/fmt_touch, test blobs): last row beat -> last event 54..63 cycles on
+// 8 x 10 palm scenes (1..4 events), worst 101 on random maps with many blobs; at
+// 30 x 40 81..108 cycles on palm scenes, worst 377 on random maps.
 //
 // Twin: sim/fmt/touch.py process_frames(fixed=True, blobs=False): per frame the same
 // events in the same order (time stamps excepted).  The run-time settings are input
