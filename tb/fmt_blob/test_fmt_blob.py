@@ -57,6 +57,14 @@ class TB(ClockedTB):
                   "mask_q_row_i", "mask_q_col_i"):
             getattr(dut, s).value = 0
         self.mon = None
+        # internal nets (Icarus exposes them; Verilator does not): a NEW that waits for
+        # a free label slot (the NL bound of the RTL says it never does)
+        try:
+            self.wait_nets = [getattr(dut, n) for n in ("cur_v_q", "has_run", "hb", "ha", "fa")]
+        except Exception:
+            self.wait_nets = None
+        self.new_waits = 0
+        dut._log.debug(f"label-wait check {'on' if self.wait_nets else 'off (nets not visible)'}")
 
     async def reset(self, cycles: int = 4):
         await super().reset(cycles)
@@ -78,6 +86,9 @@ class TB(ClockedTB):
             if int(d.rst.value):
                 self.cur = []
                 continue
+            if self.wait_nets is not None:
+                cv, hr, hb, ha, fa = (int(x.value) for x in self.wait_nets)
+                self.new_waits += cv and hr and not hb and not ha and not fa
             if int(d.blob_valid_o.value):
                 self.cur.append((int(d.blob_area_o.value), int(d.blob_cx_o.value),
                                  int(d.blob_cy_o.value), int(d.blob_rmin_o.value),
@@ -198,6 +209,7 @@ class TB(ClockedTB):
         assert rec["count"] == len(want) and rec["found"] == found
         assert rec["overflow"] == int(over) and rec["incomplete"] == 0
         assert int(self.dut.overrun_o.value) == 0
+        assert self.new_waits == 0, "a NEW waited for a free label slot"
         cyc = [x[11] for x in rec["blobs"]]
         assert cyc == list(range(cyc[0], cyc[0] + len(cyc))) if cyc else True, "one per cycle"
         assert rec["cycle"] == (cyc[-1] + 1 if cyc else rec["cycle"])
