@@ -381,7 +381,14 @@ module fmt_blob #(
     reg [NG*COL_IDX_W-1:0] gc;
     reg [AREA_W-1:0]    cnt;
     reg [COL_IDX_W-1:0] cmin, cmax;
-    reg [HM_W-1:0]      zc;
+    reg [HM_W-1:0]      pm1 [0:3];            // peak tournament: winners, decisions
+    reg [HM_W-1:0]      pm2 [0:1];
+    reg [3:0]           pd1;
+    reg [1:0]           pd2;
+    reg                 pd3, pi1;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer arithmetic: only the column bits are used
+    integer             pcol;
+    /* verilator lint_on UNUSEDSIGNAL */
     reg [GS*HM_W-1:0]   gz;
     reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
     reg [HM_W+1:0]      gv0, gv1, go;
@@ -409,14 +416,22 @@ module fmt_blob #(
             gx[g*GSX_W +: GSX_W] = {{(GSX_W-HM_W-5){1'b0}}, gv1, 2'b00}
                                  + {{(GSX_W-HM_W-3){1'b0}}, gu[1] + gu[3], 1'b0}
                                  + {{(GSX_W-HM_W-2){1'b0}}, go};
-            // peak of the group: first maximum (strict compare)
-            for (i = g * GS; i < g * GS + GS; i = i + 1) begin
-                zc = gz[(i - g * GS)*HM_W +: HM_W];
-                if (zc > gm[g*HM_W +: HM_W]) begin
-                    gm[g*HM_W +: HM_W] = zc;
-                    gc[g*COL_IDX_W +: COL_IDX_W] = i[COL_IDX_W-1:0];
-                end
+            // peak of the group: first maximum, by a tournament of 7 strict compares
+            // (the right one wins only when larger: the leftmost maximum); the
+            // winner's column comes from the decisions, not carried through muxes
+            for (i = 0; i < 4; i = i + 1) begin
+                pd1[i] = (gz[(2*i+1)*HM_W +: HM_W] > gz[(2*i)*HM_W +: HM_W]);
+                pm1[i] = pd1[i] ? gz[(2*i+1)*HM_W +: HM_W] : gz[(2*i)*HM_W +: HM_W];
             end
+            for (i = 0; i < 2; i = i + 1) begin
+                pd2[i] = (pm1[2*i+1] > pm1[2*i]);
+                pm2[i] = pd2[i] ? pm1[2*i+1] : pm1[2*i];
+            end
+            pd3 = (pm2[1] > pm2[0]);
+            gm[g*HM_W +: HM_W] = pd3 ? pm2[1] : pm2[0];
+            pi1 = pd2[pd3];
+            pcol = g * GS + 4 * pd3 + 2 * pi1 + pd1[{pd3, pi1}];
+            gc[g*COL_IDX_W +: COL_IDX_W] = pcol[COL_IDX_W-1:0];
         end
         cnt = {AREA_W{1'b0}};
         cmin = {COL_IDX_W{1'b0}};
