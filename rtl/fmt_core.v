@@ -33,6 +33,7 @@
 // memory and read a copy refreshed through its read-back port (see below).
 // TOUCH_MODE bit 2 turns fmt_touch's blob detector on (blob_en_i; BLOB_THRESHOLD and
 // BLOB_MIN_CELLS set it): fingers inside blobs are dropped and blobs leave as type-3 events.
+// A build with BLOBS = 0 leaves the detector out (the bit then has no effect).
 //
 // Block-read space (BLKREAD): HEATMAP words 0 .. ROWS*COLS-1 = the snapshot (cell (r,c)
 // at r*COLS + c, raw heat map before flattening); LAT_HIST words 0x8000 .. 0x801F = the
@@ -73,6 +74,8 @@ module fmt_core #(
     parameter CLK_PER_SAMPLE = 3,                 // clk cycles per ADC sample (1..4)
     parameter M_MAX          = 255,               // largest windows per frame M (1 .. 255)
     parameter EV_DEPTH       = 2048,              // event FIFO entries (power of two)
+    parameter BLOBS          = 1,                 // 1: blob detector built (TOUCH_MODE bit 2
+                                                  // turns it on); 0: left out, ~11k LUT6 less
     parameter UART_DIV       = 1085,              // clk cycles per UART bit (125 MHz: 115200 baud)
     parameter UART_TIMEOUT   = 40,                // control-port inter-byte timeout, bit times
     parameter TW_DIR         = "rtl/",            // directory of the FFT twiddle hex files
@@ -326,7 +329,7 @@ module fmt_core #(
     fmt_touch #(
         .ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_TOUCHES(MAX_TOUCHES), .FRAME_W(16),
         .ID_W(8), .TIME_W(32), .EV_DEPTH(EV_DEPTH), .V_W(22), .HOLD_W(12), .CNT_W(16),
-        .ROW_IDX_W(ROW_W), .COL_IDX_W(COL_W), .LIM_W(LIM_W)
+        .ROW_IDX_W(ROW_W), .COL_IDX_W(COL_W), .LIM_W(LIM_W), .BLOBS(BLOBS)
     ) u_touch (
         .clk(clk), .rst(rst),
         .threshold_i(r_threshold[HM_W-1:0]), .moore_i(r_mode[0]), .limit_i(limit),

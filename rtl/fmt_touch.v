@@ -52,6 +52,9 @@ module fmt_touch #(
     parameter V_W         = 22,                 // tracker: velocity width
     parameter HOLD_W      = 12,                 // tracker: hold-off width
     parameter CNT_W       = 16,                 // monitor counter width
+    parameter BLOBS       = 1,                  // 1: build the blob detector (blob_en_i
+                                                // selects it at run time); 0: leave it out
+                                                // (blob_en_i ignored, blob_flag_o = 0)
     parameter ROW_IDX_W   = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
     parameter COL_IDX_W   = (COLS > 1) ? $clog2(COLS) : 1,   // column index width
     parameter LIM_W       = $clog2(MAX_TOUCHES + 1),         // contact limit width
@@ -216,23 +219,34 @@ module fmt_touch #(
     wire [ROW_IDX_W-1:0]   m_q_row;
     wire [COL_IDX_W-1:0]   m_q_col;
 
-    fmt_blob #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_BLOBS(MAX_BLOBS),
-               .FRAME_W(FRAME_W), .ROW_IDX_W(ROW_IDX_W), .COL_IDX_W(COL_IDX_W),
-               .MINC_W(16)) u_blob (
-        .clk(clk), .rst(rst),
-        .blob_threshold_i(blob_threshold_i), .blob_min_cells_i(blob_min_cells_i),
-        .hm_valid_i(f_valid), .hm_row_i(f_row), .hm_frame_i(f_frame), .hm_data_i(f_data),
-        .hm_eof_i(f_eof),
-        .blob_valid_o(b_valid), .blob_frame_o(b_frame), .blob_area_o(b_area),
-        .blob_cx_o(b_cx), .blob_cy_o(b_cy), .blob_rmin_o(b_rmin), .blob_cmin_o(b_cmin),
-        .blob_rmax_o(b_rmax), .blob_cmax_o(b_cmax), .blob_peak_o(b_peak),
-        .blob_peak_row_o(b_prow), .blob_peak_col_o(b_pcol), .blob_eof_o(b_eof),
-        .blob_count_o(b_count), .blob_found_o(b_found), .blob_overflow_o(b_ovf),
-        .blob_incomplete_o(b_inc),
-        .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_q_row_i(m_q_row),
-        .mask_q_col_i(m_q_col), .mask_q_data_o(m_data),
-        .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
+    generate
+        if (BLOBS != 0) begin : g_blob
+        fmt_blob #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_BLOBS(MAX_BLOBS),
+                   .FRAME_W(FRAME_W), .ROW_IDX_W(ROW_IDX_W), .COL_IDX_W(COL_IDX_W),
+                   .MINC_W(16)) u_blob (
+            .clk(clk), .rst(rst),
+            .blob_threshold_i(blob_threshold_i), .blob_min_cells_i(blob_min_cells_i),
+            .hm_valid_i(f_valid), .hm_row_i(f_row), .hm_frame_i(f_frame), .hm_data_i(f_data),
+            .hm_eof_i(f_eof),
+            .blob_valid_o(b_valid), .blob_frame_o(b_frame), .blob_area_o(b_area),
+            .blob_cx_o(b_cx), .blob_cy_o(b_cy), .blob_rmin_o(b_rmin), .blob_cmin_o(b_cmin),
+            .blob_rmax_o(b_rmax), .blob_cmax_o(b_cmax), .blob_peak_o(b_peak),
+            .blob_peak_row_o(b_prow), .blob_peak_col_o(b_pcol), .blob_eof_o(b_eof),
+            .blob_count_o(b_count), .blob_found_o(b_found), .blob_overflow_o(b_ovf),
+            .blob_incomplete_o(b_inc),
+            .mask_ready_o(m_ready), .mask_frame_o(m_frame), .mask_q_row_i(m_q_row),
+            .mask_q_col_i(m_q_col), .mask_q_data_o(m_data),
+            .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
+        end else begin : g_no_blob
+            // the settings and the mask query have no reader without the detector
+            wire unused_blob = &{1'b0, blob_threshold_i, blob_min_cells_i, m_q_row, m_q_col};
+            assign {b_valid, b_eof, m_ready, m_data, b_ovf_flag, b_overrun} = 6'd0;
+            assign {b_frame, b_cx, b_cy, b_peak, m_frame, b_area, b_found, b_rmin, b_rmax,
+                    b_prow, b_cmin, b_cmax, b_pcol, b_count, b_ovf, b_inc} = 0;
+        end
+    endgenerate
     assign blob_flag_o = b_ovf_flag | b_overrun;
+    wire blob_on = (BLOBS != 0) && blob_en_i;          // the blob path is in use
 
     // ---- finger removal: hold the touch beats until the mask is written --------------
     reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index
@@ -243,11 +257,11 @@ module fmt_touch #(
     reg                    s0_valid_q, s0_eof_q, s1_valid_q, s1_eof_q;
 
     always @(posedge clk) begin
-        if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) begin
+        if (c_valid && blob_on && ci_q < MAX_TOUCHES) begin
             cr_mem[ci_q] <= c_row;
             cc_mem[ci_q] <= c_col;
         end
-        if (t_valid && blob_en_i && ti_q < MAX_TOUCHES)
+        if (t_valid && blob_on && ti_q < MAX_TOUCHES)
             tp_mem[ti_q] <= {t_frame, t_x, t_y, t_major, t_minor, t_strength,
                                        t_angle, t_flags};
     end
@@ -274,18 +288,18 @@ module fmt_touch #(
             s1_valid_q <= s0_valid_q;             // the query's answer comes now
             s1_eof_q   <= s0_eof_q;
             s1_idx_q   <= s0_idx_q;
-            if (c_valid && blob_en_i && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
+            if (c_valid && blob_on && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
             if (c_eof) ci_q <= {TI_W{1'b0}};
-            if (t_valid && blob_en_i && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
-            if (t_eof && blob_en_i) begin
+            if (t_valid && blob_on && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
+            if (t_eof && blob_on) begin
                 tn_q      <= ti_q + {{(TI_W-1){1'b0}}, t_valid};
                 ti_q      <= {TI_W{1'b0}};
                 have_tp_q <= 1'b1;
             end else if (t_eof) begin
                 ti_q <= {TI_W{1'b0}};
             end
-            if (m_ready && blob_en_i) have_mask_q <= 1'b1;
-            if (b_eof && blob_en_i) have_blob_q <= 1'b1;
+            if (m_ready && blob_on) have_mask_q <= 1'b1;
+            if (b_eof && blob_on) have_blob_q <= 1'b1;
             if (!rp_q && have_tp_q && have_mask_q && have_blob_q) begin
                 rp_q        <= 1'b1;                  // replay the frame's touches
                 rj_q        <= {TI_W{1'b0}};
@@ -312,14 +326,14 @@ module fmt_touch #(
     wire                 s1_keep = s1_valid_q && !m_data;
 
     // tracker input: the chain (blobs off) or the replayed touches (blobs on)
-    wire                   g_valid = blob_en_i ? s1_keep  : t_valid;
-    wire                   g_eof   = blob_en_i ? s1_eof_q : t_eof;
+    wire                   g_valid = blob_on ? s1_keep  : t_valid;
+    wire                   g_eof   = blob_on ? s1_eof_q : t_eof;
     wire [FRAME_W-1:0]     g_frame;
     wire [15:0]            g_x, g_y, g_major, g_minor;
     wire [HM_W-1:0]        g_strength;
     wire [7:0]             g_angle, g_flags;
     assign {g_frame, g_x, g_y, g_major, g_minor, g_strength, g_angle, g_flags} =
-        blob_en_i ? (s1_eof_q ? {t_frame, {(TPD_W-FRAME_W){1'b0}}} : s1_beat)
+        blob_on ? (s1_eof_q ? {t_frame, {(TPD_W-FRAME_W){1'b0}}} : s1_beat)
                   : {t_frame, t_x, t_y, t_major, t_minor, t_strength, t_angle, t_flags};
 
     // ---- frame matching -------------------------------------------------------------
@@ -354,7 +368,7 @@ module fmt_touch #(
     reg                    wt_q, em_q;
 
     always @(posedge clk) begin
-        if (b_valid && blob_en_i && bc_q < MAX_BLOBS)
+        if (b_valid && blob_on && bc_q < MAX_BLOBS)
             br_mem[bc_q] <= {b_cx, b_cy, b_peak};
     end
 
@@ -367,15 +381,15 @@ module fmt_touch #(
             wt_q <= 1'b0;
             em_q <= 1'b0;
         end else begin
-            if (b_valid && blob_en_i && bc_q < MAX_BLOBS) bc_q <= bc_q + 1'b1;
+            if (b_valid && blob_on && bc_q < MAX_BLOBS) bc_q <= bc_q + 1'b1;
             if (b_eof) begin
                 bc_q <= {BCNT_W{1'b0}};
-                if (blob_en_i) begin
+                if (blob_on) begin
                     bn_q <= bc_q;
                     bf_q <= b_frame;
                 end
             end
-            if (blob_en_i && s1_eof_q) wt_q <= 1'b1;  // tracker busy from the next cycle
+            if (blob_on && s1_eof_q) wt_q <= 1'b1;  // tracker busy from the next cycle
             if (wt_q && !k_busy) begin                // its last event is out now
                 wt_q <= 1'b0;
                 em_q <= (bn_q != {BCNT_W{1'b0}});
@@ -390,19 +404,19 @@ module fmt_touch #(
 
     wire [BRD_W-1:0] br_cur = br_mem[bi_q];
     // event port input: the tracker's events, then (blobs on) the frame's blob events
-    wire               p_valid    = (blob_en_i && em_q) ? 1'b1      : k_valid;
-    wire [FRAME_W-1:0] p_frame    = (blob_en_i && em_q) ? bf_q      : k_frame;
-    wire [ID_W-1:0]    p_id       = (blob_en_i && em_q) ? {ID_W{1'b1}} : k_id;
-    wire [1:0]         p_type     = (blob_en_i && em_q) ? 2'd3      : k_type;
-    wire [15:0]        p_x        = (blob_en_i && em_q) ? br_cur[BRD_W-1 -: 16] : k_x;
-    wire [15:0]        p_y        = (blob_en_i && em_q) ? br_cur[HM_W +: 16]    : k_y;
-    wire [HM_W-1:0]    p_strength = (blob_en_i && em_q) ? br_cur[HM_W-1:0]      : k_strength;
-    wire [15:0]        p_major    = (blob_en_i && em_q) ? 16'd0     : k_major;
-    wire [15:0]        p_minor    = (blob_en_i && em_q) ? 16'd0     : k_minor;
-    wire [7:0]         p_angle    = (blob_en_i && em_q) ? 8'd0      : k_angle;
-    wire [7:0]         p_flags    = (blob_en_i && em_q) ? 8'd0      : k_flags;
-    wire               p_last     = (blob_en_i && em_q) ? (bi_q + 1'b1 == bn_q)
-                                  : (k_last && !(blob_en_i && bn_q != {BCNT_W{1'b0}}));
+    wire               p_valid    = (blob_on && em_q) ? 1'b1      : k_valid;
+    wire [FRAME_W-1:0] p_frame    = (blob_on && em_q) ? bf_q      : k_frame;
+    wire [ID_W-1:0]    p_id       = (blob_on && em_q) ? {ID_W{1'b1}} : k_id;
+    wire [1:0]         p_type     = (blob_on && em_q) ? 2'd3      : k_type;
+    wire [15:0]        p_x        = (blob_on && em_q) ? br_cur[BRD_W-1 -: 16] : k_x;
+    wire [15:0]        p_y        = (blob_on && em_q) ? br_cur[HM_W +: 16]    : k_y;
+    wire [HM_W-1:0]    p_strength = (blob_on && em_q) ? br_cur[HM_W-1:0]      : k_strength;
+    wire [15:0]        p_major    = (blob_on && em_q) ? 16'd0     : k_major;
+    wire [15:0]        p_minor    = (blob_on && em_q) ? 16'd0     : k_minor;
+    wire [7:0]         p_angle    = (blob_on && em_q) ? 8'd0      : k_angle;
+    wire [7:0]         p_flags    = (blob_on && em_q) ? 8'd0      : k_flags;
+    wire               p_last     = (blob_on && em_q) ? (bi_q + 1'b1 == bn_q)
+                                  : (k_last && !(blob_on && bn_q != {BCNT_W{1'b0}}));
 
     // ---- event port -----------------------------------------------------------------
     fmt_event_port #(.HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W), .TIME_W(TIME_W),

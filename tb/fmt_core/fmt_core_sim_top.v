@@ -51,7 +51,8 @@ module fmt_core_sim_top #(
     parameter HM_LOG         = "",               // heat-map log file
     parameter EV_LOG         = "",               // event log file
     parameter FE_LOG         = "",               // frame-end log file
-    parameter EXT_CHANNEL    = 0                 // 1: ADC words from adc_ext_i (C++ channel)
+    parameter EXT_CHANNEL    = 0,                // 1: ADC words from adc_ext_i (C++ channel)
+    parameter BLOBS          = 1                 // fmt_core BLOBS: 0 = no blob detector
 ) (
     input  wire        clk,          // processing clock
     input  wire        rst,          // synchronous reset of core and channel
@@ -94,7 +95,7 @@ module fmt_core_sim_top #(
     fmt_core #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .HM_W(HM_W),
         .MAX_TOUCHES(MAX_TOUCHES), .CLK_PER_SAMPLE(CLK_PER_SAMPLE), .EV_DEPTH(EV_DEPTH),
-        .UART_DIV(UART_DIV), .UART_TIMEOUT(20), .TW_DIR(TW_DIR)
+        .UART_DIV(UART_DIV), .UART_TIMEOUT(20), .TW_DIR(TW_DIR), .BLOBS(BLOBS)
     ) u_core (
         .clk(clk), .rst(rst), .ce_o(ce), .dac_o(dac), .adc_i(adc),
         .ev_valid_o(ev_valid), .ev_ready_i(ev_ready_i), .ev_frame_o(ev_frame), .ev_time_o(ev_time),

@@ -245,17 +245,24 @@ def small_tap_scene(frames: int) -> _scene.Scene:
     return sc.replace(frames=frames, contacts=list(sc.contacts) + [tap])
 
 
-def _run(sim, scene, cps, uart, settings):
+def _run(sim, scene, cps, uart, settings, model_settings=None, extra_params=None, tag=""):
+    """Run the scene on the sim top; the reference uses model_settings (default: the
+    settings the registers are written with)."""
     cfg = scene.cfg
-    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None, tag=f"tb_{sim}")
+    if model_settings is not None:     # the same scene, noise and plan: only the settings differ
+        _d, ref_m, _cal, _n = rsr.prepare(scene, scene.frames, cps, model_settings, cal=None,
+                                          tag=f"tb_{sim}{tag}")
+    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None, tag=f"tb_{sim}{tag}")
+    if model_settings is not None:
+        ref = ref_m
     # slack after the last frame for the UART phase
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
                test_module="test_fmt_core", test_dir=Path(__file__).parent, testcase="run_scene",
-               parameters=rsr.sim_parameters(cfg, cps, d),
+               parameters={**rsr.sim_parameters(cfg, cps, d), **(extra_params or {})},
                extra_env={"FMT_CORE_JOB": str(d / "job.json"), "FMT_CORE_UART": int(uart),
                           "FMT_CORE_CFG": cfg.name, "FMT_QUIET": 1},
                build_args=rsr.build_args(sim, fast_sim=cfg.name == "default"),
-               tag=f"c{cps}")
+               tag=f"c{cps}{tag}")
     res = json.loads((d / "result.json").read_text())
     rep = rsr.analyse(scene, ref, d, cps, res["status"], scene.frames, res["wall_s"], None, False, cal)
     return d, ref, res, rep
@@ -344,6 +351,22 @@ def test_fmt_core_blobs(sim):
         if any(e.type == "blob" for e in evs):
             assert {e.id for e in evs if e.type in ("new", "move")} == {still}, evs
     assert res["status"]["STATUS"] >> 7 & 1 == 0          # no blob overflow/overrun
+
+
+def test_fmt_core_no_blob_build(sim):
+    """fmt_core built with BLOBS = 0: the detector is left out, so TOUCH_MODE bit 2 (written
+    here) has no effect: the palm scene's events are those of the model with blobs off."""
+    frames = 8
+    st_on = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0, blobs=True,
+                          blob_threshold=3500, blob_min_cells=5)
+    scene = small_palm_scene(frames)
+    d, ref, res, rep = _run(sim, scene, 3, False, st_on, model_settings=st_on.replace(blobs=False),
+                            extra_params={"BLOBS": 0}, tag="_nb")
+    assert rep["frames_dropped"] == 0, rep
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+    types = {e.type for evs in ref.events for e in evs}
+    assert "blob" not in types and len({e.id for evs in ref.events for e in evs}) == 2, types
+    assert res["status"]["STATUS"] >> 7 & 1 == 0
 
 
 @pytest.mark.verilator_only
