@@ -18,6 +18,12 @@
 // saturate at their maximum instead of wrapping; `sat_o` is sticky.
 // The histogram is read through a window: `hist_sel_i` (0 = first-event, 1 = last-event)
 // and `hist_addr_i` -> `hist_data_o` (registered, one cycle).
+// Implementation: each histogram is a small distributed RAM (asynchronous read, one
+// write port) with ONE read-modify-write incrementer at the event's bin, read in the
+// same cycle, so back-to-back updates are exact.  A per-bin "holds data" bit (BINS
+// flip-flops, cleared by rst/clear_i in one cycle, set by the bin's first update)
+// masks the RAM word to 0: after a clear every bin reads 0 at once, without a sweep
+// and without a reset on the RAM (which would prevent the RAM inference).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -66,8 +72,10 @@ module fmt_latency #(
     reg  [TIME_W-1:0]  now_q;
     reg  [TIME_W-1:0]  stamp_q [0:SLOTS-1];
     reg  [SLOTS-1:0]   seen_first_q;     // slot's frame has had its first event
-    reg  [NUM_W-1:0]   hist_first_q [0:BINS-1];
-    reg  [NUM_W-1:0]   hist_last_q  [0:BINS-1];
+    reg  [NUM_W-1:0]   hist_first_mem [0:BINS-1];  // distributed RAM, no reset
+    reg  [NUM_W-1:0]   hist_last_mem  [0:BINS-1];
+    reg  [BINS-1:0]    hist_first_ok_q;  // bin written since the last clear (else reads 0)
+    reg  [BINS-1:0]    hist_last_ok_q;
     reg  [2:0]         trig_sync_q;      // 2-FF synchroniser + edge detector
     reg  [TIME_W-1:0]  trig_start_q;
 
@@ -83,6 +91,14 @@ module fmt_latency #(
     wire [CNT_W-1:0]         hist_idx_full = ev_lat >> HIST_SHIFT;
     wire [HIST_BINS_W-1:0]   hist_idx = (hist_idx_full > BINS - 1) ? BINS[HIST_BINS_W-1:0] - 1'b1
                                                                   : hist_idx_full[HIST_BINS_W-1:0];
+
+    // current contents of the event's bin (0 when not written since the clear)
+    wire [NUM_W-1:0]         hf_cur = hist_first_ok_q[hist_idx] ? hist_first_mem[hist_idx]
+                                                                 : {NUM_W{1'b0}};
+    wire [NUM_W-1:0]         hl_cur = hist_last_ok_q[hist_idx] ? hist_last_mem[hist_idx]
+                                                                : {NUM_W{1'b0}};
+    wire                     hf_we  = is_first && hf_cur != NUM_MAX && !rst && !clear_i;
+    wire                     hl_we  = is_last  && hl_cur != NUM_MAX && !rst && !clear_i;
 
     wire                     trig_rise = trig_sync_q[1] && !trig_sync_q[2];
     wire [TIME_W-1:0]        trig_age  = now_q - trig_start_q;
@@ -121,8 +137,8 @@ module fmt_latency #(
             end
             if ((is_first || is_last) && ev_big) sat_o <= 1'b1;
             if (trig_done && trig_big) sat_o <= 1'b1;
-            if ((is_first && (first_count_o == NUM_MAX || hist_first_q[hist_idx] == NUM_MAX)) ||
-                (is_last  && (last_count_o  == NUM_MAX || hist_last_q[hist_idx]  == NUM_MAX)) ||
+            if ((is_first && (first_count_o == NUM_MAX || hf_cur == NUM_MAX)) ||
+                (is_last  && (last_count_o  == NUM_MAX || hl_cur == NUM_MAX)) ||
                 (trig_done && trig_count_o == NUM_MAX))
                 sat_o <= 1'b1;
         end
@@ -143,26 +159,22 @@ module fmt_latency #(
             trig_min_o    <= CNT_MAX;
             trig_max_o    <= {CNT_W{1'b0}};
             trig_count_o  <= {NUM_W{1'b0}};
-            for (i = 0; i < BINS; i = i + 1) begin
-                hist_first_q[i] <= {NUM_W{1'b0}};
-                hist_last_q[i]  <= {NUM_W{1'b0}};
-            end
+            hist_first_ok_q <= {BINS{1'b0}};
+            hist_last_ok_q  <= {BINS{1'b0}};
         end else begin
             if (is_first) begin
                 first_last_o <= ev_lat;
                 if (ev_lat < first_min_o) first_min_o <= ev_lat;
                 if (ev_lat > first_max_o) first_max_o <= ev_lat;
                 if (first_count_o != NUM_MAX) first_count_o <= first_count_o + 1'b1;
-                if (hist_first_q[hist_idx] != NUM_MAX)
-                    hist_first_q[hist_idx] <= hist_first_q[hist_idx] + 1'b1;
+                hist_first_ok_q[hist_idx] <= 1'b1;
             end
             if (is_last) begin
                 last_last_o <= ev_lat;
                 if (ev_lat < last_min_o) last_min_o <= ev_lat;
                 if (ev_lat > last_max_o) last_max_o <= ev_lat;
                 if (last_count_o != NUM_MAX) last_count_o <= last_count_o + 1'b1;
-                if (hist_last_q[hist_idx] != NUM_MAX)
-                    hist_last_q[hist_idx] <= hist_last_q[hist_idx] + 1'b1;
+                hist_last_ok_q[hist_idx] <= 1'b1;
             end
             if (trig_done) begin
                 trig_last_o <= trig_lat;
@@ -173,8 +185,17 @@ module fmt_latency #(
         end
     end
 
+    // histogram RAMs: one read-modify-write port (the event's bin) + the readout port
     always @(posedge clk) begin
-        hist_data_o <= hist_sel_i ? hist_last_q[hist_addr_i] : hist_first_q[hist_addr_i];
+        if (hf_we) hist_first_mem[hist_idx] <= hf_cur + 1'b1;
+        if (hl_we) hist_last_mem[hist_idx]  <= hl_cur + 1'b1;
+    end
+
+    always @(posedge clk) begin
+        if (hist_sel_i)
+            hist_data_o <= hist_last_ok_q[hist_addr_i] ? hist_last_mem[hist_addr_i] : {NUM_W{1'b0}};
+        else
+            hist_data_o <= hist_first_ok_q[hist_addr_i] ? hist_first_mem[hist_addr_i] : {NUM_W{1'b0}};
     end
 
 endmodule

@@ -28,7 +28,8 @@ INS = ["clear", "frame_end", "frame_end_slot", "ev_fire", "ev_slot", "ev_last", 
 class TB(ClockedTB):
     def __init__(self, dut):
         super().__init__(dut)
-        self.model = LatencyCounters(cnt_w=env_int("CNT_W", 16), hist_shift=env_int("HIST_SHIFT", 5))
+        self.model = LatencyCounters(cnt_w=env_int("CNT_W", 16), num_w=env_int("NUM_W", 32),
+                                     hist_shift=env_int("HIST_SHIFT", 5))
         for n in INS:
             getattr(dut, f"{n}_i").value = 0
         dut.hist_sel_i.value = 0
@@ -89,11 +90,7 @@ async def random_traffic_matches_model(dut):
     stim = traffic(rng, 60, 48, 30, 90)
     stim[len(stim) // 2]["clear"] = 1
     await tb.run(stim)
-    for sel, name in ((0, "first"), (1, "last")):
-        for a in range(16):
-            exp = tb.model.hist[name][a]
-            got = await tb.hist(sel, a)
-            assert got == exp, f"hist {name}[{a}] = {got}, model {exp}"
+    await check_hists(tb, "random traffic")
     assert tb.model.out["first_count"] > 5 and tb.model.out["trig_count"] > 0, "traffic too thin"
     # reset in the middle of traffic: model and RTL restart together
     await tb.reset()
@@ -125,6 +122,48 @@ async def directed_numbers(dut):
     assert int(d.sat_o.value) == 0
 
 
+async def check_hists(tb, what: str):
+    for sel, name in ((0, "first"), (1, "last")):
+        for a in range(16):
+            exp = tb.model.hist[name][a]
+            got = await tb.hist(sel, a)
+            assert got == exp, f"{what}: hist {name}[{a}] = {got}, model {exp}"
+
+
+@cocotb.test()
+async def histogram_back_to_back_and_clear(dut):
+    """The histograms are RAMs with one read-modify-write port: first/last events of
+    four frames on four consecutive cycles into the same bin (and the next cycle into
+    another bin) must all count; a clear makes every bin read 0 at once (read right
+    after the clear cycle), and bins count from 0 again afterwards."""
+    tb = TB(dut)
+    await tb.reset()
+    tb.model.reset()
+    stim = [dict() for _ in range(400)]
+    for f in range(4):
+        stim[f].update(frame_end=1, frame_end_slot=f)
+    for f in range(4):                                   # latency 100 each: one bin
+        stim[100 + f].update(ev_fire=1, ev_slot=f, ev_last=1)
+    for f in range(4):
+        stim[200 + f].update(frame_end=1, frame_end_slot=f)
+    stim[200 + 100].update(ev_fire=1, ev_slot=0, ev_last=0)     # first of slot 0: 100
+    stim[200 + 101].update(ev_fire=1, ev_slot=1, ev_last=1)     # first+last of slot 1
+    stim[200 + 102].update(ev_fire=1, ev_slot=0, ev_last=1)     # last of slot 0: 102
+    stim[200 + 140].update(ev_fire=1, ev_slot=2, ev_last=1)     # 3rd bin, other latency
+    await tb.run(stim)
+    assert tb.model.hist["first"][3] == 6 and tb.model.hist["last"][3] == 6   # stimulus sanity
+    await check_hists(tb, "before clear")
+    await tb.run([dict(clear=1)])
+    assert sum(tb.model.hist["first"]) == 0
+    await check_hists(tb, "after clear")
+    stim = [dict() for _ in range(150)]
+    stim[0].update(frame_end=1, frame_end_slot=3)
+    stim[120].update(ev_fire=1, ev_slot=3, ev_last=1)
+    await tb.run(stim)
+    assert tb.model.hist["last"][120 >> 5] == 1
+    await check_hists(tb, "after clear and one event")
+
+
 @cocotb.test()
 async def saturation_is_flagged(dut):
     """A latency beyond 2^CNT_W - 1 reads as the maximum and sets the sticky flag
@@ -147,8 +186,10 @@ async def saturation_is_flagged(dut):
     assert int(dut.sat_o.value) == 1
 
 
-@pytest.mark.parametrize("cnt_w", [8, 16])
-def test_fmt_latency(sim, cnt_w):
+# num_w = 3: event counters and histogram bins saturate at 7 (sticky flag, no wrap)
+@pytest.mark.parametrize("cnt_w, num_w", [(8, 32), (16, 32), (8, 3)])
+def test_fmt_latency(sim, cnt_w, num_w):
     run_cocotb(sim=sim, toplevel="fmt_latency", sources=rtl_sources("fmt_latency"),
                test_module="test_fmt_latency", test_dir=Path(__file__).parent,
-               parameters={"CNT_W": cnt_w}, extra_env={"CNT_W": cnt_w})
+               parameters={"CNT_W": cnt_w, "NUM_W": num_w},
+               extra_env={"CNT_W": cnt_w, "NUM_W": num_w})
