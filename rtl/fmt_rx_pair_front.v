@@ -57,8 +57,6 @@ module fmt_rx_pair_front #(
 
     localparam W  = FFT_OUT_W;
     localparam MW = W + 1;
-    localparam [MC_W-1:0]     MMAX = M_MAX[MC_W-1:0];
-    localparam [MC_W-1:0]     MONE = 1;
 
     // ---- despread ----
     wire signed [ADC_BITS:0] xa, xb;
@@ -92,38 +90,12 @@ module fmt_rx_pair_front #(
     wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
 
     // ---- window / frame bookkeeping (at the FFT output) ----
-    reg                  started_q;
-    reg [MC_W-1:0]       wcnt_q;                    // window index inside the frame, 0 .. M-1
-    reg [MC_W-1:0]       m_q;                       // M of the current frame
-    wire [MC_W-1:0]      m_lim;                     // m_i clamped to M_MAX
-    wire [MC_W-1:0]      m_in    = (m_lim == {MC_W{1'b0}}) ? MONE : m_lim;
-    generate
-        if (M_MAX < (1 << MC_W) - 1) begin : g_clamp
-            assign m_lim = (m_i > MMAX) ? MMAX : m_i;
-        end else begin : g_noclamp
-            assign m_lim = m_i;                     // every MC_W-bit value is <= M_MAX
-        end
-    endgenerate
-    wire [MC_W-1:0]      last_q  = m_q - 1'b1;
     wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}});
-    wire                 wrap    = !started_q || (wcnt_q == last_q);
-    wire [MC_W-1:0]      w_cur   = new_win ? (wrap ? {MC_W{1'b0}} : wcnt_q + 1'b1) : wcnt_q;
-    wire [MC_W-1:0]      m_cur   = (new_win && wrap) ? m_in : m_q;
-    wire [MC_W-1:0]      last_cur = m_cur - 1'b1;
-    wire                 w_first = (w_cur == {MC_W{1'b0}});
-    wire                 w_last  = (w_cur == last_cur);
-
-    always @(posedge clk) begin
-        if (rst) begin
-            started_q <= 1'b0;
-            wcnt_q    <= {MC_W{1'b0}};
-            m_q       <= MONE;
-        end else if (ce && new_win) begin
-            started_q <= 1'b1;
-            wcnt_q    <= w_cur;
-            m_q       <= m_cur;
-        end
-    end
+    wire [MC_W-1:0]      m_cur;                     // M of the current frame
+    wire                 w_first, w_last;           // first / last window of the frame
+    fmt_rx_frame_win #(.M_MAX(M_MAX), .MC_W(MC_W)) u_win (
+        .clk(clk), .rst(rst), .en_i(ce), .win_i(new_win), .m_i(m_i),
+        .m_cur_o(m_cur), .w_first_o(w_first), .w_last_o(w_last));
 
     // ---- pair split ----
     // one channel per engine here (fmt_rx_group_front shares one between column pairs)

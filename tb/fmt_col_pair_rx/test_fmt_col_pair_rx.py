@@ -25,7 +25,7 @@ from fmt import params                                    # noqa: E402
 from fmt import rx_fixed as R                             # noqa: E402
 import rx_stim                                            # noqa: E402
 
-RTL_FILES = ["fmt_col_pair_rx", "fmt_rx_pair_front", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf", "fmt_fft_delay",
+RTL_FILES = ["fmt_col_pair_rx", "fmt_rx_pair_front", "fmt_rx_frame_win", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf", "fmt_fft_delay",
              "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
 
 

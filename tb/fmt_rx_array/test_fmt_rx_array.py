@@ -39,7 +39,7 @@ FLOAT_BOUND_LSB = 2.0
 # the precompiled-header rule of split (parallel) C++ builds: build unsplit.  -O0: the
 # C++ compile dominates these short runs.
 VERILATOR_ARGS = ["--output-split", "0", "-CFLAGS", "-O0"]
-RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_rx_group_front", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
+RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_rx_group_front", "fmt_rx_frame_win", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
              "fmt_fft_delay", "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
 
 
