@@ -18,9 +18,13 @@
 // clear the RAM (block RAM has no reset); after configuration load offset 0 / gain
 // 16384 (identity) or a calibration: with INIT_IDENTITY = 1 (default) the memories are
 // initialised to the identity for simulation and FPGA configuration.
-// Read-back: cal_re_i latches (row, col, sel); the read uses the memories' read port in
-// the first cycle without a heat-map beat, cal_rvalid_o/cal_rdata_o follow 2 cycles
-// later (a new request before the answer replaces the pending one).
+// Read-back: cal_re_i latches (row, col, sel); the read is served in the first cycle
+// without a heat-map beat, cal_rvalid_o/cal_rdata_o follow 2 cycles later (a new
+// request before the answer replaces the pending one).  It reads a shadow copy of the
+// calibration (one memory of 2^(1+ROW_IDX_W+COL_IDX_W) CAL_W-bit words, address
+// {sel, row, col}, written with the column memories, read-first; block RAM at the
+// default size) instead of a COLS:1 multiplexer over the column memories' read
+// registers: 2 RAMB36 at 30 x 40 instead of ~510 LUT6.
 // Saturation: sat_flag_o is sticky (cleared by rst or sat_clr_i), sat_count_o counts
 // saturated cells (saturating counter), one cycle behind the output beat.
 `default_nettype none
@@ -90,9 +94,7 @@ module fmt_flatten #(
     reg [ROW_IDX_W-1:0]  rd_row_q;
     reg [COL_IDX_W-1:0]  rd_col_q;
     wire                 rd_serve = rd_pend_q && !hm_valid_i;
-    wire [ROW_IDX_W-1:0] rd_addr  = hm_valid_i ? hm_row_i : rd_row_q;
-    wire [COLS*HM_W-1:0]   off_all;
-    wire [COLS*GAIN_W-1:0] gain_all;
+    wire [ROW_IDX_W-1:0] rd_addr  = hm_row_i;   // column memories: heat-map beats only
 
     genvar c;
     generate
@@ -115,8 +117,6 @@ module fmt_flatten #(
                 off_rd_q  <= off_mem[rd_addr];
                 gain_rd_q <= gain_mem[rd_addr];
             end
-            assign off_all[c*HM_W +: HM_W]      = off_rd_q;
-            assign gain_all[c*GAIN_W +: GAIN_W] = gain_rd_q;
 
             // s2: subtract, clamp at zero
             wire [HM_W:0] diff = {1'b0, z1_q[c*HM_W +: HM_W]} - {1'b0, off_rd_q};
@@ -146,12 +146,26 @@ module fmt_flatten #(
     end
     wire [CNT_W:0] cnt_sum = {1'b0, sat_count_o} + {{(CNT_W+1-POP_W){1'b0}}, pop};
 
-    // read-back: column select of the read registers
-    reg [CAL_W-1:0] rd_word;
+    // read-back: shadow copy of the calibration, address {sel, row, col}, holding the
+    // word as it is read back (offset: low HM_W bits, gain: low 16 bits, zero-extended)
+    localparam SH_AW = 1 + ROW_IDX_W + COL_IDX_W;
+    reg  [CAL_W-1:0] shadow_mem [0:(1 << SH_AW)-1];
+    reg  [CAL_W-1:0] rd_word_q;                 // shadow read register (serve cycle + 1)
+    reg  [CAL_W-1:0] sh_wdata;
+    integer j;
+    initial begin
+        for (j = 0; j < (1 << SH_AW); j = j + 1)
+            shadow_mem[j] = ((INIT_IDENTITY != 0) && (j >= (1 << (SH_AW - 1))))
+                            ? (16'd1 << GAIN_FRAC) : {CAL_W{1'b0}};
+    end
     always @(*) begin
-        rd_word = {CAL_W{1'b0}};
-        if (rd_sel_q) rd_word[GAIN_W-1:0] = gain_all[rd_col_q*GAIN_W +: GAIN_W];
-        else          rd_word[HM_W-1:0]   = off_all[rd_col_q*HM_W +: HM_W];
+        sh_wdata = {CAL_W{1'b0}};
+        if (cal_sel_i) sh_wdata[GAIN_W-1:0] = cal_data_i[GAIN_W-1:0];
+        else           sh_wdata[HM_W-1:0]   = cal_data_i[HM_W-1:0];
+    end
+    always @(posedge clk) begin
+        if (cal_we_i) shadow_mem[{cal_sel_i, cal_row_i, cal_col_i}] <= sh_wdata;
+        rd_word_q <= shadow_mem[{rd_sel_q, rd_row_q, rd_col_q}];
     end
     always @(posedge clk) begin
         if (rst) begin
@@ -173,7 +187,7 @@ module fmt_flatten #(
             rd_go_q      <= rd_serve && !cal_re_i;
             cal_rvalid_o <= rd_go_q;
         end
-        cal_rdata_o <= rd_word;
+        cal_rdata_o <= rd_word_q;
     end
 
     always @(posedge clk) begin

@@ -123,7 +123,8 @@ class TB(ClockedTB):
 
 @cocotb.test()
 async def power_on_identity(dut):
-    """Without any calibration write the block passes the heat map unchanged."""
+    """Without any calibration write the block passes the heat map unchanged and reads
+    back offset 0 / gain 1.0."""
     tb = TB(dut)
     await tb.reset()
     rng = random.Random(env_int("SEED", 1))
@@ -134,6 +135,9 @@ async def power_on_identity(dut):
     assert int(dut.sat_flag_o.value) == 0 and int(dut.sat_count_o.value) == 0
     assert [tb.unpack(o[3]) for o in out if o[0]] == [list(hms[0][item[1]]) for item in sched
                                                       if item and item[0] == "row"]
+    # power-on contents (INIT_IDENTITY) read back: offset 0, gain 1.0 (this test runs first)
+    await readback_trials(tb, rng, np.zeros((tb.rows, tb.cols), dtype=int),
+                          np.full((tb.rows, tb.cols), 1 << 14), 8)
 
 
 @cocotb.test()
@@ -206,7 +210,12 @@ async def calibration_readback(dut):
     off = nrng.integers(0, 1 << tb.w, size=(tb.rows, tb.cols))
     gain = nrng.integers(0, GAIN_MAX + 1, size=(tb.rows, tb.cols))
     await tb.load(off, gain)
-    for trial in range(24):
+    await readback_trials(tb, rng, off, gain, 24)
+
+
+async def readback_trials(tb, rng, off, gain, n):
+    dut = tb.dut
+    for trial in range(n):
         r, c, sel = rng.randrange(tb.rows), rng.randrange(tb.cols), rng.randrange(2)
         busy = rng.randrange(0, 4) if trial % 2 else 0      # beats occupying the read port
         await tb.writable()
