@@ -12,7 +12,9 @@
 // Bit-exact twin: sim/fmt/flatten.py flatten_fixed().
 //
 // Calibration memory: per cell offset and gain in inferred RAM, one memory per column
-// and kind (ROWS words of HM_W / 16 bits each); written one cell at a time through
+// (ROWS words of {gain 16, offset HM_W} bits, the halves written separately; block RAM
+// with CAL_BRAM = 1: one RAMB18 (512 x 36 simple dual port) per column at the default
+// size, ~960 LUT6 of RAM32M with CAL_BRAM = 0); written one cell at a time through
 // cal_we_i / cal_sel_i / cal_row_i / cal_col_i / cal_data_i.  A write is seen by beats
 // that arrive at least one cycle after it (read-first RAM).  Power-on / reset does NOT
 // clear the RAM (block RAM has no reset); after configuration load offset 0 / gain
@@ -37,6 +39,7 @@ module fmt_flatten #(
     parameter FRAME_W       = 16,                // frame number width
     parameter CNT_W         = 16,                // saturation counter width
     parameter INIT_IDENTITY = 1,                 // 1: memories start at offset 0, gain 1.0
+    parameter CAL_BRAM      = 1,                 // column calibration memories: 1 block RAM, 0 LUT RAM
     parameter ROW_IDX_W     = (ROWS > 1) ? $clog2(ROWS) : 1,  // row index width
     parameter COL_IDX_W     = (COLS > 1) ? $clog2(COLS) : 1,  // column index width
     parameter CAL_W         = (HM_W > 16) ? HM_W : 16         // calibration data width
@@ -99,23 +102,43 @@ module fmt_flatten #(
     genvar c;
     generate
         for (c = 0; c < COLS; c = c + 1) begin : g_col
-            reg [HM_W-1:0]   off_mem  [0:ROWS-1];
-            reg [GAIN_W-1:0] gain_mem [0:ROWS-1];
-            reg [HM_W-1:0]   off_rd_q;
-            reg [GAIN_W-1:0] gain_rd_q;
-            integer i;
-            initial begin
-                for (i = 0; i < ROWS; i = i + 1) begin
-                    off_mem[i]  = {HM_W{1'b0}};
-                    gain_mem[i] = (INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0;
+            // {gain, offset} of this column's cells; read-first (a write is seen by the
+            // beats of the following cycles); no reset (block RAM has none)
+            wire [HM_W+GAIN_W-1:0] cal_rd;           // read register (s1)
+            wire [HM_W-1:0]   off_rd_q  = cal_rd[HM_W-1:0];
+            wire [GAIN_W-1:0] gain_rd_q = cal_rd[HM_W +: GAIN_W];
+            wire we_off  = cal_we_i && (cal_col_i == c) && !cal_sel_i;
+            wire we_gain = cal_we_i && (cal_col_i == c) &&  cal_sel_i;
+            if (CAL_BRAM != 0) begin : g_bram
+                (* ram_style = "block" *)
+                reg [HM_W+GAIN_W-1:0] mem [0:ROWS-1];
+                reg [HM_W+GAIN_W-1:0] rd_q;
+                integer i;
+                initial begin
+                    for (i = 0; i < ROWS; i = i + 1)
+                        mem[i] = {((INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0), {HM_W{1'b0}}};
                 end
-            end
-            wire we_col = cal_we_i && (cal_col_i == c);
-            always @(posedge clk) begin
-                if (we_col && !cal_sel_i) off_mem[cal_row_i] <= cal_data_i[HM_W-1:0];
-                if (we_col &&  cal_sel_i) gain_mem[cal_row_i] <= cal_data_i[GAIN_W-1:0];
-                off_rd_q  <= off_mem[rd_addr];
-                gain_rd_q <= gain_mem[rd_addr];
+                always @(posedge clk) begin
+                    if (we_off)  mem[cal_row_i][HM_W-1:0]      <= cal_data_i[HM_W-1:0];
+                    if (we_gain) mem[cal_row_i][HM_W +: GAIN_W] <= cal_data_i[GAIN_W-1:0];
+                    rd_q <= mem[rd_addr];
+                end
+                assign cal_rd = rd_q;
+            end else begin : g_lutram
+                (* ram_style = "distributed" *)
+                reg [HM_W+GAIN_W-1:0] mem [0:ROWS-1];
+                reg [HM_W+GAIN_W-1:0] rd_q;
+                integer i;
+                initial begin
+                    for (i = 0; i < ROWS; i = i + 1)
+                        mem[i] = {((INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0), {HM_W{1'b0}}};
+                end
+                always @(posedge clk) begin
+                    if (we_off)  mem[cal_row_i][HM_W-1:0]      <= cal_data_i[HM_W-1:0];
+                    if (we_gain) mem[cal_row_i][HM_W +: GAIN_W] <= cal_data_i[GAIN_W-1:0];
+                    rd_q <= mem[rd_addr];
+                end
+                assign cal_rd = rd_q;
             end
 
             // s2: subtract, clamp at zero

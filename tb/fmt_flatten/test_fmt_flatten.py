@@ -247,11 +247,14 @@ async def readback_trials(tb, rng, off, gain, n):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-@pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
-def test_fmt_flatten(sim, cfg):
+# CAL_BRAM = 0: the LUT-RAM variant of the column memories (same behaviour)
+@pytest.mark.parametrize("cfg, cal_bram", [(params.SMALL, 1), (params.MEDIUM, 1), (params.SMALL, 0)],
+                         ids=["SMALL", "MEDIUM", "SMALL-lutram"])
+def test_fmt_flatten(sim, cfg, cal_bram):
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
-               parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width},
+               parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
+                           "CAL_BRAM": cal_bram},
                extra_env={"FMT_CFG": cfg.name, "SEED": 1})
 
 
