@@ -23,7 +23,9 @@
 // same cycle, so back-to-back updates are exact.  A per-bin "holds data" bit (BINS
 // flip-flops, cleared by rst/clear_i in one cycle, set by the bin's first update)
 // masks the RAM word to 0: after a clear every bin reads 0 at once, without a sweep
-// and without a reset on the RAM (which would prevent the RAM inference).
+// and without a reset on the RAM (which would prevent the RAM inference).  The
+// frame-end time-stamp table is a distributed RAM too, with a per-slot bit (cleared
+// by rst only) that makes a slot's stamp read 0 until its first frame end.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -70,7 +72,8 @@ module fmt_latency #(
     localparam [NUM_W-1:0] NUM_MAX = {NUM_W{1'b1}};
 
     reg  [TIME_W-1:0]  now_q;
-    reg  [TIME_W-1:0]  stamp_q [0:SLOTS-1];
+    reg  [TIME_W-1:0]  stamp_mem [0:SLOTS-1];  // frame-end time stamps, distributed RAM
+    reg  [SLOTS-1:0]   stamp_ok_q;       // slot written since reset (else its stamp reads 0)
     reg  [SLOTS-1:0]   seen_first_q;     // slot's frame has had its first event
     reg  [NUM_W-1:0]   hist_first_mem [0:BINS-1];  // distributed RAM, no reset
     reg  [NUM_W-1:0]   hist_last_mem  [0:BINS-1];
@@ -83,7 +86,8 @@ module fmt_latency #(
 
     // latency of the current event, saturated to CNT_W bits
     wire [FRAME_SLOTS_W-1:0] ev_slot  = ev_slot_i;
-    wire [TIME_W-1:0]        ev_age   = now_q - stamp_q[ev_slot];
+    wire [TIME_W-1:0]        ev_stamp = stamp_ok_q[ev_slot] ? stamp_mem[ev_slot] : {TIME_W{1'b0}};
+    wire [TIME_W-1:0]        ev_age   = now_q - ev_stamp;
     wire                     ev_big   = (ev_age > {{(TIME_W-CNT_W){1'b0}}, CNT_MAX});
     wire [CNT_W-1:0]         ev_lat   = ev_big ? CNT_MAX : ev_age[CNT_W-1:0];
     wire                     is_first = ev_fire_i && !seen_first_q[ev_slot];
@@ -114,13 +118,11 @@ module fmt_latency #(
             trig_start_q  <= {TIME_W{1'b0}};
             trig_armed_o  <= 1'b0;
             sat_o         <= 1'b0;
-            for (i = 0; i < SLOTS; i = i + 1) stamp_q[i] <= {TIME_W{1'b0}};
+            stamp_ok_q    <= {SLOTS{1'b0}};
         end else begin
             now_q       <= now_q + 1'b1;
             trig_sync_q <= {trig_sync_q[1:0], trig_i};
-            if (frame_end_i) begin
-                stamp_q[frame_end_slot_i] <= now_q;
-            end
+            if (frame_end_i) stamp_ok_q[frame_end_slot_i] <= 1'b1;
             // a slot is re-armed by its frame end; the event bookkeeping of the same
             // cycle belongs to an older frame in another slot
             for (i = 0; i < SLOTS; i = i + 1) begin
@@ -185,8 +187,10 @@ module fmt_latency #(
         end
     end
 
-    // histogram RAMs: one read-modify-write port (the event's bin) + the readout port
+    // histogram RAMs: one read-modify-write port (the event's bin) + the readout port;
+    // time-stamp RAM: written at frame ends, read at the event's slot
     always @(posedge clk) begin
+        if (frame_end_i && !rst) stamp_mem[frame_end_slot_i] <= now_q;
         if (hf_we) hist_first_mem[hist_idx] <= hf_cur + 1'b1;
         if (hl_we) hist_last_mem[hist_idx]  <= hl_cur + 1'b1;
     end

@@ -135,10 +135,18 @@ async def histogram_back_to_back_and_clear(dut):
     """The histograms are RAMs with one read-modify-write port: first/last events of
     four frames on four consecutive cycles into the same bin (and the next cycle into
     another bin) must all count; a clear makes every bin read 0 at once (read right
-    after the clear cycle), and bins count from 0 again afterwards."""
+    after the clear cycle), and bins count from 0 again afterwards.  The frame-end
+    time stamps (also a RAM) read 0 after a reset until their slot's frame end."""
     tb = TB(dut)
     await tb.reset()
     tb.model.reset()
+    # an event before any frame end since the reset: its slot's stamp reads 0 (the RAM
+    # still holds stamps of the previous test).  Absolute time matters here: tb.reset()
+    # returns at a falling edge and run() waits for the next one, so the RTL sees one
+    # rising edge with rst low and idle inputs before the first stimulus cycle.
+    tb.model.step()
+    await tb.run([dict(ev_fire=1, ev_slot=2, ev_last=1) if t == 20 else dict() for t in range(24)])
+    assert tb.model.hist["last"][0] == 1 and tb.model.out["last_count"] == 1
     stim = [dict() for _ in range(400)]
     for f in range(4):
         stim[f].update(frame_end=1, frame_end_slot=f)
