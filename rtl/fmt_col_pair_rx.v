@@ -144,31 +144,7 @@ module fmt_col_pair_rx #(
         .out_valid(out_valid), .out_row(out_row), .out_data(out_hm), .sat_o(sat_o));
 
     // the frame's last row is the row whose pair completes last (a constant)
-    function integer bitrev_f;
-        input integer v;
-        integer j;
-        begin
-            bitrev_f = 0;
-            for (j = 0; j < LOG2_N; j = j + 1)
-                if (((v >> j) & 1) != 0) bitrev_f = bitrev_f | (1 << (LOG2_N - 1 - j));
-        end
-    endfunction
-    function integer last_row_f;
-        input integer dummy;
-        integer r, k, s, best;
-        begin
-            best = -1;
-            last_row_f = 0;
-            for (r = 0; r < ROWS; r = r + 1) begin
-                k = BIN_LO + r * BIN_STEP;
-                s = (bitrev_f(k) > bitrev_f((1 << LOG2_N) - k)) ? bitrev_f(k) : bitrev_f((1 << LOG2_N) - k);
-                if (s > best) begin
-                    best = s;
-                    last_row_f = r + 0 * dummy;
-                end
-            end
-        end
-    endfunction
+    `include "fmt_rx_last_row.vh"
     localparam LAST_ROW = last_row_f(0);
     assign out_last_row = (out_row == LAST_ROW[ROW_W-1:0]);
 

@@ -115,31 +115,7 @@ module fmt_rx_array #(
     localparam STEPC = (POST_CLK != 0) ? CLK_PER_SAMPLE : 1; // steps per FFT slot
 
     // ---- the frame's last row (the row whose pair completes last in bit-reversed order)
-    function integer bitrev_f;
-        input integer v;
-        integer j;
-        begin
-            bitrev_f = 0;
-            for (j = 0; j < LOG2_N; j = j + 1)
-                if (((v >> j) & 1) != 0) bitrev_f = bitrev_f | (1 << (LOG2_N - 1 - j));
-        end
-    endfunction
-    function integer last_row_f;
-        input integer dummy;
-        integer r, k, s, best;
-        begin
-            best = -1;
-            last_row_f = 0;
-            for (r = 0; r < ROWS; r = r + 1) begin
-                k = BIN_LO + r * BIN_STEP;
-                s = (bitrev_f(k) > bitrev_f(N - k)) ? bitrev_f(k) : bitrev_f(N - k);
-                if (s > best) begin
-                    best = s;
-                    last_row_f = r + 0 * dummy;
-                end
-            end
-        end
-    endfunction
+    `include "fmt_rx_last_row.vh"
 
     // MAG_UNITS = 0: K = ceil(COLS / (4 * STEPC)), a row in at most 4 steps per FFT slot:
     // the comb's rows complete at most two in any 8 consecutive slots (bit-reversed order;

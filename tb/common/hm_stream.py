@@ -8,6 +8,37 @@ and a monitor cycle counter ``cycle``.
 from __future__ import annotations
 
 
+def pack_row(values, w: int) -> int:
+    """A heat-map row as the hm_data bus value: column c at bits [c*w +: w]."""
+    v = 0
+    for c, x in enumerate(values):
+        v |= int(x) << (c * w)
+    return v
+
+
+def frame_schedule(rng, hms, n_rows: int, min_cycles, first_frame: int = 0,
+                   gap_p: float = 0.0, order=None) -> list:
+    """Schedule of whole frames: the rows of each frame (shuffled by ``rng`` unless
+    ``order`` is given), random idle gaps (probability ``gap_p`` per cycle), hm_eof right
+    after the last row.  Frame i spans at least ``min_cycles[i]`` cycles: a short frame is
+    stretched by idle cycles before its last row (the block must finish a frame before a
+    later one arrives)."""
+    sched = []
+    for i, hm in enumerate(hms):
+        rows = list(range(n_rows)) if order is None else list(order)
+        if order is None:
+            rng.shuffle(rows)
+        fr = []
+        for r in rows:
+            while rng.random() < gap_p:
+                fr.append(None)
+            fr.append(("row", r, hm[r]))
+        pad = max(0, min_cycles[i] - len(fr) - 1)
+        fr = fr[:-1] + [None] * pad + fr[-1:]
+        sched += fr + [("eof", (first_frame + i) & 0xFFFF)]
+    return sched
+
+
 async def drive_hm_schedule(tb, sched):
     """Drive the schedule; returns (cycle of the last row beat, cycle of hm_eof) per
     frame, in the TB's monitor cycle numbers."""

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.hm_stream import drive_hm_schedule
+from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
@@ -148,10 +148,7 @@ class TB(ClockedTB):
         return cells + rng.sample(rest, QMAX - len(cells))
 
     def pack(self, row) -> int:
-        v = 0
-        for c, x in enumerate(row):
-            v |= int(x) << (c * self.w)
-        return v
+        return pack_row(row, self.w)
 
     def work(self, hm) -> int:
         """Cycles the RTL needs for a frame, generously: one per row, two per run (a run
@@ -165,21 +162,8 @@ class TB(ClockedTB):
         the last row.  A frame must be finished before the next frame's hm_eof
         (overrun_o), so short test frames are stretched to the processing time of the
         previous frame by idle cycles before their last row."""
-        sched, prev = [], 0
-        for i, hm in enumerate(hms):
-            rows = list(range(self.rows)) if order is None else list(order)
-            if order is None:
-                rng.shuffle(rows)
-            fr = []
-            for r in rows:
-                while rng.random() < gap_p:
-                    fr.append(None)
-                fr.append(("row", r, hm[r]))
-            pad = max(0, prev - len(fr) - 1)
-            fr = fr[:-1] + [None] * pad + fr[-1:]
-            sched += fr + [("eof", (first_frame + i) & 0xFFFF)]
-            prev = self.work(hm)
-        return sched
+        prev = [0] + [self.work(hm) for hm in hms[:-1]]
+        return frame_schedule(rng, hms, self.rows, prev, first_frame, gap_p, order)
 
     async def drive(self, sched):
         """Drive the schedule (tb/common/hm_stream.py); returns (last row beat, hm_eof)

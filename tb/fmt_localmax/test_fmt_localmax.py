@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.hm_stream import drive_hm_schedule
+from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
@@ -76,10 +76,7 @@ class TB(ClockedTB):
                 self.cur = []
 
     def pack(self, row) -> int:
-        v = 0
-        for c, x in enumerate(row):
-            v |= int(x) << (c * self.w)
-        return v
+        return pack_row(row, self.w)
 
     def schedule(self, rng, hms, first_frame=0, gap_p=0.0, order=None):
         """Rows of each frame (random order unless given), random gaps, eof right after
@@ -88,22 +85,10 @@ class TB(ClockedTB):
         period is N x CLK_PER_SAMPLE = 192..768 cycles, so short test frames are stretched
         to ``min_period`` cycles by idle cycles before their last row (processing takes
         about ROWS + maxima + 2 x count cycles per frame)."""
-        sched = []
-        for i, hm in enumerate(hms):
-            # every maximum takes one cycle in the serialiser
-            min_period = 2 * self.k + 32 + self.rows + int(maxima_mask(hm, self.thr, self.nb).sum())
-            rows = list(range(self.rows)) if order is None else list(order)
-            if order is None:
-                rng.shuffle(rows)
-            fr = []
-            for r in rows:
-                while rng.random() < gap_p:
-                    fr.append(None)
-                fr.append(("row", r, hm[r]))
-            pad = max(0, min_period - len(fr) - 1)
-            fr = fr[:-1] + [None] * pad + fr[-1:]
-            sched += fr + [("eof", (first_frame + i) & 0xFFFF)]
-        return sched
+        # every maximum takes one cycle in the serialiser
+        min_period = [2 * self.k + 32 + self.rows + int(maxima_mask(hm, self.thr, self.nb).sum())
+                      for hm in hms]
+        return frame_schedule(rng, hms, self.rows, min_period, first_frame, gap_p, order)
 
     async def drive(self, sched):
         """Drive the schedule (tb/common/hm_stream.py); returns (last row beat, hm_eof)
