@@ -1,0 +1,4 @@
+// fmt_blob: connected-region (palm) detector
++incdir+rtl
+rtl/fmt_blob.v
+rtl/fmt_div.v

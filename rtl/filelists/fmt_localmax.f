@@ -1,0 +1,3 @@
+// fmt_localmax: local maxima of the heat map
++incdir+rtl
+rtl/fmt_localmax.v

@@ -1,0 +1,4 @@
+// fmt_tracker: contact tracking
++incdir+rtl
+rtl/fmt_tracker.v
+rtl/fmt_tracker_vel.v
