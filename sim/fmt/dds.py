@@ -32,12 +32,10 @@ output rounding); the fixed words differ from it by at most
 tuning words with non-zero low bits, the phase-truncation term
 peak * 2 pi / 2**A (see :func:`error_bound`).
 
-Run ``python -m fmt.dds --write-hex`` to regenerate the committed sine tables.
+``python -m fmt.generate`` writes the committed sine tables (:func:`render_hex`).
 """
 from __future__ import annotations
 
-import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -72,15 +70,6 @@ def render_hex(table_addr: int, sine_bits: int) -> str:
     digits = (sine_bits + 3) // 4
     mask = (1 << sine_bits) - 1
     return "".join(f"{int(v) & mask:0{digits}x}\n" for v in t)
-
-
-def write_hex(tables=HEX_TABLES) -> list[Path]:
-    out = []
-    for a, s in tables:
-        p = RTL / hex_name(a, s)
-        p.write_text(render_hex(a, s))
-        out.append(p)
-    return out
 
 
 # ---- widths ----------------------------------------------------------------------
@@ -291,17 +280,3 @@ def worst_spur_dbc(x: np.ndarray, tone_bins) -> tuple[float, int]:
     k = int(np.flatnonzero(mask)[np.argmax(X[mask])])
     spur = max(X[k], tone * 1e-15)
     return 20 * np.log10(spur / tone), k
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--write-hex", action="store_true", help="regenerate rtl/fmt_sine_rom_*.hex")
-    a = ap.parse_args(argv)
-    if a.write_hex:
-        for p in write_hex():
-            print(f"wrote {p}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

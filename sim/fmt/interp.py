@@ -344,12 +344,6 @@ def render_exp_hex() -> str:
     return "\n".join(f"{v:04x}" for v in EXP_ROM) + "\n"
 
 
-def write_hex():
-    BIAS_HEX.write_text(render_bias_hex())
-    LOG_HEX.write_text(render_log_hex())
-    EXP_HEX.write_text(render_exp_hex())
-
-
 # ---- fixed point ------------------------------------------------------------------------
 def div_fixed(num: int, den: int, qw: int = DIV_QW):
     """The RTL divider fmt_div: (floor(num / den), overflow = num >= den << qw); the
@@ -534,10 +528,3 @@ def interp_frame_fixed(cands, cfg, moore=True, bias=True, frame=0):
 
 def interp_frame(cands, cfg, moore=True, bias=True, frame=0):
     return [interp_float(c, cfg, moore, bias, frame) for c in cands]
-
-
-if __name__ == "__main__":
-    import sys
-    if "--write-hex" in sys.argv:
-        write_hex()
-        print(f"wrote {BIAS_HEX}, {LOG_HEX}, {EXP_HEX}")

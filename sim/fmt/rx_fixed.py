@@ -388,18 +388,3 @@ def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None
     # split of slot 0 (the queue push), clk; the schedule counts from there
     base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1)
     return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}
-
-
-def write_recip_hex() -> Path:
-    path = RTL / RECIP_HEX
-    path.write_text(render_recip_hex())
-    return path
-
-
-if __name__ == "__main__":
-    import argparse
-    ap = argparse.ArgumentParser(description="receive back-end twin: generated files")
-    ap.add_argument("--write-hex", action="store_true", help=f"regenerate rtl/{RECIP_HEX}")
-    a = ap.parse_args()
-    if a.write_hex:
-        print(write_recip_hex())

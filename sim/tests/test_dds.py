@@ -10,9 +10,9 @@ from fmt import dds, params
 @pytest.mark.parametrize("table_addr,sine_bits", dds.HEX_TABLES)
 def test_hex_tables_current(table_addr, sine_bits):
     path = dds.RTL / dds.hex_name(table_addr, sine_bits)
-    assert path.exists(), f"{path} missing: run python -m fmt.dds --write-hex"
+    assert path.exists(), f"{path} missing: run python -m fmt.generate"
     assert path.read_text() == dds.render_hex(table_addr, sine_bits), \
-        f"{path} is stale: run python -m fmt.dds --write-hex"
+        f"{path} is stale: run python -m fmt.generate"
 
 
 def test_table_symmetric_and_in_range():

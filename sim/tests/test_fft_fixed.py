@@ -84,8 +84,8 @@ def test_exact_cases():
 def test_twiddle_hex_files_current(log2_n):
     for m in F.twiddle_blocks(log2_n):
         p = F.RTL / F.twiddle_hex_name(m)
-        assert p.exists(), f"{p} missing: python -m fmt.fft_fixed --write-hex"
-        assert p.read_text() == F.twiddle_hex_text(m), f"{p} stale: python -m fmt.fft_fixed --write-hex"
+        assert p.exists(), f"{p} missing: python -m fmt.generate"
+        assert p.read_text() == F.twiddle_hex_text(m), f"{p} stale: python -m fmt.generate"
 
 
 def test_structure():

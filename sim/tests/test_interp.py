@@ -22,7 +22,7 @@ def paraboloid(A, B, C, D, E, F):
 
 
 def test_hex_files_are_fresh():
-    assert interp.BIAS_HEX.read_text() == interp.render_bias_hex(), "run python -m fmt.interp --write-hex"
+    assert interp.BIAS_HEX.read_text() == interp.render_bias_hex(), "run python -m fmt.generate"
     assert interp.LOG_HEX.read_text() == interp.render_log_hex()
     assert interp.EXP_HEX.read_text() == interp.render_exp_hex()
 

@@ -35,4 +35,4 @@ def test_invalid_tone_plans_are_refused(kw, msg):
 
 def test_generated_header_is_current():
     assert params.VH_PATH.read_text() == params.render_vh(), (
-        "rtl/fmt_defaults.vh is stale: run `cd sim && python -m fmt.params --write-vh`")
+        "rtl/fmt_defaults.vh is stale: run `python -m fmt.generate`")

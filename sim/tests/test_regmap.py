@@ -10,7 +10,7 @@ from fmt.tracking import TrackParams
 
 def test_generated_files_fresh():
     stale = regmap.stale_files()
-    assert not stale, f"stale generated files {stale}: run `python -m fmt.regmap --write`"
+    assert not stale, f"stale generated files {stale}: run `python -m fmt.generate`"
 
 
 def test_map_consistent():

@@ -136,9 +136,9 @@ def test_accum_pow2_equals_shift(hm_shift):
 def test_recip_hex_current():
     """rtl/fmt_recip.hex (fmt_rx_array's reciprocal ROM) equals the model's table."""
     path = RTL / R.RECIP_HEX
-    assert path.exists(), f"{path} missing: run python -m fmt.rx_fixed --write-hex"
+    assert path.exists(), f"{path} missing: run python -m fmt.generate"
     assert path.read_text() == R.render_recip_hex(), \
-        f"{path} is stale: run python -m fmt.rx_fixed --write-hex"
+        f"{path} is stale: run python -m fmt.generate"
     src = (RTL / "fmt_rx_array.v").read_text()
     assert re.search(r"localparam\s+TR\s*=\s*(\d+)", src).group(1) == str(R.RECIP_TR)
 
