@@ -1,8 +1,12 @@
 # Fast Multi-Touch (FMT) controller -- top-level commands.
 #   make sim     the main job: the default scene (or SCENE=path) through the RTL core
+#                (the bench in bench/core: python -m bench.core.run_sim_rtl)
 #   make sim-serve  make sim, then serve the core's UART to scripts/fmtctl (PORT=5555)
+#   make sim-model  the scene through the floating-point model only
 #   make test    the whole suite (model tests + cocotb under Icarus and Verilator)
-#   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file
+#   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file, the
+#                source lists (rtl/filelists), latches (Yosys), generated files current
+#   make generate  write every generated file (python -m fmt.generate)
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
 #   make synth-core  the whole default core in one Yosys run -> build/synth/core_default.json
 # Every target installs what it needs the first time (iverilog from Debian, a pinned
@@ -16,7 +20,8 @@ STAMP        := $(VENV)/.installed
 VERILATOR_ROOT := $(abspath $(VENV))/lib/python3.11/site-packages/verilator
 export VERILATOR_ROOT
 export PATH  := $(abspath $(VENV))/bin:$(VERILATOR_ROOT)/bin:$(PATH)
-export PYTHONPATH := $(abspath sim):$(abspath tb)
+# the repository root (bench/), the model package (sim/fmt) and the testbench helpers (tb/common)
+export PYTHONPATH := $(abspath .):$(abspath sim):$(abspath tb)
 # Verilator builds compile through ccache when it is there (scripts/objcache)
 export OBJCACHE := $(abspath scripts/objcache)
 export CCACHE_DIR := $(abspath build/ccache)
@@ -27,7 +32,7 @@ PORT         ?= 5555
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity regmap clean distclean iverilog ccache
+.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -58,7 +63,7 @@ setup: iverilog ccache $(STAMP)
 # The scene through the RTL (fmt_core under Verilator, the fixed-point model in lockstep).
 # The first full-size Verilator build takes 10-17 minutes; later runs reuse it.
 sim: setup
-	$(VPY) -m fmt.run_sim_rtl --scene $(SCENE)
+	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE)
 
 # The scene through the floating-point model only (seconds).
 sim-model: setup
@@ -95,9 +100,10 @@ fft-accuracy: setup
 interp-accuracy: setup
 	$(VPY) scripts/interp_accuracy.py --n 2000
 
-# regenerate rtl/fmt_regfile.v and docs/REGISTERS.md from sim/fmt/regmap.py
-regmap: setup
-	$(VPY) -m fmt.regmap --write
+# every generated file: rtl/fmt_defaults.vh (params.py), the register map (regmap.py:
+# rtl/fmt_regmap.vh, rtl/fmt_regfile.v, docs/REGISTERS.md), the ROM .hex files in rtl/
+generate: setup
+	$(VPY) -m fmt.generate
 
 dds-purity: setup
 	$(VPY) scripts/dds_purity.py
@@ -105,7 +111,7 @@ dds-purity: setup
 # the scene (SCENE=...) through the RTL core, then its UART on socket://127.0.0.1:$(PORT)
 # for scripts/fmtctl until Ctrl-C (or 1 h)
 sim-serve: setup
-	$(VPY) -m fmt.run_sim_rtl --scene $(SCENE) --serve $(PORT) --serve-seconds 3600
+	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE) --serve $(PORT) --serve-seconds 3600
 
 synth: setup
 	$(VPY) scripts/synth.py

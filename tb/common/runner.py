@@ -1,7 +1,9 @@
 """Run a cocotb test module against an RTL top from pytest (cocotb_tools.runner).
 
 Every ``tb/<module>/test_<module>.py`` calls :func:`run_cocotb` from its pytest
-function.  The simulator comes from the ``sim`` fixture (``tb/conftest.py``): both
+function with the files of its top from ``sources(top)`` (rtl/filelists, see
+``tb/common/sources.py``) and the ROM directory define ``rom_define()``.  The
+simulator comes from the ``sim`` fixture (``tb/conftest.py``): both
 Icarus and Verilator by default, one of them with ``SIM=icarus`` or
 ``SIM=verilator``.  ``WAVES=1`` dumps waves (FST under Verilator, VCD/FST under
 Icarus) into the test's build folder, which is printed.
@@ -15,8 +17,8 @@ from pathlib import Path
 
 from cocotb_tools.runner import get_runner
 
-ROOT = Path(__file__).resolve().parents[2]
-RTL = ROOT / "rtl"
+from .sources import INCLUDE_DIRS, ROOT, RTL, module_file, rom_define, sources  # noqa: F401
+
 BUILD = ROOT / "build" / "cocotb"
 
 # Verilator warnings that are lint matters, not simulation errors (lint runs -Wall
@@ -27,14 +29,9 @@ _VERILATOR_ARGS = ["-Wno-fatal", "--x-assign", "unique", "--x-initial", "unique"
 
 
 def rtl_sources(*names: str) -> list[Path]:
-    """Paths of rtl/<name>.v for each module name."""
-    out = []
-    for n in names:
-        p = RTL / f"{n}.v"
-        if not p.exists():
-            raise FileNotFoundError(p)
-        out.append(p)
-    return out
+    """Paths of rtl/<name>.v (or rtl/ref/<name>.v) for each module name (older call
+    sites; a top's whole list is ``sources(top)``)."""
+    return [module_file(n) for n in names]
 
 
 def waves_requested() -> bool:
@@ -67,7 +64,7 @@ def run_cocotb(sim: str, toplevel: str, sources: list, test_module: str,
     runner = get_runner(sim)
     runner.build(
         sources=[str(s) for s in sources],
-        includes=[str(RTL)],
+        includes=[str(d) for d in INCLUDE_DIRS],
         hdl_toplevel=toplevel,
         parameters=parameters,
         build_args=args,

@@ -1,4 +1,4 @@
-"""cocotb testbench of the simulation-only channel sim/verilog/fmt_channel_sim.v
+"""cocotb testbench of the simulation-only channel bench/core/fmt_channel_sim.v
 against its twin sim/fmt/dds.py channel_sim_fixed.
 
 Random row words and a random ce pattern; the coupling matrix is loaded through the
@@ -21,7 +21,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import BUILD, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import dds, params
-from fmt_dds_bank.test_fmt_dds_bank import skip_extra_verilator_build
+from fmt_dds_bank.dds_driver import skip_extra_verilator_build
 
 ROOT = Path(__file__).resolve().parents[2]
 COUP_BITS, COUP_FRAC, NOISE_BITS, NOISE_FRAC, NOISE_LEN = 16, 16, 16, 4, 64
@@ -138,7 +138,7 @@ def test_fmt_channel_sim(sim, cfg):
     run_cocotb(
         sim=sim,
         toplevel="fmt_channel_sim",
-        sources=[ROOT / "sim" / "verilog" / "fmt_channel_sim.v"],
+        sources=[ROOT / "bench" / "core" / "fmt_channel_sim.v"],
         test_module="test_fmt_channel_sim",
         test_dir=Path(__file__).parent,
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "DAC_BITS": cfg.dac_bits,

@@ -1,5 +1,5 @@
-"""The standalone C++ Verilator harness of ``make sim`` (tb/fmt_core/sim_main.cpp driving
-tb/fmt_core/fmt_core_sim_top.v with EXT_CHANNEL = 1; sim/fmt/run_sim_rtl.py
+"""The standalone C++ Verilator harness of ``make sim`` (bench/core/sim_main.cpp driving
+bench/core/fmt_core_sim_top.v with EXT_CHANNEL = 1; bench/core/run_sim_rtl.py
 run_harness) on the small sensor (4 x 6, N = 64): a finger, a drag that starts
 mid-window and a tap that lands and lifts inside windows, CLK_PER_SAMPLE 3.
 
@@ -16,18 +16,12 @@ Verilator only (there is no Icarus variant of a Verilator C++ harness).
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "sim"))
-sys.path.insert(0, str(ROOT / "tb"))
-
-from fmt import run_sim_rtl as rsr  # noqa: E402
-from fmt import scene as _scene  # noqa: E402
-from fmt.settings import TouchSettings  # noqa: E402
+from bench.core import run_sim_rtl as rsr
+from fmt import scene as _scene
+from fmt.settings import TouchSettings
 
 
 def small_tap_scene(frames: int) -> _scene.Scene:

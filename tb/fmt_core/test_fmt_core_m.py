@@ -4,26 +4,21 @@ fixed-point model at M = 3 (rx_fixed.rx_heatmaps_fixed(m=3): the receive array's
 reciprocal divider), the core's own frame-end counter (fmt_latency) one frame = 3
 windows apart, the latency counters equal to the cycles measured from the logs.
 
-The cocotb side is ``run_scene`` of test_fmt_core.py (the job-file engine of
-``python -m fmt.run_sim_rtl``); the reference is computed by run_sim_rtl.prepare, which
+The cocotb side is ``run_scene`` of bench/core/core_cocotb.py (the job-file engine of
+``python -m bench.core.run_sim_rtl``); the reference is computed by run_sim_rtl.prepare, which
 passes the scene's M to rx_heatmaps_fixed.
 """
 from __future__ import annotations
 
 import json
 import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "sim"))
-sys.path.insert(0, str(ROOT / "tb"))
-
-from common.runner import run_cocotb  # noqa: E402
-from fmt import run_sim_rtl as rsr  # noqa: E402
-from fmt import scene as _scene  # noqa: E402
-from fmt.settings import TouchSettings  # noqa: E402
+from bench.core import run_sim_rtl as rsr
+from common.runner import run_cocotb
+from fmt import scene as _scene
+from fmt.settings import TouchSettings
 
 M = 3
 
@@ -37,7 +32,7 @@ def test_fmt_core_m3(sim):
     d, ref, cal, _n_upd = rsr.prepare(scene, frames, cps, st, cal=None, tag=f"tbm{M}_{sim}")
     assert ref.heatmaps.shape[0] == frames
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
-               test_module="test_fmt_core", test_dir=Path(__file__).parent, testcase="run_scene",
+               test_module="core_cocotb", test_dir=rsr.BENCH, testcase="run_scene",
                parameters=rsr.sim_parameters(cfg, cps, d),
                extra_env={"FMT_CORE_JOB": str(d / "job.json"), "FMT_CORE_UART": 0,
                           "FMT_CORE_CFG": cfg.name, "FMT_QUIET": 1},

@@ -1,7 +1,7 @@
 """scripts/fmtctl against the running full-core simulation (issue #5): the C++ Verilator
-harness of ``make sim`` in serve mode (``python -m fmt.run_sim_rtl --serve PORT``,
-tb/fmt_core/sim_main.cpp) bridges socket://127.0.0.1:PORT to the UART of fmt_core inside
-tb/fmt_core/fmt_core_sim_top.v, so that the same fmtctl drives the simulation and the
+harness of ``make sim`` in serve mode (``python -m bench.core.run_sim_rtl --serve PORT``,
+bench/core/sim_main.cpp) bridges socket://127.0.0.1:PORT to the UART of fmt_core inside
+bench/core/fmt_core_sim_top.v, so that the same fmtctl drives the simulation and the
 board.  Small sensor (4 x 6, N = 64), sim/scenes/small.json (a still finger and a
 drag: events every frame), 12 scene frames, CLK_PER_SAMPLE 3, UART_DIV 4, the -O0
 build of the harness test (own tag: pytest-xdist may run both at once).
@@ -49,13 +49,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "sim"))
+from bench.core import run_sim_rtl as rsr
+from fmt import params
+from fmt import protocol as P
+from fmt import regmap
 
-from fmt import params  # noqa: E402
-from fmt import protocol as P  # noqa: E402
-from fmt import regmap  # noqa: E402
-from fmt import run_sim_rtl as rsr  # noqa: E402
+ROOT = rsr.ROOT
 
 FMTCTL = ROOT / "scripts" / "fmtctl"
 SCENE = ROOT / "sim" / "scenes" / "small.json"
@@ -67,13 +66,14 @@ SLACK = 16          # clk: register pipeline between an event leaving and its co
 
 
 class Server:
-    """python -m fmt.run_sim_rtl --serve 0 in its own session; stdout read by a thread."""
+    """python -m bench.core.run_sim_rtl --serve 0 in its own session; stdout read by a thread."""
 
     def __init__(self, out_dir: Path, *extra: str):
-        env = dict(os.environ, PYTHONPATH=str(ROOT / "sim") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+        path = [str(ROOT), str(ROOT / "sim"), str(ROOT / "tb")]
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(path + [os.environ.get("PYTHONPATH", "")]))
         self.err = open(out_dir / "serve_stderr.txt", "w+")
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "fmt.run_sim_rtl", "--scene", str(SCENE), "--frames", str(FRAMES),
+            [sys.executable, "-m", "bench.core.run_sim_rtl", "--scene", str(SCENE), "--frames", str(FRAMES),
              "--cps", str(CPS), "--serve", "0", "--serve-log-frames", "-1", "--no-plot", "--quiet",
              "--cflags=-O0", "--tag", TAG, "--out", str(out_dir), *extra],
             cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=self.err, text=True, start_new_session=True)

@@ -19,7 +19,7 @@ from common.runner import rtl_sources, run_cocotb
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.dds import despread_fixed
-from fmt_dds_bank.test_fmt_dds_bank import skip_extra_verilator_build
+from fmt_dds_bank.dds_driver import skip_extra_verilator_build
 
 
 class TB(ClockedTB):

@@ -24,7 +24,7 @@ from common.runner import rtl_sources, run_cocotb
 from common.tb_util import env_int
 from fmt import dds, params
 from fmt.pn import MAXIMAL_TAPS, lfsr_chips
-from fmt_dds_bank.test_fmt_dds_bank import LATENCY, TB as BankTB, build_args, skip_extra_verilator_build
+from fmt_dds_bank.dds_driver import LATENCY, TB as BankTB, build_args, skip_extra_verilator_build
 
 ALIGN_DELAY = 3   # rx_delay_i that lines rx_sign_o up with the words on dac_o
 

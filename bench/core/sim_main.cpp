@@ -1,7 +1,7 @@
-// sim_main.cpp -- standalone Verilator harness of tb/fmt_core/fmt_core_sim_top.v
+// sim_main.cpp -- standalone Verilator harness of bench/core/fmt_core_sim_top.v
 // (EXT_CHANNEL = 1): the full-chain RTL simulation of `make sim` without cocotb.
 //
-// It replays exactly what the cocotb test run_scene (tb/fmt_core/test_fmt_core.py)
+// It replays exactly what the cocotb test run_scene (bench/core/core_cocotb.py)
 // does, cycle for cycle, with the clock toggled here (two evals per clk cycle, no
 // tracing, single thread):
 //   phase 1: rst for 8 cycles, one idle cycle, the calibration writes (one per cycle)
@@ -12,7 +12,7 @@
 //   then:    ev_ready_i = 0, 4 cycles, the status registers read over the bus
 //            (two cycles each), flush_i pulsed, result JSON written.
 //
-// The channel (sim/verilog/fmt_channel_sim.v, bit-exact, in C++): at every clk edge
+// The channel (bench/core/fmt_channel_sim.v, bit-exact, in C++): at every clk edge
 // with rst low and ce_o high (sample k = k-th such edge since reset)
 //   acc[c] = sum_r dac[r] * G[r][c] + noise[(k mod NOISE_LEN)][c] << (16 - 4)
 //   adc[c] = clip((acc[c] + 2^15) >> 16, -2048, 2047)     (arithmetic shift: floor)
@@ -46,7 +46,7 @@
 // when the loggers stop).  serve_log_clk >= 0: the loggers (play_i) stop after that many
 // clk of serving (the logs of a long session at full size would grow by MB/s); -1: on.
 //
-// Usage: Vfmt_core_sim_top <job.txt>   (written by sim/fmt/run_sim_rtl.py, write_cpp_job)
+// Usage: Vfmt_core_sim_top <job.txt>   (written by bench/core/run_sim_rtl.py, write_cpp_job)
 // Progress on stderr when the job says so; result JSON to the job's out path.
 #include <arpa/inet.h>
 #include <fcntl.h>

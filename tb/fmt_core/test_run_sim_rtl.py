@@ -1,4 +1,4 @@
-"""Tests of sim/fmt/run_sim_rtl.py (``make sim`` through the RTL).
+"""Tests of bench/core/run_sim_rtl.py (``make sim`` through the RTL).
 
 Model side: the int64 channel twin equals ``dds.channel_sim_fixed`` (the bit-exact twin
 of fmt_channel_sim) on a stream with stamped updates and noise; the coupling plan
@@ -14,8 +14,8 @@ import shutil
 import numpy as np
 import pytest
 
+from bench.core import run_sim_rtl as rsr
 from fmt import dds, params
-from fmt import run_sim_rtl as rsr
 from fmt import scene as _scene
 
 

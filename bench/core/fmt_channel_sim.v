@@ -1,7 +1,7 @@
 // fmt_channel_sim -- SIMULATION-ONLY channel model for full-chain simulations: the
 // DDS bank's row words, a ROWS x COLS coupling matrix and additive noise make COLS
 // ADC samples per sample strobe.  Not synthesizable by intent (64-bit arithmetic,
-// whole-matrix copies, a file of noise); it lives in sim/verilog/, not rtl/.
+// whole-matrix copies, a file of noise); it lives in bench/core/, not rtl/.
 //
 // Sample k = k-th ce edge after reset; the row words present at that edge are sample k.
 //   acc[c] = sum_r dac[r] * G[r][c]  +  noise[(k mod NOISE_LEN)][c] << (COUP_FRAC - NOISE_FRAC)

@@ -1,11 +1,15 @@
 """``make sim`` through the RTL: a scene through ``fmt_core`` under Verilator, the
 fixed-point model in lockstep as the reference.
 
-    python -m fmt.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
+    python -m bench.core.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
         [--frames F] [--cps 3] [--engine cpp|cocotb] [--sim verilator|icarus]
         [--no-plot] [--quiet] [--serve PORT [--serve-seconds S] [--serve-once]]
 
-The simulation top ``tb/fmt_core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
+(from the repository root with the repository, ``sim`` and ``tb`` on PYTHONPATH:
+``source scripts/env.sh``; ``make sim`` sets them).  The files of the bench are in
+``bench/core/`` (README.md there); the RTL comes from ``rtl/filelists/fmt_core.f``.
+
+The simulation top ``bench/core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
 channel (DAC words x coupling matrix + file noise -> ADC words) + a coupling-update
 player + loggers; nothing in Python is on the per-sample path:
 
@@ -23,12 +27,12 @@ player + loggers; nothing in Python is on the per-sample path:
    1-sample ADC register -> ``rx_heatmaps_fixed`` (PN receive delay 4 samples) ->
    ``touch.process_frames(fixed=True)`` with the scene's calibration.
 3. The RTL run.  Engine ``cpp`` (default): the standalone Verilator harness
-   ``tb/fmt_core/sim_main.cpp`` (:func:`run_harness`; built once per sensor size and
+   ``bench/core/sim_main.cpp`` (:func:`run_harness`; built once per sensor size and
    CLK_PER_SAMPLE under ``build/sim_cpp/`` with -O3 and rebuilt only when a source
    changes) clocks ``fmt_core_sim_top`` with EXT_CHANNEL = 1 and computes the channel
    in C++, bit-exact with ``fmt_channel_sim``; it replays the phases of the cocotb test
    cycle for cycle.  Engine ``cocotb``: the cocotb test ``run_scene`` in
-   ``tb/fmt_core/test_fmt_core.py`` (Verilator or Icarus, the Verilog channel and
+   ``bench/core/core_cocotb.py`` (Verilator or Icarus, the Verilog channel and
    player; ~40x slower).  Both program the registers (calibration, settings,
    REPORT_PERIOD 0) through the core's local bus, run the clock and read the status;
    the loggers write every heat-map beat, every event and every receiver frame end
@@ -70,17 +74,18 @@ from pathlib import Path
 
 import numpy as np
 
-from . import channel as _channel
-from . import dds as _dds
-from . import params as _params
-from . import pn as _pn
-from . import rx_fixed as _rx
-from . import scene as _scene
-from . import sensor as _sensor
-from .settings import TouchSettings
-from .tracking import TrackParams
+from common.sources import INCLUDE_DIRS, rom_define, sources
+from fmt import channel as _channel
+from fmt import dds as _dds
+from fmt import pn as _pn
+from fmt import rx_fixed as _rx
+from fmt import scene as _scene
+from fmt import sensor as _sensor
+from fmt.settings import TouchSettings
+from fmt.tracking import TrackParams
 
 ROOT = Path(__file__).resolve().parents[2]
+BENCH = Path(__file__).resolve().parent
 COUP_BITS, COUP_FRAC = 16, 16
 NOISE_BITS, NOISE_FRAC = 16, 4
 DAC_DELAY = 3            # channel sample k multiplies DDS sample k - 3 (fmt_tx + channel input)
@@ -225,7 +230,7 @@ def pn_of(scene):
 
 
 def model_reference(scene: _scene.Scene, g0, updates, noise, frames: int, settings, cal) -> Reference:
-    from . import touch as _touch
+    from fmt import touch as _touch
     cfg = scene.cfg
     spf = scene.samples_per_frame
     n = frames * spf
@@ -326,7 +331,7 @@ def _stats(v) -> dict:
 
 def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict, frames: int,
             wall_s: float, out_dir: Path | None, plot: bool, cal, max_cycle: int | None = None) -> dict:
-    from . import run_sim as _run_sim
+    from fmt import run_sim as _run_sim
     cfg = scene.cfg
     clk_hz = cfg.fs_hz * cps
     hm_rows, eof, evs, fend = parse_logs(d, cfg, max_cycle)
@@ -414,8 +419,8 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
         od.mkdir(parents=True, exist_ok=True)
         if plot and n_rtl:
             try:
-                from . import flatten as _flatten
-                from . import plots as _plots
+                from fmt import flatten as _flatten
+                from fmt import plots as _plots
                 flat = _flatten.flatten(rtl_hm, cal[0], cal[1], cfg) if cal is not None else rtl_hm
                 _plots.heatmap_with_tracks(flat, scene.replace(frames=n_rtl),
                                            _run_sim.tracks(frame_events, cfg), od / "heatmap.png")
@@ -453,29 +458,27 @@ def latency_histogram(first, last, onset, path) -> None:
 def sim_parameters(cfg, cps: int, d: Path) -> dict:
     return {"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n, "BIN_LO": cfg.bin_lo,
             "HM_W": cfg.hm_width, "MAX_TOUCHES": cfg.max_touches, "CLK_PER_SAMPLE": cps,
-            "EV_DEPTH": 2048, "UART_DIV": 4, "TW_DIR": f'"{ROOT / "rtl"}/"',
+            "EV_DEPTH": 2048, "UART_DIV": 4,
             "NOISE_LEN": noise_len(cfg), "NOISE_FILE": f'"{d / "noise.hex"}"',
             "UPD_LEN": upd_len(cfg), "UPD_FILE": f'"{d / "upd.hex"}"',
             "HM_LOG": f'"{d / "hm.log"}"', "EV_LOG": f'"{d / "ev.log"}"', "FE_LOG": f'"{d / "fe.log"}"'}
 
 
 def sim_sources() -> list:
-    sys.path.insert(0, str(ROOT / "tb"))
-    rtl = sorted(p for p in (ROOT / "rtl").glob("fmt_*.v"))
-    return rtl + [ROOT / "sim" / "verilog" / "fmt_channel_sim.v",
-                  ROOT / "tb" / "fmt_core" / "fmt_core_sim_top.v"]
+    """fmt_core's list (rtl/filelists/fmt_core.f) and the bench's Verilog."""
+    return sources("fmt_core") + [BENCH / "fmt_channel_sim.v", BENCH / "fmt_core_sim_top.v"]
 
 
 def build_args(sim: str, fast_sim: bool = True) -> list:
     """Build options; fast_sim: optimise the model (long runs) rather than the build (tests)."""
-    args = [f'-DFMT_ROM_DIR="{ROOT / "rtl"}/"']
+    args = [rom_define()]
     if sim == "verilator":
         args += ["-O3", "--x-assign", "fast", "--x-initial", "fast"] if fast_sim else ["-CFLAGS", "-O0"]
     return args
 
 
-# ---- the standalone C++ harness (tb/fmt_core/sim_main.cpp) -------------------------------
-HARNESS_SRC = ROOT / "tb" / "fmt_core" / "sim_main.cpp"
+# ---- the standalone C++ harness (bench/core/sim_main.cpp) ---------------------------------
+HARNESS_SRC = BENCH / "sim_main.cpp"
 HARNESS_CFLAGS = "-O3 -march=native"
 STATUS_REGS = ("FRAME_COUNT", "STATUS", "EV_DROP_COUNT", "EV_SKIP_COUNT", "FLAT_SAT_COUNT",
                "LM_DROP_COUNT", "LAT_FIRST_MIN", "LAT_FIRST_MAX", "LAT_FIRST_COUNT",
@@ -503,7 +506,7 @@ def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAG
     args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
             "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "--output-split", "0",
             "--top-module", "fmt_core_sim_top", "-Mdir", str(bdir), "-o", "Vfmt_core_sim_top",
-            f"-I{ROOT / 'rtl'}", f'-DFMT_ROM_DIR="{ROOT / "rtl"}/"',
+            *[f"-I{d}" for d in INCLUDE_DIRS], rom_define(),
             "-CFLAGS", cflags, "-MAKEFLAGS", "--no-print-directory",
             # verilated.mk compiles the harness and the runtime with OPT_GLOBAL (-Os) after
             # CFLAGS: the same optimisation everywhere
@@ -557,7 +560,7 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
     """The job of the C++ harness: the same phases as the cocotb run_scene; serve:
     {"port", "seconds", "cycles", "once", "log_clk"} for serve mode (see the module doc;
     log_clk: clk of serving with the loggers on, -1 = all)."""
-    from . import regmap as _regmap
+    from fmt import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
              f"progress {int(progress)}", f"noise_len {noise_len(cfg)}",
@@ -620,7 +623,7 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
 
 def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene", tag: str = ""):
     """Write the job folder (records, noise, job.json) and compute the reference."""
-    from . import run_sim as _run_sim
+    from fmt import run_sim as _run_sim
     cfg = scene.cfg
     settings = settings or TouchSettings()
     d = job_dir(cfg, cps, tag)
@@ -679,14 +682,13 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
             Path(rep["report"]).write_text(json.dumps({k: v for k, v in rep.items() if k != "report"},
                                                       indent=1) + "\n")
         return rep
-    sys.path.insert(0, str(ROOT / "tb"))
     from common.runner import run_cocotb
     t0 = time.perf_counter()
     d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag="" if sim == "verilator" else sim)
     t1 = time.perf_counter()
     env = {"FMT_CORE_JOB": str(d / "job.json"), "FMT_QUIET": int(quiet)}
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=sim_sources(),
-               test_module="test_fmt_core", test_dir=ROOT / "tb" / "fmt_core",
+               test_module="core_cocotb", test_dir=BENCH,
                testcase="run_scene", parameters=sim_parameters(scene.cfg, cps, d),
                extra_env=env, build_args=build_args(sim), tag="run_sim_rtl")
     res = json.loads((d / "result.json").read_text())

@@ -11,7 +11,7 @@
 //                next record, so the next writes cannot reach the armed copy
 //   [63:60] = 0  end (the player stops)
 // Records before the first commit may be written while rst is high (the initial matrix);
-// a commit is only issued with rst low.  The generator (sim/fmt/run_sim_rtl.py) spaces the
+// a commit is only issued with rst low.  The generator (bench/core/run_sim_rtl.py) spaces the
 // commits so that every one is issued before its stamp; upd_late_o counts commits issued
 // at or after their stamp (the run must report 0).
 //
@@ -24,7 +24,7 @@
 // Ports: the core's control ports are passed through (clock, reset, UART, local bus,
 // trigger, event ready).
 //
-// EXT_CHANNEL = 1 (the standalone C++ harness tb/fmt_core/sim_main.cpp, `make sim`):
+// EXT_CHANNEL = 1 (the standalone C++ harness bench/core/sim_main.cpp, `make sim`):
 // no fmt_channel_sim and no player; the core's ADC inputs come from adc_ext_i and the
 // harness computes them from ce_o / dac_o itself (the same formula, bit-exact, in C++:
 // a 30 x 40 matrix product per sample is far cheaper there); upd_late_o, upd_done_o
@@ -43,7 +43,6 @@ module fmt_core_sim_top #(
     parameter CLK_PER_SAMPLE = 3,                // clk cycles per sample
     parameter EV_DEPTH       = 2048,             // event FIFO depth
     parameter UART_DIV       = 8,                // clk cycles per UART bit
-    parameter TW_DIR         = "rtl/",           // twiddle hex directory
     parameter NOISE_LEN      = 1024,             // noise samples per column in NOISE_FILE
     parameter NOISE_FILE     = "",               // channel noise ($readmemh), "" = none
     parameter UPD_LEN        = 1,                // coupling-update records
@@ -95,7 +94,7 @@ module fmt_core_sim_top #(
     fmt_core #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .HM_W(HM_W),
         .MAX_TOUCHES(MAX_TOUCHES), .CLK_PER_SAMPLE(CLK_PER_SAMPLE), .EV_DEPTH(EV_DEPTH),
-        .UART_DIV(UART_DIV), .UART_TIMEOUT(20), .TW_DIR(TW_DIR), .BLOBS(BLOBS)
+        .UART_DIV(UART_DIV), .UART_TIMEOUT(20), .BLOBS(BLOBS)
     ) u_core (
         .clk(clk), .rst(rst), .ce_o(ce), .dac_o(dac), .adc_i(adc),
         .ev_valid_o(ev_valid), .ev_ready_i(ev_ready_i), .ev_frame_o(ev_frame), .ev_time_o(ev_time),

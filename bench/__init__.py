@@ -1,0 +1,1 @@
+"""The benches: bench/core is the `make sim` bench (fmt_core through a scene)."""
