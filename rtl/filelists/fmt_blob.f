@@ -2,3 +2,4 @@
 +incdir+rtl
 rtl/fmt_blob.v
 rtl/fmt_div.v
+rtl/fmt_sorted_list.v

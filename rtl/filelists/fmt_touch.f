@@ -2,7 +2,7 @@
 +incdir+rtl
 rtl/fmt_touch.v
 rtl/fmt_flatten.v
-rtl/fmt_localmax.v
+-f rtl/filelists/fmt_localmax.f
 rtl/fmt_event_port.v
 -f rtl/filelists/fmt_interp.f
 -f rtl/filelists/fmt_tracker.f
