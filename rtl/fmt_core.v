@@ -78,7 +78,6 @@ module fmt_core #(
                                                   // turns it on); 0: left out, ~11k LUT6 less
     parameter UART_DIV       = 1085,              // clk cycles per UART bit (125 MHz: 115200 baud)
     parameter UART_TIMEOUT   = 40,                // control-port inter-byte timeout, bit times
-    parameter TW_DIR         = "rtl/",            // directory of the FFT twiddle hex files
     parameter REGMAP_ID      = `FMT_REGMAP_ID,    // register-map id reported by INFO (generated)
     parameter ROW_W          = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
     parameter COL_W          = (COLS > 1) ? $clog2(COLS) : 1    // column index width
@@ -255,12 +254,12 @@ module fmt_core #(
     fmt_rx_array #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
         .ADC_BITS(ADC_BITS), .HM_W(HM_W), .FRAME_W(16), .M_MAX(M_MAX),
-        .TW_DIR(TW_DIR), .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .MC_W(MC_W),
+        .POST_CLK(CPS > 1 ? 1 : 0), .ROW_W(ROW_W), .MC_W(MC_W),
         .CLK_PER_SAMPLE(CPS)
     ) u_rx (
         .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_i), .rx_sign_i(rx_sign), .m_i(m_sel),
-        .hm_valid(hm_valid), .hm_row(hm_row), .hm_frame(hm_frame), .hm_data(hm_data),
-        .hm_eof(hm_eof), .fft_ovf_o(rx_fft_ovf), .sat_o(rx_sat), .ovf_o(rx_ovf));
+        .hm_valid_o(hm_valid), .hm_row_o(hm_row), .hm_frame_o(hm_frame), .hm_data_o(hm_data),
+        .hm_eof_o(hm_eof), .fft_ovf_o(rx_fft_ovf), .sat_o(rx_sat), .ovf_o(rx_ovf));
 
     // frame end of the receive side: the ce edge taking a frame's last ADC sample
     reg [LOG2_N-1:0] samp_q;

@@ -4,7 +4,8 @@
 // multiplied by W_M^e(i), e(i) = r(q) n, q = i div (M/4), n = i mod (M/4),
 // r = (0, 2, 1, 3), W_M = exp(-j 2 pi / M).  The ROM holds {cos, -sin} of W_M^e(i) per i
 // (TW_W bits each, scale 2^(TW_W-2), so +1 and -1 are exact), read from the hex file
-// TW_DIR + "fmt_fft_twMMMM.hex" that sim/fmt/fft_fixed.py generates.
+// fmt_fft_twMMMM.hex that sim/fmt/fft_fixed.py generates (folder: the macro FMT_ROM_DIR
+// when defined, e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\", else the name alone, as fmt_dds_rom2).
 //
 // Arithmetic: four DW x TW_W products (one DSP48E each, DW <= 25), each truncated
 // (floor, arithmetic shift) by T = SH - GUARD bits, then
@@ -25,8 +26,7 @@ module fmt_fft_twiddle #(
     parameter OW     = 19,           // output width (signed)
     parameter TW_W   = 18,           // twiddle width (signed), scale 2^(TW_W-2)
     parameter SH     = 13,           // right shift after the products (>= 1)
-    parameter GUARD  = 3,            // product bits kept below the output LSB (>= 1)
-    parameter TW_DIR = "rtl/"        // directory of the twiddle hex files (with trailing /)
+    parameter GUARD  = 3             // product bits kept below the output LSB (>= 1)
 ) (
     input  wire              clk,
     input  wire              rst,          // synchronous, active high
@@ -58,7 +58,13 @@ module fmt_fft_twiddle #(
     localparam [8*18-1:0] TW_NAME = {"fmt_fft_tw", DIG3[7:0], DIG2[7:0], DIG1[7:0], DIG0[7:0], ".hex"};
 
     reg [2*TW_W-1:0] rom [0:M-1];
-    initial $readmemh({TW_DIR, TW_NAME}, rom);
+    initial begin
+`ifdef FMT_ROM_DIR
+        $readmemh({`FMT_ROM_DIR, TW_NAME}, rom);
+`else
+        $readmemh(TW_NAME, rom);
+`endif
+    end
 
     // step 1: twiddle and data registers
     reg [2*TW_W-1:0]    tw_q;

@@ -4,7 +4,7 @@
 // docstring is the full arithmetic specification; summary below).
 //
 // Fully pipelined: one candidate per clock in, touches out in the same order after
-// LAT = 23 clock cycles (cand_valid -> tp_valid, cand_eof -> tp_eof likewise).
+// LAT = 23 clock cycles (cand_valid_i -> tp_valid_o, cand_eof_i -> tp_eof_o likewise).
 //
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
@@ -12,14 +12,14 @@
 // and its denominator is > 0; one neighbour missing: the one-sided estimate from the
 // ratio neighbour / z00 (same divider, edge table); else 0 (cell centre).  |offset| = round half up of a
 // 9-bit truncating quotient (fmt_div) in 1/256 cell, clamped to 128 (0.5 cell) when
-// >= 257/512; optional bias table (fmt_interp_bias_rom).  tp_x = col * 256 + offset
-// clamped to [0, (COLS-1) * 256], tp_y likewise: cells, 8 fractional bits.
+// >= 257/512; optional bias table (fmt_interp_bias_rom).  tp_x_o = col * 256 + offset
+// clamped to [0, (COLS-1) * 256], tp_y_o likewise: cells, 8 fractional bits.
 // Ellipse (Moore fit only): coefficients normalised to ~10-bit cells, G = F_v * 36 dm,
 // CORDIC (fmt_interp_cordic) for |(2(a-c), 3b)| and 1/2 atan2(B, A - C), log2 ROMs
 // (fmt_interp_lg) and an exp2 ROM (fmt_interp_exp) for the semi-axes
-// sqrt(F_v / (2 |lambda|)): tp_axis_major / tp_axis_minor in cells Q8.8 (0xFFFF =
-// saturated), tp_angle in pi/256 (0..255 = 0..pi).  0 when not defined.
-// tp_strength = the centre cell z00.  tp_flags: bit 0 fallback (Moore fit rejected,
+// sqrt(F_v / (2 |lambda|)): tp_axis_major_o / tp_axis_minor_o in cells Q8.8 (0xFFFF =
+// saturated), tp_angle_o in pi/256 (0..255 = 0..pi).  0 when not defined.
+// tp_strength_o = the centre cell z00.  tp_flags_o: bit 0 fallback (Moore fit rejected,
 // Von Neumann denominator <= 0, or offset clamped), bit 1 saturated cell (2^HM_W - 1) in
 // the 3x3, bit 2 edge (a neighbour missing), bit 3 Moore fit used; bits 7:4 zero.
 `default_nettype none
@@ -40,28 +40,28 @@ module fmt_interp #(
     input  wire                 moore_i,        // 1 = Moore fit (Eq. 5-6), 0 = Von Neumann (Eq. 3-4)
     input  wire                 bias_en_i,      // 1 = bias correction on
     // candidate stream (fmt_localmax)
-    input  wire                 cand_valid,     // one candidate this cycle
-    input  wire [FRAME_W-1:0]   cand_frame,     // frame number (with cand_valid and cand_eof)
-    input  wire [ROW_W-1:0]     cand_row,       // row of the centre cell
-    input  wire [COL_W-1:0]     cand_col,       // column of the centre cell
-    input  wire [9*HM_W-1:0]    cand_z,         // z[dy][dx] at [((dy+1)*3+dx+1)*HM_W +: HM_W]
-    input  wire [8:0]           cand_missing,   // bit k = neighbour k outside the sensor
-    input  wire                 cand_eof,       // end of the frame's candidates (pulse)
-    input  wire [CNT_W-1:0]     cand_count,     // candidates of the frame (with cand_eof)
-    input  wire                 cand_overflow,  // contact limit hit (with cand_eof)
+    input  wire                 cand_valid_i,   // one candidate this cycle
+    input  wire [FRAME_W-1:0]   cand_frame_i,   // frame number (with cand_valid_i and cand_eof_i)
+    input  wire [ROW_W-1:0]     cand_row_i,     // row of the centre cell
+    input  wire [COL_W-1:0]     cand_col_i,     // column of the centre cell
+    input  wire [9*HM_W-1:0]    cand_z_i,       // z[dy][dx] at [((dy+1)*3+dx+1)*HM_W +: HM_W]
+    input  wire [8:0]           cand_missing_i, // bit k = neighbour k outside the sensor
+    input  wire                 cand_eof_i,     // end of the frame's candidates (pulse)
+    input  wire [CNT_W-1:0]     cand_count_i,   // candidates of the frame (with cand_eof_i)
+    input  wire                 cand_overflow_i, // contact limit hit (with cand_eof_i)
     // touch stream (fmt_tracker)
-    output wire                 tp_valid,       // one touch this cycle
-    output wire [FRAME_W-1:0]   tp_frame,       // frame number (with tp_valid and tp_eof)
-    output wire [15:0]          tp_x,           // column position, cells Q8.8 from cell (0,0)'s centre
-    output wire [15:0]          tp_y,           // row position, cells Q8.8
-    output wire [HM_W-1:0]      tp_strength,    // centre (peak) cell value
-    output wire [15:0]          tp_axis_major,  // semi-major axis of the half-height contour, Q8.8
-    output wire [15:0]          tp_axis_minor,  // semi-minor axis, Q8.8
-    output wire [7:0]           tp_angle,       // major-axis angle, pi/256 units
-    output wire [7:0]           tp_flags,       // see header
-    output wire                 tp_eof,         // cand_eof delayed by LAT
-    output wire [CNT_W-1:0]     tp_count,       // cand_count delayed by LAT
-    output wire                 tp_overflow     // cand_overflow delayed by LAT
+    output wire                 tp_valid_o,     // one touch this cycle
+    output wire [FRAME_W-1:0]   tp_frame_o,     // frame number (with tp_valid_o and tp_eof_o)
+    output wire [15:0]          tp_x_o,         // column position, cells Q8.8 from cell (0,0)'s centre
+    output wire [15:0]          tp_y_o,         // row position, cells Q8.8
+    output wire [HM_W-1:0]      tp_strength_o,  // centre (peak) cell value
+    output wire [15:0]          tp_axis_major_o, // semi-major axis of the half-height contour, Q8.8
+    output wire [15:0]          tp_axis_minor_o, // semi-minor axis, Q8.8
+    output wire [7:0]           tp_angle_o,     // major-axis angle, pi/256 units
+    output wire [7:0]           tp_flags_o,     // see header
+    output wire                 tp_eof_o,       // cand_eof_i delayed by LAT
+    output wire [CNT_W-1:0]     tp_count_o,     // cand_count_i delayed by LAT
+    output wire                 tp_overflow_o   // cand_overflow_i delayed by LAT
 );
     // ---- constants shared with the model (sim/tests/test_interp.py checks them) ----
     localparam integer KQ = 6745;
@@ -102,10 +102,10 @@ module fmt_interp #(
     integer k;
     always @(posedge clk) begin
         for (k = 0; k < 9; k = k + 1)
-            s1_z[k] <= cand_missing[k] ? {Z{1'b0}} : cand_z[k*Z +: Z];
-        s1_miss  <= cand_missing;
-        s1_row   <= cand_row;
-        s1_col   <= cand_col;
+            s1_z[k] <= cand_missing_i[k] ? {Z{1'b0}} : cand_z_i[k*Z +: Z];
+        s1_miss  <= cand_missing_i;
+        s1_row   <= cand_row_i;
+        s1_col   <= cand_col_i;
         s1_moore <= moore_i;
         s1_bias  <= bias_en_i;
     end
@@ -113,12 +113,12 @@ module fmt_interp #(
     // valid pipeline and the pass-through of frame / eof / count / overflow
     wire [1:0] ctl_q;
     fmt_interp_dly #(.W(2), .N(LAT), .RST(1)) u_dly_ctl (
-        .clk(clk), .rst(rst), .d_i({cand_valid, cand_eof}), .q_o(ctl_q));
+        .clk(clk), .rst(rst), .d_i({cand_valid_i, cand_eof_i}), .q_o(ctl_q));
     fmt_interp_dly #(.W(FRAME_W + CNT_W + 1), .N(LAT), .RST(0)) u_dly_frm (
-        .clk(clk), .rst(rst), .d_i({cand_frame, cand_count, cand_overflow}),
-        .q_o({tp_frame, tp_count, tp_overflow}));
-    assign tp_valid = ctl_q[1];
-    assign tp_eof   = ctl_q[0];
+        .clk(clk), .rst(rst), .d_i({cand_frame_i, cand_count_i, cand_overflow_i}),
+        .q_o({tp_frame_o, tp_count_o, tp_overflow_o}));
+    assign tp_valid_o = ctl_q[1];
+    assign tp_eof_o   = ctl_q[0];
 
     // =================================================================================
     // s2: sums, Von Neumann terms, flags, normalisation shift
@@ -530,17 +530,17 @@ module fmt_interp #(
     end
     /* verilator lint_on WIDTHTRUNC */
     fmt_interp_dly #(.W(32), .N(4), .RST(0)) u_dly_xy (
-        .clk(clk), .rst(rst), .d_i({s19_x, s19_y}), .q_o({tp_x, tp_y}));
+        .clk(clk), .rst(rst), .d_i({s19_x, s19_y}), .q_o({tp_x_o, tp_y_o}));
     wire [3:0] flags23;
     fmt_interp_dly #(.W(4), .N(6), .RST(0)) u_dly_flg (
         .clk(clk), .rst(rst), .d_i(s17_flags), .q_o(flags23));
     fmt_interp_dly #(.W(Z), .N(LAT - 1), .RST(0)) u_dly_str (
-        .clk(clk), .rst(rst), .d_i(s1_z[4]), .q_o(tp_strength));
+        .clk(clk), .rst(rst), .d_i(s1_z[4]), .q_o(tp_strength_o));
 
     wire ell23 = flags23[3] & ell_ok23;
-    assign tp_flags      = {4'd0, flags23};
-    assign tp_axis_major = ell23 ? ax_maj23 : 16'd0;
-    assign tp_axis_minor = ell23 ? ax_min23 : 16'd0;
-    assign tp_angle      = ell23 ? ang23 : 8'd0;
+    assign tp_flags_o      = {4'd0, flags23};
+    assign tp_axis_major_o = ell23 ? ax_maj23 : 16'd0;
+    assign tp_axis_minor_o = ell23 ? ax_min23 : 16'd0;
+    assign tp_angle_o      = ell23 ? ang23 : 8'd0;
 endmodule
 `default_nettype wire

@@ -32,13 +32,13 @@ module fmt_magnitude #(
     input  wire                  clk,
     input  wire                  rst,       // synchronous, active high (clears valid)
     input  wire                  ce,        // sample strobe: the pipeline advances on ce
-    input  wire                  in_valid,  // a sample this ce cycle
-    input  wire signed [IN_W-1:0] in_re,    // real part
-    input  wire signed [IN_W-1:0] in_im,    // imaginary part
-    input  wire [TAG_W-1:0]      in_tag,    // side band (row index, flags), delayed with the data
-    output reg                   out_valid, // magnitude valid (ITER + 3 ce cycles later)
-    output reg  [IN_W-1:0]       out_mag,   // unsigned magnitude, same LSB as the input
-    output reg  [TAG_W-1:0]      out_tag    // the sample's tag
+    input  wire                  in_valid_i, // a sample this ce cycle
+    input  wire signed [IN_W-1:0] in_re_i,  // real part
+    input  wire signed [IN_W-1:0] in_im_i,  // imaginary part
+    input  wire [TAG_W-1:0]      in_tag_i,  // side band (row index, flags), delayed with the data
+    output reg                   out_valid_o, // magnitude valid (ITER + 3 ce cycles later)
+    output reg  [IN_W-1:0]       out_mag_o, // unsigned magnitude, same LSB as the input
+    output reg  [TAG_W-1:0]      out_tag_o  // the sample's tag
 );
 
     localparam IW  = IN_W + GUARD + 2;              // CORDIC register width (signed)
@@ -57,9 +57,9 @@ module fmt_magnitude #(
     reg                 pv_q;
     reg [TAG_W-1:0]     pt_q;
 
-    wire signed [IW-1:0] re_ext = {{(IW-IN_W){in_re[IN_W-1]}}, in_re};
-    wire signed [IW-1:0] im_ext = {{(IW-IN_W){in_im[IN_W-1]}}, in_im};
-    wire signed [IW-1:0] re_abs = in_re[IN_W-1] ? -re_ext : re_ext;
+    wire signed [IW-1:0] re_ext = {{(IW-IN_W){in_re_i[IN_W-1]}}, in_re_i};
+    wire signed [IW-1:0] im_ext = {{(IW-IN_W){in_im_i[IN_W-1]}}, in_im_i};
+    wire signed [IW-1:0] re_abs = in_re_i[IN_W-1] ? -re_ext : re_ext;
 
     // the constant minus its top bit, as a PW-bit unsigned operand
     wire [PW-1:0] gain_lo = GAIN_C - (1 << (GAIN_BITS - 1));
@@ -69,7 +69,7 @@ module fmt_magnitude #(
         if (rst) begin
             v_q <= {NS{1'b0}};
         end else if (ce) begin
-            v_q <= {v_q[NS-2:0], in_valid};
+            v_q <= {v_q[NS-2:0], in_valid_i};
         end
     end
 
@@ -77,7 +77,7 @@ module fmt_magnitude #(
         if (ce) begin
             x_q[0] <= re_abs <<< GUARD;
             y_q[0] <= im_ext <<< GUARD;
-            t_q[0] <= in_tag;
+            t_q[0] <= in_tag_i;
         end
     end
 
@@ -110,11 +110,11 @@ module fmt_magnitude #(
 
     always @(posedge clk) begin
         if (rst) begin
-            pv_q      <= 1'b0;
-            out_valid <= 1'b0;
+            pv_q        <= 1'b0;
+            out_valid_o <= 1'b0;
         end else if (ce) begin
-            pv_q      <= v_q[NS-1];
-            out_valid <= pv_q;
+            pv_q        <= v_q[NS-1];
+            out_valid_o <= pv_q;
         end
     end
 
@@ -122,8 +122,8 @@ module fmt_magnitude #(
         if (ce) begin
             prod_q  <= (x_fin << (GAIN_BITS - 1)) + x_fin * gain_lo;
             pt_q    <= t_q[NS-1];
-            out_mag <= prod_rnd[SH +: IN_W];
-            out_tag <= pt_q;
+            out_mag_o <= prod_rnd[SH +: IN_W];
+            out_tag_o <= pt_q;
         end
     end
 

@@ -13,10 +13,10 @@
 // leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
 // clears it.  Twin: sim/fmt/rx_fixed.py pair_split_fixed.
 // Channels (CH > 1): the input interleaves CH FFT streams in lockstep (fmt_fft_r22sdf
-// CH, in_ch = its out_ch_o): every bin arrives for channel 0, 1, .., CH-1 in turn, all
+// CH, in_ch_i = its out_ch_o): every bin arrives for channel 0, 1, .., CH-1 in turn, all
 // channels in the same bin order.  The held memory is per {channel, row} (CH x 2^ROW_W
 // entries, LUT RAM); the held bits stay one per row, read by every channel and updated
-// by channel CH-1 (the channels of a bin all see the state before that bin).  out_ch
+// by channel CH-1 (the channels of a bin all see the state before that bin).  out_ch_o
 // names the output's channel.  One split serves the CH column pairs of one
 // time-multiplexed FFT engine.
 // Requires BIN_LO >= 1 and BIN_LO + (ROWS-1)*BIN_STEP < N/2 (checked by params.py), so
@@ -39,27 +39,27 @@ module fmt_pair_split #(
     input  wire                 clk,
     input  wire                 rst,       // synchronous, active high
     input  wire                 ce,        // sample strobe
-    input  wire                 in_valid,  // FFT output bin valid
-    input  wire [LOG2_N-1:0]    in_bin,    // its bin index 0..N-1
-    input  wire signed [W-1:0]  in_re,     // Z[bin] real
-    input  wire signed [W-1:0]  in_im,     // Z[bin] imaginary
-    input  wire [TAG_W-1:0]     in_tag,    // side band (taken with the second bin of a pair)
-    input  wire [CH_W-1:0]      in_ch,     // channel of the input bin (CH > 1; unused when CH = 1)
-    output reg                  out_valid, // one row's (2A, 2B) this ce cycle
-    output reg  [ROW_W-1:0]     out_row,   // row index r
-    output reg  signed [W:0]    a_re,      // 2 Re A[k]
-    output reg  signed [W:0]    a_im,      // 2 Im A[k]
-    output reg  signed [W:0]    b_re,      // 2 Re B[k]
-    output reg  signed [W:0]    b_im,      // 2 Im B[k]
-    output reg  [TAG_W-1:0]     out_tag,   // in_tag of the second bin
-    output reg  [CH_W-1:0]      out_ch     // channel of the output row
+    input  wire                 in_valid_i, // FFT output bin valid
+    input  wire [LOG2_N-1:0]    in_bin_i,  // its bin index 0..N-1
+    input  wire signed [W-1:0]  in_re_i,   // Z[bin] real
+    input  wire signed [W-1:0]  in_im_i,   // Z[bin] imaginary
+    input  wire [TAG_W-1:0]     in_tag_i,  // side band (taken with the second bin of a pair)
+    input  wire [CH_W-1:0]      in_ch_i,   // channel of the input bin (CH > 1; unused when CH = 1)
+    output reg                  out_valid_o, // one row's (2A, 2B) this ce cycle
+    output reg  [ROW_W-1:0]     out_row_o, // row index r
+    output reg  signed [W:0]    a_re_o,    // 2 Re A[k]
+    output reg  signed [W:0]    a_im_o,    // 2 Im A[k]
+    output reg  signed [W:0]    b_re_o,    // 2 Re B[k]
+    output reg  signed [W:0]    b_im_o,    // 2 Im B[k]
+    output reg  [TAG_W-1:0]     out_tag_o, // in_tag_i of the second bin
+    output reg  [CH_W-1:0]      out_ch_o   // channel of the output row
 );
 
     localparam N   = 1 << LOG2_N;
     localparam DW  = LOG2_N + 2;           // signed width for bin differences
     localparam SPAN = ROWS * BIN_STEP;
 
-    // ---- decode: is in_bin a comb bin (k) or a mirror (N-k), and of which row ----
+    // ---- decode: is in_bin_i a comb bin (k) or a mirror (N-k), and of which row ----
     localparam [31:0]          LO_I   = BIN_LO;
     localparam [31:0]          N_I    = N;
     localparam [31:0]          SPAN_I = SPAN;
@@ -69,7 +69,7 @@ module fmt_pair_split #(
     localparam signed [DW-1:0] SPAN_S = SPAN_I[DW-1:0];
     localparam signed [DW-1:0] STEP_S = STEP_I[DW-1:0];
     localparam signed [DW-1:0] ZERO_S = 0;
-    wire signed [DW-1:0] bin_s  = {2'b00, in_bin};
+    wire signed [DW-1:0] bin_s  = {2'b00, in_bin_i};
     wire signed [DW-1:0] d_k    = bin_s - LO_S;                   // k - BIN_LO
     wire signed [DW-1:0] d_m    = N_S - bin_s - LO_S;             // (N - bin) - BIN_LO
     wire                 hit_k  = (d_k >= ZERO_S) && (d_k < SPAN_S) && ((d_k % STEP_S) == ZERO_S);
@@ -80,7 +80,7 @@ module fmt_pair_split #(
     wire signed [DW-1:0] r_m    = d_m / STEP_S;
     /* verilator lint_on UNUSEDSIGNAL */
     wire [ROW_W-1:0]     row    = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
-    wire                 hit    = in_valid && (hit_k || hit_m);
+    wire                 hit    = in_valid_i && (hit_k || hit_m);
 
     // ---- held first-of-pair memory, per {channel, row} ----
     localparam AW = (CH > 1) ? CH_W + ROW_W : ROW_W;
@@ -91,14 +91,14 @@ module fmt_pair_split #(
     wire          upd;                     // the last channel of this bin: update held_q
     generate
         if (CH > 1) begin : g_ch
-            assign addr = {in_ch, row};
-            assign upd  = (in_ch == CH_LAST);
+            assign addr = {in_ch_i, row};
+            assign upd  = (in_ch_i == CH_LAST);
         end else begin : g_one
             assign addr = row;
             assign upd  = 1'b1;
-            // one channel: in_ch is not used
+            // one channel: in_ch_i is not used
             /* verilator lint_off UNUSEDSIGNAL */
-            wire unused_ch = &{1'b0, in_ch};
+            wire unused_ch = &{1'b0, in_ch_i};
             /* verilator lint_on UNUSEDSIGNAL */
         end
     endgenerate
@@ -111,31 +111,31 @@ module fmt_pair_split #(
     wire signed [W-1:0] h_re     = rd[2*W-1:W];
     wire signed [W-1:0] h_im     = rd[W-1:0];
     // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
-    wire signed [W:0]   p_re = hit_m ? {h_re[W-1], h_re}   : {in_re[W-1], in_re};
-    wire signed [W:0]   p_im = hit_m ? {h_im[W-1], h_im}   : {in_im[W-1], in_im};
-    wire signed [W:0]   q_re = hit_m ? {in_re[W-1], in_re} : {h_re[W-1], h_re};
-    wire signed [W:0]   q_im = hit_m ? {in_im[W-1], in_im} : {h_im[W-1], h_im};
+    wire signed [W:0]   p_re = hit_m ? {h_re[W-1], h_re}   : {in_re_i[W-1], in_re_i};
+    wire signed [W:0]   p_im = hit_m ? {h_im[W-1], h_im}   : {in_im_i[W-1], in_im_i};
+    wire signed [W:0]   q_re = hit_m ? {in_re_i[W-1], in_re_i} : {h_re[W-1], h_re};
+    wire signed [W:0]   q_im = hit_m ? {in_im_i[W-1], in_im_i} : {h_im[W-1], h_im};
 
     // the second arrival of a pair: the other member is held
     wire                second   = held && (rd[2*W] != hit_m);
 
     always @(posedge clk) begin
         if (ce && hit && !second) begin
-            mem[addr] <= {hit_m, in_re, in_im};
+            mem[addr] <= {hit_m, in_re_i, in_im_i};
         end
     end
 
     always @(posedge clk) begin
         if (rst) begin
-            held_q    <= {ROWS{1'b0}};
-            out_valid <= 1'b0;
+            held_q      <= {ROWS{1'b0}};
+            out_valid_o <= 1'b0;
         end else if (ce) begin
-            out_valid <= 1'b0;
+            out_valid_o <= 1'b0;
             if (hit) begin
                 // the second arrival must be the other member of the pair
                 if (second) begin
                     if (upd) held_q[row] <= 1'b0;
-                    out_valid <= 1'b1;
+                    out_valid_o <= 1'b1;
                 end else if (upd) begin
                     held_q[row] <= 1'b1;   // first arrival (or a repeat: keep the newest)
                 end
@@ -145,13 +145,13 @@ module fmt_pair_split #(
 
     always @(posedge clk) begin
         if (ce) begin
-            out_row <= row;
-            a_re    <= p_re + q_re;
-            a_im    <= p_im - q_im;
-            b_re    <= p_im + q_im;
-            b_im    <= q_re - p_re;
-            out_tag <= in_tag;
-            out_ch  <= in_ch;
+            out_row_o <= row;
+            a_re_o    <= p_re + q_re;
+            a_im_o    <= p_im - q_im;
+            b_re_o    <= p_im + q_im;
+            b_im_o    <= q_re - p_re;
+            out_tag_o <= in_tag_i;
+            out_ch_o  <= in_ch_i;
         end
     end
 

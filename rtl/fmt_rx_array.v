@@ -26,10 +26,10 @@
 //           R M - 2^(T+l) < M <= 2^l; rx_fixed.recip / recip_divide, tested exhaustively
 //           at small T and by the bound for every M at the build's T); for M = 2^m exactly
 //           (sum + 2^m) >> (m + 1), the arithmetic of fmt_accum.  R comes from
-//           TW_DIR/fmt_recip.hex (rx_fixed.recip_rom: ceil(2^(40+l) / M) for M = 0..255)
+//           fmt_recip.hex (rx_fixed.recip_rom: ceil(2^(40+l) / M) for M = 0..255)
 //           as ceil(entry / 2^(40-T)) (one add per row).  Then saturate to HM_W bits
 //   stream  group g's cells go into the row register at [g*MAG_UNITS*HM_W]; after the
-//           last group hm_valid is high for one clk with the whole row
+//           last group hm_valid_o is high for one clk with the whole row
 // A "step" is a clk (POST_CLK = 1) or a ce cycle (POST_CLK = 0); rows complete at most
 // one per ce, in the FFT's bit-reversed order (bursts of two then >= 7 slots at N = 256;
 // sim/fmt/rx_fixed.py row_order).
@@ -42,9 +42,9 @@
 // processed in a window); at run time (ce faster than CLK_PER_SAMPLE says) a row arriving
 // with the queue full or while its previous window's copy is still queued or being fed
 // sets the sticky overrun bit, reported in ovf_o.  Twin: rx_fixed.rx_share_schedule.
-// Stream: hm_valid one clk per row, hm_row its index, hm_frame the frame number (wraps,
-// FRAME_W bits, from 0 after reset), hm_data column c at [c*HM_W +: HM_W] (valid with
-// hm_valid), hm_eof one step after the frame's last row, never with a row.  Frame =
+// Stream: hm_valid_o one clk per row, hm_row_o its index, hm_frame_o the frame number (wraps,
+// FRAME_W bits, from 0 after reset), hm_data_o column c at [c*HM_W +: HM_W] (valid with
+// hm_valid_o), hm_eof_o one step after the frame's last row, never with a row.  Frame =
 // M = m_i windows, any 1 .. M_MAX (latched at a frame's first window; 0 is taken as 1,
 // values above M_MAX as M_MAX; fmt_rx_pair_front); a reset in the middle of a window
 // drops it and the stream restarts with the first full frame.
@@ -58,7 +58,7 @@
 // row register); the same for every M (counted from the frame's last window).  N = 256,
 // 30 x 40: last row 300 ce cycles after the window's last sample at ce = 1 (K = 10); at
 // 3 x fs (K = 4) 810 clk = 270.0 fs cycles with FFT_CH = 3 (854 clk with FFT_CH = 1),
-// hm_eof 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
+// hm_eof_o 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
 // heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
 // before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
@@ -77,7 +77,6 @@ module fmt_rx_array #(
     parameter HM_W       = `FMT_HM_W,      // heat-map cell width (unsigned)
     parameter FRAME_W    = 16,             // frame counter width
     parameter M_MAX      = 255,            // largest windows per frame M (1 .. 255)
-    parameter TW_DIR     = "rtl/",         // directory of the hex files (FFT twiddles, fmt_recip.hex)
     parameter POST_CLK   = 1,              // 1: back end after the FFT on every clk, 0: on ce
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
     parameter MC_W       = $clog2(M_MAX + 1),                  // width of m_i
@@ -95,11 +94,11 @@ module fmt_rx_array #(
     input  wire [COLS*ADC_BITS-1:0] adc_i,     // column c ADC sample at [c*ADC_BITS +: ADC_BITS]
     input  wire                     rx_sign_i, // receive PN sign (fmt_pn_gen rx_sign_o)
     input  wire [MC_W-1:0]          m_i,       // windows per frame M (0 = 1, > M_MAX = M_MAX)
-    output reg                      hm_valid,  // heat-map row beat
-    output reg  [ROW_W-1:0]         hm_row,    // row index
-    output reg  [FRAME_W-1:0]       hm_frame,  // frame number
-    output wire [COLS*HM_W-1:0]     hm_data,   // the row's cells
-    output reg                      hm_eof,    // end of frame marker
+    output reg                      hm_valid_o, // heat-map row beat
+    output reg  [ROW_W-1:0]         hm_row_o,  // row index
+    output reg  [FRAME_W-1:0]       hm_frame_o, // frame number
+    output wire [COLS*HM_W-1:0]     hm_data_o, // the row's cells
+    output reg                      hm_eof_o,  // end of frame marker
     output wire                     fft_ovf_o, // sticky: an FFT saturated
     output wire                     sat_o,     // sticky: a heat-map cell saturated
     output wire                     ovf_o      // sticky: either of the above or a queue overrun
@@ -200,7 +199,7 @@ module fmt_rx_array #(
                 fmt_rx_pair_front #(
                     .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
                     .ADC_BITS(ADC_BITS), .M_MAX(M_MAX), .FFT_OUT_W(W),
-                    .TW_DIR(TW_DIR), .POST_CLK(POST_CLK), .ROW_W(ROW_W), .MC_W(MC_W)
+                    .POST_CLK(POST_CLK), .ROW_W(ROW_W), .MC_W(MC_W)
                 ) u_front (
                     .clk(clk), .rst(rst), .ce(ce),
                     .adc_a_i(adc_i[(2*p)*ADC_BITS +: ADC_BITS]),
@@ -237,7 +236,7 @@ module fmt_rx_array #(
                 fmt_rx_group_front #(
                     .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
                     .ADC_BITS(ADC_BITS), .M_MAX(M_MAX), .FFT_OUT_W(W),
-                    .TW_DIR(TW_DIR), .G(GC), .NP(NPG), .ROW_W(ROW_W), .MC_W(MC_W),
+                    .G(GC), .NP(NPG), .ROW_W(ROW_W), .MC_W(MC_W),
                     .CH_W(GCH_W)
                 ) u_front (
                     .clk(clk), .rst(rst), .ce(ce),
@@ -351,19 +350,19 @@ module fmt_rx_array #(
             end
             if (u == 0) begin : g_lead
                 fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag (
-                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid(busy_q),
-                    .in_re(sel[MW-1:0]), .in_im(sel[CW-1:MW]),
-                    .in_tag({row_q, g_q, etag_q}),
-                    .out_valid(mg_valid), .out_mag(mags[u*MW +: MW]), .out_tag(mg_tag));
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(busy_q),
+                    .in_re_i(sel[MW-1:0]), .in_im_i(sel[CW-1:MW]),
+                    .in_tag_i({row_q, g_q, etag_q}),
+                    .out_valid_o(mg_valid), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(mg_tag));
             end else begin : g_follow
                 // runs in lockstep with unit 0: its valid and tag are unit 0's
                 /* verilator lint_off UNUSEDSIGNAL */
                 wire unused_v, unused_t;
                 /* verilator lint_on UNUSEDSIGNAL */
                 fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag (
-                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid(busy_q),
-                    .in_re(sel[MW-1:0]), .in_im(sel[CW-1:MW]), .in_tag(1'b0),
-                    .out_valid(unused_v), .out_mag(mags[u*MW +: MW]), .out_tag(unused_t));
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(busy_q),
+                    .in_re_i(sel[MW-1:0]), .in_im_i(sel[CW-1:MW]), .in_tag_i(1'b0),
+                    .out_valid_o(unused_v), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(unused_t));
             end
         end
     endgenerate
@@ -417,7 +416,13 @@ module fmt_rx_array #(
         a_m8 = 8'd0;
         a_m8[MC_W-1:0] = a_tag_q[MC_W+1:2];
     end
-    initial $readmemh({TW_DIR, "fmt_recip.hex"}, recip_rom);
+    initial begin
+`ifdef FMT_ROM_DIR
+        $readmemh({`FMT_ROM_DIR, "fmt_recip.hex"}, recip_rom);
+`else
+        $readmemh("fmt_recip.hex", recip_rom);
+`endif
+    end
     always @(posedge clk) begin
         if (post_ce) begin
             b_sum_q <= sum_d;
@@ -529,7 +534,7 @@ module fmt_rx_array #(
                 if (c_g_q == gg[G_W-1:0]) row_q_data[gg*K*HM_W +: K*HM_W] <= c_cells_q;
         end
     end
-    assign hm_data = row_q_data[COLS*HM_W-1:0];
+    assign hm_data_o = row_q_data[COLS*HM_W-1:0];
     generate
         if (P * K > COLS) begin : g_pad_out
             // the last group's cells beyond COLS are zero magnitudes of padding
@@ -540,31 +545,31 @@ module fmt_rx_array #(
     endgenerate
 
     wire row_done = c_valid_q && (c_g_q == G_LAST);
-    reg  eof_pend_q;   // the frame's last row has gone out, hm_eof follows
+    reg  eof_pend_q;   // the frame's last row has gone out, hm_eof_o follows
     always @(posedge clk) begin
         if (rst) begin
             eof_pend_q <= 1'b0;
-            hm_valid   <= 1'b0;
-            hm_eof     <= 1'b0;
-            hm_frame   <= {FRAME_W{1'b0}};
+            hm_valid_o <= 1'b0;
+            hm_eof_o   <= 1'b0;
+            hm_frame_o <= {FRAME_W{1'b0}};
         end else begin
-            hm_valid <= 1'b0;
-            hm_eof   <= 1'b0;
+            hm_valid_o <= 1'b0;
+            hm_eof_o   <= 1'b0;
             if (post_ce) begin
                 if (row_done) begin
-                    hm_valid <= 1'b1;
+                    hm_valid_o <= 1'b1;
                     if (c_row_q == LAST_ROW[ROW_W-1:0]) eof_pend_q <= 1'b1;
                 end else if (eof_pend_q) begin
-                    hm_eof     <= 1'b1;
+                    hm_eof_o   <= 1'b1;
                     eof_pend_q <= 1'b0;
                 end
             end
-            if (hm_eof) hm_frame <= hm_frame + 1'b1;
+            if (hm_eof_o) hm_frame_o <= hm_frame_o + 1'b1;
         end
     end
 
     always @(posedge clk) begin
-        if (post_ce && row_done) hm_row <= c_row_q;
+        if (post_ce && row_done) hm_row_o <= c_row_q;
     end
 
     assign fft_ovf_o = fft_ovf_any;

@@ -38,7 +38,6 @@ module fmt_rx_group_front #(
     parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
     parameter M_MAX      = 255,            // largest windows per frame M (<= 255)
     parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
-    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter G          = 3,              // column pairs per engine (FFT channels), >= 2
     parameter NP         = G,              // pairs actually connected, 1..G
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
@@ -126,11 +125,11 @@ module fmt_rx_group_front #(
     wire [CH_W-1:0]     f_ch;
     wire signed [W-1:0] f_re, f_im;
     fmt_fft_r22sdf #(
-        .LOG2_N(LOG2_N), .IN_W(XW), .OUT_W(W), .TW_DIR(TW_DIR), .CH(G), .CH_W(CH_W)
+        .LOG2_N(LOG2_N), .IN_W(XW), .OUT_W(W), .CH(G), .CH_W(CH_W)
     ) u_fft (
-        .clk(clk), .rst(rst), .ce(run_q), .in_re(xa), .in_im(xb),
-        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
-        .out_re(f_re), .out_im(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
+        .clk(clk), .rst(rst), .ce(run_q), .in_re_i(xa), .in_im_i(xb),
+        .out_valid_o(f_valid), .out_slot_o(f_slot), .out_bin_o(f_bin),
+        .out_re_o(f_re), .out_im_o(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
 
     // ---- window / frame bookkeeping (at the FFT output; channel 0 opens a window) ----
     wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}}) && (f_ch == {CH_W{1'b0}});
@@ -147,11 +146,11 @@ module fmt_rx_group_front #(
         .W(W), .TAG_W(MC_W + 2), .ROW_W(ROW_W), .CH(G), .CH_W(CH_W)
     ) u_split (
         .clk(clk), .rst(rst), .ce(1'b1),
-        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
-        .in_tag({m_cur, w_first, w_last}), .in_ch(f_ch),
-        .out_valid(ps_valid_o), .out_row(ps_row_o),
-        .a_re(s_ar), .a_im(s_ai), .b_re(s_br), .b_im(s_bi), .out_tag(ps_tag_o),
-        .out_ch(ps_ch_o));
+        .in_valid_i(f_valid), .in_bin_i(f_bin), .in_re_i(f_re), .in_im_i(f_im),
+        .in_tag_i({m_cur, w_first, w_last}), .in_ch_i(f_ch),
+        .out_valid_o(ps_valid_o), .out_row_o(ps_row_o),
+        .a_re_o(s_ar), .a_im_o(s_ai), .b_re_o(s_br), .b_im_o(s_bi), .out_tag_o(ps_tag_o),
+        .out_ch_o(ps_ch_o));
 
     // ---- result memories, one per pair (read all at once by the shared magnitude units)
     genvar p;

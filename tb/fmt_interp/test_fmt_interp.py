@@ -90,15 +90,15 @@ class TB(ClockedTB):
 
     def idle(self):
         d = self.dut
-        d.cand_valid.value = 0
-        d.cand_eof.value = 0
-        d.cand_frame.value = 0
-        d.cand_row.value = 0
-        d.cand_col.value = 0
-        d.cand_z.value = 0
-        d.cand_missing.value = 0
-        d.cand_count.value = 0
-        d.cand_overflow.value = 0
+        d.cand_valid_i.value = 0
+        d.cand_eof_i.value = 0
+        d.cand_frame_i.value = 0
+        d.cand_row_i.value = 0
+        d.cand_col_i.value = 0
+        d.cand_z_i.value = 0
+        d.cand_missing_i.value = 0
+        d.cand_count_i.value = 0
+        d.cand_overflow_i.value = 0
         d.moore_i.value = 1
         d.bias_en_i.value = 1
 
@@ -108,16 +108,16 @@ class TB(ClockedTB):
             await RisingEdge(self.clk)
             await ReadOnly()
             self.cycle += 1
-            if not (d.tp_valid.value.is_resolvable and d.tp_eof.value.is_resolvable):
+            if not (d.tp_valid_o.value.is_resolvable and d.tp_eof_o.value.is_resolvable):
                 continue            # before the reset
-            if int(d.tp_valid.value):
+            if int(d.tp_valid_o.value):
                 self.out.append((self.cycle, "tp", (
-                    int(d.tp_frame.value), int(d.tp_x.value), int(d.tp_y.value),
-                    int(d.tp_strength.value), int(d.tp_axis_major.value),
-                    int(d.tp_axis_minor.value), int(d.tp_angle.value), int(d.tp_flags.value))))
-            if int(d.tp_eof.value):
-                self.out.append((self.cycle, "eof", (int(d.tp_frame.value), int(d.tp_count.value),
-                                                     int(d.tp_overflow.value))))
+                    int(d.tp_frame_o.value), int(d.tp_x_o.value), int(d.tp_y_o.value),
+                    int(d.tp_strength_o.value), int(d.tp_axis_major_o.value),
+                    int(d.tp_axis_minor_o.value), int(d.tp_angle_o.value), int(d.tp_flags_o.value))))
+            if int(d.tp_eof_o.value):
+                self.out.append((self.cycle, "eof", (int(d.tp_frame_o.value), int(d.tp_count_o.value),
+                                                     int(d.tp_overflow_o.value))))
 
     async def drive(self, beats):
         """beats: list of None (idle), ('c', cand, frame, moore, bias) or ('e', frame, count, ovf).
@@ -129,12 +129,12 @@ class TB(ClockedTB):
             self.idle()
             if b is not None and b[0] == "c":
                 _, c, frame, moore, bias = b
-                d.cand_valid.value = 1
-                d.cand_frame.value = frame
-                d.cand_row.value = c.row
-                d.cand_col.value = c.col
-                d.cand_z.value = c.packed_z(self.cfg.hm_width)
-                d.cand_missing.value = c.missing
+                d.cand_valid_i.value = 1
+                d.cand_frame_i.value = frame
+                d.cand_row_i.value = c.row
+                d.cand_col_i.value = c.col
+                d.cand_z_i.value = c.packed_z(self.cfg.hm_width)
+                d.cand_missing_i.value = c.missing
                 d.moore_i.value = int(moore)
                 d.bias_en_i.value = int(bias)
                 tp = interp.interp_fixed(c, self.cfg, moore=moore, bias=bias, frame=frame)
@@ -142,10 +142,10 @@ class TB(ClockedTB):
                                                    tp.axis_minor, tp.angle, tp.flags)))
             elif b is not None and b[0] == "e":
                 _, frame, count, ovf = b
-                d.cand_eof.value = 1
-                d.cand_frame.value = frame
-                d.cand_count.value = count
-                d.cand_overflow.value = ovf
+                d.cand_eof_i.value = 1
+                d.cand_frame_i.value = frame
+                d.cand_count_i.value = count
+                d.cand_overflow_i.value = ovf
                 exp.append((self.cycle + 1, "eof", (frame, count, ovf)))
         await self.writable()
         self.idle()
@@ -238,6 +238,6 @@ def test_fmt_interp(sim, cfg):
     p = c.verilog_params()
     run_cocotb(
         sim, "fmt_interp", rtl_sources(*MODULES), "test_fmt_interp",
-        parameters={"ROWS": p["ROWS"], "COLS": p["COLS"], "HM_W": p["HM_W"]},
+        parameters={k: p[k] for k in ("ROWS", "COLS", "HM_W")},
         extra_env={"CFG": cfg, "SEED": 1 if cfg == "small" else 2},
         test_dir=Path(__file__).parent, build_args=build_args(sim), tag=cfg)

@@ -26,10 +26,10 @@ class TB(ClockedTB):
         self.w = env_int("IN_W", 19)
         self.iters = env_int("ITER", 12)
         dut.ce.value = 0
-        dut.in_valid.value = 0
-        dut.in_re.value = 0
-        dut.in_im.value = 0
-        dut.in_tag.value = 0
+        dut.in_valid_i.value = 0
+        dut.in_re_i.value = 0
+        dut.in_im_i.value = 0
+        dut.in_tag_i.value = 0
 
     async def stream(self, re_, im_, ce_prob=1.0, rng=None):
         """Drive samples (one per ce), return [(ce_index_of_output, mag, tag)] and the
@@ -44,12 +44,12 @@ class TB(ClockedTB):
             ce = 1 if rng.random() < ce_prob else 0
             dut.ce.value = ce
             if i < n:
-                dut.in_valid.value = 1
-                dut.in_re.value = int(re_[i])
-                dut.in_im.value = int(im_[i])
-                dut.in_tag.value = i & 0xFF
+                dut.in_valid_i.value = 1
+                dut.in_re_i.value = int(re_[i])
+                dut.in_im_i.value = int(im_[i])
+                dut.in_tag_i.value = i & 0xFF
             else:
-                dut.in_valid.value = 0
+                dut.in_valid_i.value = 0
             await RisingEdge(self.clk)
             await ReadOnly()
             if ce:
@@ -57,8 +57,8 @@ class TB(ClockedTB):
                     in_at.append(ce_idx)
                     i += 1
                 ce_idx += 1
-                if int(dut.out_valid.value):
-                    outs.append((ce_idx, int(dut.out_mag.value), int(dut.out_tag.value)))
+                if int(dut.out_valid_o.value):
+                    outs.append((ce_idx, int(dut.out_mag_o.value), int(dut.out_tag_o.value)))
         return outs, in_at
 
 
@@ -105,16 +105,16 @@ async def reset_clears_valid(dut):
     await tb.reset()
     await tb.writable()
     dut.ce.value = 1
-    dut.in_valid.value = 1
+    dut.in_valid_i.value = 1
     await tb.cycles(5)
     await tb.reset(cycles=1)
-    dut.in_valid.value = 0
+    dut.in_valid_i.value = 0
     dut.ce.value = 1
     seen = 0
     for _ in range(tb.iters + 6):
         await RisingEdge(tb.clk)
         await ReadOnly()
-        seen += int(dut.out_valid.value)
+        seen += int(dut.out_valid_o.value)
     assert seen == 0, "samples in flight at reset must not come out"
 
 

@@ -27,7 +27,7 @@ class TB(ClockedTB):
         super().__init__(dut)
         self.cfg = params.get(env_str("CFG", "small"))
         self.w = env_int("W", 18)
-        for s in ("ce", "in_valid", "in_bin", "in_re", "in_im", "in_tag", "in_ch"):
+        for s in ("ce", "in_valid_i", "in_bin_i", "in_re_i", "in_im_i", "in_tag_i", "in_ch_i"):
             getattr(dut, s).value = 0
 
     async def run(self, order, z_re, z_im, ce_prob=1.0, rng=None, gaps=False):
@@ -44,22 +44,22 @@ class TB(ClockedTB):
             if i < len(items):
                 w, s = items[i]
                 b = order[s]
-                dut.in_valid.value = 1
-                dut.in_bin.value = int(b)
-                dut.in_re.value = int(z_re[w, b])
-                dut.in_im.value = int(z_im[w, b])
-                dut.in_tag.value = w & 0xF
+                dut.in_valid_i.value = 1
+                dut.in_bin_i.value = int(b)
+                dut.in_re_i.value = int(z_re[w, b])
+                dut.in_im_i.value = int(z_im[w, b])
+                dut.in_tag_i.value = w & 0xF
             else:
-                dut.in_valid.value = 0
+                dut.in_valid_i.value = 0
             await RisingEdge(self.clk)
             await ReadOnly()
             if ce:
-                if int(dut.out_valid.value):
+                if int(dut.out_valid_o.value):
                     assert i < len(items), "output without a bin in"
                     ow, os_ = items[i]
-                    outs.append((int(dut.out_tag.value), int(dut.out_row.value),
-                                 dut.a_re.value.to_signed(), dut.a_im.value.to_signed(),
-                                 dut.b_re.value.to_signed(), dut.b_im.value.to_signed(), os_))
+                    outs.append((int(dut.out_tag_o.value), int(dut.out_row_o.value),
+                                 dut.a_re_o.value.to_signed(), dut.a_im_o.value.to_signed(),
+                                 dut.b_re_o.value.to_signed(), dut.b_im_o.value.to_signed(), os_))
                 if i < len(items):
                     i += 1
                 else:
@@ -151,24 +151,24 @@ async def run_ch(tb, order, zs_re, zs_im, ch, ce_prob=1.0, rng=None):
         if i < len(items):
             w, s, c = items[i]
             b = order[s]
-            dut.in_valid.value = 1
-            dut.in_bin.value = int(b)
-            dut.in_ch.value = c
-            dut.in_re.value = int(zs_re[c, w, b])
-            dut.in_im.value = int(zs_im[c, w, b])
-            dut.in_tag.value = w & 0xF
+            dut.in_valid_i.value = 1
+            dut.in_bin_i.value = int(b)
+            dut.in_ch_i.value = c
+            dut.in_re_i.value = int(zs_re[c, w, b])
+            dut.in_im_i.value = int(zs_im[c, w, b])
+            dut.in_tag_i.value = w & 0xF
         else:
-            dut.in_valid.value = 0
+            dut.in_valid_i.value = 0
         await RisingEdge(tb.clk)
         await ReadOnly()
         if ce:
-            if int(dut.out_valid.value):
+            if int(dut.out_valid_o.value):
                 assert i < len(items), "output without a bin in"
                 _, os_, oc = items[i]
-                assert int(dut.out_ch.value) == oc, f"out_ch {int(dut.out_ch.value)}, input channel {oc}"
-                outs.append((oc, int(dut.out_tag.value), int(dut.out_row.value),
-                             dut.a_re.value.to_signed(), dut.a_im.value.to_signed(),
-                             dut.b_re.value.to_signed(), dut.b_im.value.to_signed(), os_))
+                assert int(dut.out_ch_o.value) == oc, f"out_ch_o {int(dut.out_ch_o.value)}, input channel {oc}"
+                outs.append((oc, int(dut.out_tag_o.value), int(dut.out_row_o.value),
+                             dut.a_re_o.value.to_signed(), dut.a_im_o.value.to_signed(),
+                             dut.b_re_o.value.to_signed(), dut.b_im_o.value.to_signed(), os_))
             if i < len(items):
                 i += 1
             else:
@@ -201,7 +201,7 @@ async def channels_lockstep(dut):
 
 @pytest.mark.parametrize("cfg_name", ["small", "medium"])
 def test_fmt_pair_split(sim, cfg_name, ch=1):
-    cfg = params.get(cfg_name)
+    p = params.get(cfg_name).verilog_params()
     w = 18
     run_cocotb(
         sim=sim,
@@ -209,8 +209,8 @@ def test_fmt_pair_split(sim, cfg_name, ch=1):
         sources=rtl_sources("fmt_pair_split"),
         test_module="test_fmt_pair_split",
         test_dir=Path(__file__).parent,
-        parameters={"LOG2_N": cfg.log2_n, "ROWS": cfg.rows, "BIN_LO": cfg.bin_lo,
-                    "BIN_STEP": cfg.bin_step, "W": w, "TAG_W": 4, "CH": ch},
+        parameters={**{k: p[k] for k in ("LOG2_N", "ROWS", "BIN_LO", "BIN_STEP")},
+                    "W": w, "TAG_W": 4, "CH": ch},
         extra_env={"CFG": cfg_name, "W": w, "CH": ch},
         testcase="channels_lockstep" if ch > 1 else None,
         build_args=["-CFLAGS", "-O0"] if sim == "verilator" else None,   # compile time dominates

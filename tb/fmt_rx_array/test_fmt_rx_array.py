@@ -4,7 +4,7 @@ receivers) against rx_heatmaps_fixed (sim/fmt/rx_fixed.py).
 Checks: heat maps bit-exact for touch-like stirred tones with random PN settings (on/off,
 chip length, delay) and M = 1, 2, 3, 5 windows per frame (any M: the exact reciprocal
 divider; M_LIST); the heat-map stream protocol (each row once per
-frame in rx_fixed.row_order, frame numbers from 0, hm_eof one cycle after the last row
+frame in rx_fixed.row_order, frame numbers from 0, hm_eof_o one cycle after the last row
 and never with a row); accuracy against a floating-point receiver (numpy FFT, exact
 split and magnitude, mean over M) within 2 LSB; the hard cases (palm = saturated column,
 DC offset, impulse, tone between bins, all rows in phase, full-scale random, full-scale
@@ -12,7 +12,7 @@ tone: sticky saturation flag exactly when the model saturates); a reset in the m
 a window (the stream restarts cleanly with the next full frame); ce = 1 in 3
 (CLK_PER_SAMPLE = 3); every row's beat time (the schedule of the shared magnitude units,
 rx_fixed.rx_row_beats) and the LATENCY from a window's last ADC sample to its last row and
-to hm_eof, written to build/rx_latency_<cfg>_postclk<p>_cps<c>.txt; the sticky queue
+to hm_eof_o, written to build/rx_latency_<cfg>_postclk<p>_cps<c>.txt; the sticky queue
 overrun (ovf_o) when ce comes faster than the units were sized for.
 """
 from __future__ import annotations
@@ -29,6 +29,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common.runner import ROOT, rtl_sources, run_cocotb   # noqa: E402
+from common.sources import rom_define                     # noqa: E402
 from common.tb_util import ClockedTB, env_int, env_str    # noqa: E402
 from fmt import fft_fixed, params                         # noqa: E402
 from fmt import rx_fixed as R                             # noqa: E402
@@ -40,7 +41,7 @@ FLOAT_BOUND_LSB = 2.0
 # C++ compile dominates these short runs.
 VERILATOR_ARGS = ["--output-split", "0", "-CFLAGS", "-O0"]
 RTL_FILES = ["fmt_rx_array", "fmt_rx_pair_front", "fmt_rx_group_front", "fmt_rx_frame_win", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf",
-             "fmt_fft_delay", "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
+             "fmt_fft_delay", "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude"]
 
 
 class TB(ClockedTB):
@@ -99,11 +100,11 @@ class TB(ClockedTB):
             if ce:
                 taken.append(clk_n)
                 i += 1
-            if int(dut.hm_valid.value):
-                assert not int(dut.hm_eof.value), "hm_eof in the same cycle as a row beat"
-                beats.append((clk_n, int(dut.hm_row.value), int(dut.hm_frame.value), int(dut.hm_data.value)))
-            if int(dut.hm_eof.value):
-                eofs.append((clk_n, int(dut.hm_frame.value)))
+            if int(dut.hm_valid_o.value):
+                assert not int(dut.hm_eof_o.value), "hm_eof_o in the same cycle as a row beat"
+                beats.append((clk_n, int(dut.hm_row_o.value), int(dut.hm_frame_o.value), int(dut.hm_data_o.value)))
+            if int(dut.hm_eof_o.value):
+                eofs.append((clk_n, int(dut.hm_frame_o.value)))
             clk_n += 1
         return beats, eofs, taken
 
@@ -113,12 +114,12 @@ class TB(ClockedTB):
         order = R.row_order(cfg)
         hm = np.zeros((nframes, cfg.rows, cfg.cols), dtype=np.int64)
         assert len(beats) >= nframes * cfg.rows, f"{len(beats)} row beats, expected >= {nframes * cfg.rows}"
-        assert len(eofs) >= nframes, f"{len(eofs)} hm_eof, expected >= {nframes}"
+        assert len(eofs) >= nframes, f"{len(eofs)} hm_eof_o, expected >= {nframes}"
         mask = (1 << cfg.hm_width) - 1
         for f in range(nframes):
             fb = beats[f * cfg.rows:(f + 1) * cfg.rows]
             assert [b[1] for b in fb] == order.tolist(), f"frame {f}: rows {[b[1] for b in fb]}"
-            assert all(b[2] == f for b in fb), f"frame {f}: hm_frame {[b[2] for b in fb]}"
+            assert all(b[2] == f for b in fb), f"frame {f}: hm_frame_o {[b[2] for b in fb]}"
             ec, ef = eofs[f]
             assert ef == f and ec > fb[-1][0], f"frame {f}: eof at {ec} (frame {ef}), last row at {fb[-1][0]}"
             if f + 1 < len(beats) // cfg.rows:
@@ -198,7 +199,7 @@ async def reset_mid_window(dut):
     pre = rx_stim.uniform_random(cfg, 3 * n, rng)
     await tb.reset()
     beats0, eofs0, _ = await tb.run(pre, np.zeros(len(pre), np.uint8), 1, tail=0, stop_at=3 * n // 2)
-    # window 0's early rows may be out already (a cut frame, never with hm_eof): the
+    # window 0's early rows may be out already (a cut frame, never with hm_eof_o): the
     # touch processing is reset with the receiver
     assert len(beats0) < cfg.rows and not eofs0 and all(b[2] == 0 for b in beats0)
     await tb.reset(cycles=1)
@@ -288,7 +289,7 @@ async def overrun_flag(dut):
 
 
 def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1, cps=None, params_extra=None):
-    cfg = params.get(cfg_name)
+    p = params.get(cfg_name).verilog_params()
     cps = (3 if post_clk else 1) if cps is None else cps
     fft_ch = (params_extra or {}).get("FFT_CH", R.rx_fft_ch_default(post_clk, cps))
     env = {"CFG": cfg_name, "POST_CLK": post_clk, "CPS": cps, "FFT_CH": fft_ch}
@@ -299,13 +300,11 @@ def _run(sim, cfg_name, extra=None, testcase=None, post_clk=1, cps=None, params_
         sources=rtl_sources(*RTL_FILES),
         test_module="test_fmt_rx_array",
         test_dir=Path(__file__).parent,
-        parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
-                    "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
-                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"', "POST_CLK": post_clk,
-                    "CLK_PER_SAMPLE": cps, **(params_extra or {})},
+        parameters={**{k: p[k] for k in ("ROWS", "COLS", "LOG2_N", "BIN_LO", "BIN_STEP", "ADC_BITS", "HM_W")},
+                    "POST_CLK": post_clk, "CLK_PER_SAMPLE": cps, **(params_extra or {})},
         extra_env=env,
         testcase=testcase,
-        build_args=VERILATOR_ARGS if sim == "verilator" else None,
+        build_args=[rom_define()] + (VERILATOR_ARGS if sim == "verilator" else []),
     )
 
 

@@ -36,7 +36,7 @@ from fmt.tracking import TrackParams
 MODULES = ["fmt_touch", "fmt_flatten", "fmt_localmax", "fmt_interp", "fmt_interp_dly",
            "fmt_interp_cordic", "fmt_div", "fmt_interp_lg", "fmt_interp_exp",
            "fmt_interp_bias_rom", "fmt_tracker", "fmt_tracker_vel", "fmt_event_port",
-           "fmt_blob"]
+           "fmt_blob", "fmt_sorted_list"]
 BUDGET = 120
 BLOB_BUDGET = 200              # blobs on: + the wait for the blob mask and the replay
 FRAME_PERIOD_S = 1e-3          # scaled timeline for the tracking settings
@@ -358,15 +358,14 @@ def test_fmt_touch(sim, cfg_name):
 
 
 def _run_touch(sim, cfg_name):
-    cfg = params.get(cfg_name)
+    p = params.get(cfg_name).verilog_params()
     run_cocotb(
         sim=sim,
         toplevel="fmt_touch",
         sources=rtl_sources(*MODULES),
         test_module="test_fmt_touch",
         test_dir=Path(__file__).parent,
-        parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
-                    "MAX_TOUCHES": cfg.max_touches, "EV_DEPTH": 256},
+        parameters={**{k: p[k] for k in ("ROWS", "COLS", "HM_W", "MAX_TOUCHES")}, "EV_DEPTH": 256},
         extra_env={"CFG": cfg_name, "SEED": 1},
         build_args=build_args(sim), tag=cfg_name,
     )

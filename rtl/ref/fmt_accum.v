@@ -1,17 +1,20 @@
+// Reference only: not instantiated by fmt_core; kept as the documented, tested reference of
+// the frame accumulation for M = 2^m (exact sum, round half up, saturation: rx_fixed.accum_fixed,
+// tb/fmt_accum), which fmt_rx_array's shared accumulator extends to any M.
 // fmt_accum -- accumulates per-cell signal strengths over the M windows of a frame
 // and scales the sum to HM_W-bit unsigned heat-map cells, saturating.
 //
 // One beat = one row (cell) of LANES columns (D_W-bit unsigned magnitudes each); each
 // row comes once per window.  M = 2^m_log2 windows per frame (run-time, carried per beat
-// as in_shift = m_log2 so a change never splits a frame); in_first / in_last mark the
+// as in_shift_i = m_log2 so a change never splits a frame); in_first_i / in_last_i mark the
 // first and last window of the frame (both 1 when M = 1).
-//   sum   = in_first ? mag : mem[row] + mag           (SUM_W = D_W + M_LOG2_MAX bits, exact)
-//   cell  = (sum + 2^(s-1)) >> s,  s = in_shift + HM_SHIFT   (round half up; s = 0: sum)
+//   sum   = in_first_i ? mag : mem[row] + mag         (SUM_W = D_W + M_LOG2_MAX bits, exact)
+//   cell  = (sum + 2^(s-1)) >> s,  s = in_shift_i + HM_SHIFT (round half up; s = 0: sum)
 //   out   = min(cell, 2^HM_W - 1), sat_o sticky when the min clips
 // HM_SHIFT includes the factor 2 of fmt_pair_split (HM_SHIFT = 1: cell = |A| in FFT
 // output LSBs, averaged over M).  Per-cell storage: ROWS x LANES*SUM_W bits, an
 // inferred distributed RAM (read asynchronously, written at the beat).
-// Latency: 2 ce cycles from the beat to out_valid (only for in_last beats).
+// Latency: 2 ce cycles from the beat to out_valid_o (only for in_last_i beats).
 // Twin: sim/fmt/rx_fixed.py accum_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -24,20 +27,20 @@ module fmt_accum #(
     parameter HM_W       = `FMT_HM_W,    // heat-map cell width (unsigned)
     parameter HM_SHIFT   = 1,            // fixed right shift of the sum (1 = undo the 2 of pair split)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
-    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of in_shift
+    parameter SH_W       = (M_LOG2_MAX > 0) ? $clog2(M_LOG2_MAX + 1) : 1  // width of in_shift_i
 ) (
     input  wire                    clk,
     input  wire                    rst,        // synchronous, active high (clears flag, valid)
     input  wire                    ce,         // sample strobe
-    input  wire                    in_valid,   // one row of magnitudes this ce cycle
-    input  wire [ROW_W-1:0]        in_row,     // row index
-    input  wire [LANES*D_W-1:0]    in_data,    // lane l at [l*D_W +: D_W]
-    input  wire                    in_first,   // first window of the frame (restart the sum)
-    input  wire                    in_last,    // last window of the frame (emit the cell)
-    input  wire [SH_W-1:0]         in_shift,   // log2 M of this frame (0..M_LOG2_MAX)
-    output reg                     out_valid,  // one row of heat-map cells this ce cycle
-    output reg  [ROW_W-1:0]        out_row,    // its row index
-    output reg  [LANES*HM_W-1:0]   out_data,   // lane l at [l*HM_W +: HM_W], unsigned
+    input  wire                    in_valid_i, // one row of magnitudes this ce cycle
+    input  wire [ROW_W-1:0]        in_row_i,   // row index
+    input  wire [LANES*D_W-1:0]    in_data_i,  // lane l at [l*D_W +: D_W]
+    input  wire                    in_first_i, // first window of the frame (restart the sum)
+    input  wire                    in_last_i,  // last window of the frame (emit the cell)
+    input  wire [SH_W-1:0]         in_shift_i, // log2 M of this frame (0..M_LOG2_MAX)
+    output reg                     out_valid_o, // one row of heat-map cells this ce cycle
+    output reg  [ROW_W-1:0]        out_row_o,  // its row index
+    output reg  [LANES*HM_W-1:0]   out_data_o, // lane l at [l*HM_W +: HM_W], unsigned
     output reg                     sat_o       // sticky: a cell saturated at 2^HM_W - 1
 );
 
@@ -46,7 +49,7 @@ module fmt_accum #(
     localparam EW    = (SUM_W > HM_W) ? SUM_W + 1 : HM_W + 1;  // width after adding the rounding half
 
     reg [LANES*SUM_W-1:0] mem [0:ROWS-1];
-    wire [LANES*SUM_W-1:0] rd = mem[in_row];
+    wire [LANES*SUM_W-1:0] rd = mem[in_row_i];
 
     reg [LANES*SUM_W-1:0] sum_q;
     reg                   sv_q;
@@ -58,14 +61,14 @@ module fmt_accum #(
     integer l;
     always @* begin
         for (l = 0; l < LANES; l = l + 1) begin
-            sum_d[l*SUM_W +: SUM_W] = (in_first ? {SUM_W{1'b0}} : rd[l*SUM_W +: SUM_W])
-                                    + {{M_LOG2_MAX{1'b0}}, in_data[l*D_W +: D_W]};
+            sum_d[l*SUM_W +: SUM_W] = (in_first_i ? {SUM_W{1'b0}} : rd[l*SUM_W +: SUM_W])
+                                    + {{M_LOG2_MAX{1'b0}}, in_data_i[l*D_W +: D_W]};
         end
     end
 
     always @(posedge clk) begin
-        if (ce && in_valid) begin
-            mem[in_row] <= sum_d;
+        if (ce && in_valid_i) begin
+            mem[in_row_i] <= sum_d;
         end
     end
 
@@ -73,15 +76,15 @@ module fmt_accum #(
         if (rst) begin
             sv_q <= 1'b0;
         end else if (ce) begin
-            sv_q <= in_valid && in_last;
+            sv_q <= in_valid_i && in_last_i;
         end
     end
 
     always @(posedge clk) begin
         if (ce) begin
             sum_q  <= sum_d;
-            srow_q <= in_row;
-            ssh_q  <= in_shift;
+            srow_q <= in_row_i;
+            ssh_q  <= in_shift_i;
         end
     end
 
@@ -107,18 +110,18 @@ module fmt_accum #(
 
     always @(posedge clk) begin
         if (rst) begin
-            out_valid <= 1'b0;
-            sat_o     <= 1'b0;
+            out_valid_o <= 1'b0;
+            sat_o       <= 1'b0;
         end else if (ce) begin
-            out_valid <= sv_q;
+            out_valid_o <= sv_q;
             if (sv_q && clip_d) sat_o <= 1'b1;
         end
     end
 
     always @(posedge clk) begin
         if (ce) begin
-            out_row  <= srow_q;
-            out_data <= cell_d;
+            out_row_o  <= srow_q;
+            out_data_o <= cell_d;
         end
     end
 

@@ -1,3 +1,6 @@
+// Reference only: not instantiated by fmt_core; kept as the documented, tested reference of
+// one column pair's whole receive chain with its own magnitude units and accumulator
+// (rx_fixed.rx_heatmaps_fixed on two columns, tb/fmt_col_pair_rx); fmt_rx_array shares them.
 // fmt_col_pair_rx -- receiver of two real columns a, b sharing one complex FFT:
 // despread (x2) -> fmt_fft_r22sdf (z = a + j b) -> fmt_pair_split -> fmt_magnitude (x2,
 // one per column: a completed pair needs |A| and |B| in the same ce cycle) ->
@@ -22,7 +25,7 @@
 // its input register, which the despread register feeds); magnitude ITER + 3 and
 // accum 2 stages follow, on every clk (POST_CLK = 1: 17 clk) or on ce (POST_CLK = 0).
 // Last row at N = 256: 274 ce cycles + 17 clk (ce = 1: 291 cycles; 3 x fs: 839 clk).
-// With POST_CLK = 1 out_valid is a one-clk pulse, else it is held for the ce period.
+// With POST_CLK = 1 out_valid_o is a one-clk pulse, else it is held for the ce period.
 // Flags (sticky until reset): fft_ovf_o (FFT internal saturation), sat_o (a cell
 // clipped at 2^HM_W - 1).  The magnitude cannot overflow (fmt_magnitude).
 // Structure: fmt_rx_pair_front (despread, FFT, bookkeeping, split) + this pair's own
@@ -43,7 +46,6 @@ module fmt_col_pair_rx #(
     parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
     parameter FFT_SHIFT  = (ADC_BITS + LOG2_N - 2 > HM_W) ? ADC_BITS + LOG2_N - 2 - HM_W : 0, // S
     parameter FFT_OUT_W  = ADC_BITS + LOG2_N + 2 - FFT_SHIFT,  // FFT output width (X * 2^-S)
-    parameter TW_DIR     = "rtl/",         // directory of the FFT twiddle hex files
     parameter POST_CLK   = 1,              // 1: split/magnitude/accum advance on every clk (lower
                                            //    latency at CLK_PER_SAMPLE > 1), 0: on ce
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
@@ -56,10 +58,10 @@ module fmt_col_pair_rx #(
     input  wire signed [ADC_BITS-1:0] adc_b_i,    // column b ADC sample (odd column)
     input  wire                       rx_sign_i,  // receive PN sign (1 = invert), shared
     input  wire [SH_W-1:0]            m_log2_i,   // log2 of windows per frame
-    output wire                       out_valid,  // one row of the pair this ce cycle
-    output wire [ROW_W-1:0]           out_row,    // row index
-    output wire [2*HM_W-1:0]          out_hm,     // {cell b, cell a}, unsigned
-    output wire                       out_last_row, // this row is the frame's last row
+    output wire                       out_valid_o, // one row of the pair this ce cycle
+    output wire [ROW_W-1:0]           out_row_o,  // row index
+    output wire [2*HM_W-1:0]          out_hm_o,   // {cell b, cell a}, unsigned
+    output wire                       out_last_row_o, // this row is the frame's last row
     output wire                       fft_ovf_o,  // sticky FFT saturation
     output wire                       sat_o       // sticky heat-map cell saturation
 );
@@ -94,7 +96,7 @@ module fmt_col_pair_rx #(
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_rx_pair_front #(
         .LOG2_N(LOG2_N), .ROWS(ROWS), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .ADC_BITS(ADC_BITS), .M_MAX(FM_MAX), .FFT_OUT_W(W), .TW_DIR(TW_DIR),
+        .ADC_BITS(ADC_BITS), .M_MAX(FM_MAX), .FFT_OUT_W(W),
         .POST_CLK(POST_CLK), .RES_MEM(0), .ROW_W(ROW_W), .MC_W(FMC_W)
     ) u_front (
         .clk(clk), .rst(rst), .ce(ce), .adc_a_i(adc_a_i), .adc_b_i(adc_b_i),
@@ -116,11 +118,11 @@ module fmt_col_pair_rx #(
     wire             mg_tag_b;
     /* verilator lint_on UNUSEDSIGNAL */
     fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag_a (
-        .clk(clk), .rst(rst), .ce(post_ce), .in_valid(ps_valid), .in_re(ps_ar), .in_im(ps_ai),
-        .in_tag({ps_row, ps_tag}), .out_valid(mg_valid), .out_mag(mag_a), .out_tag(mg_tag));
+        .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(ps_valid), .in_re_i(ps_ar), .in_im_i(ps_ai),
+        .in_tag_i({ps_row, ps_tag}), .out_valid_o(mg_valid), .out_mag_o(mag_a), .out_tag_o(mg_tag));
     fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag_b (
-        .clk(clk), .rst(rst), .ce(post_ce), .in_valid(ps_valid), .in_re(ps_br), .in_im(ps_bi),
-        .in_tag(1'b0), .out_valid(mg_valid_b), .out_mag(mag_b), .out_tag(mg_tag_b));
+        .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(ps_valid), .in_re_i(ps_br), .in_im_i(ps_bi),
+        .in_tag_i(1'b0), .out_valid_o(mg_valid_b), .out_mag_o(mag_b), .out_tag_o(mg_tag_b));
 
     // ---- accumulation over the frame ----
     wire [ROW_W-1:0] mg_row   = mg_tag[TAGW-1 -: ROW_W];
@@ -139,14 +141,14 @@ module fmt_col_pair_rx #(
         .HM_SHIFT(1), .ROW_W(ROW_W), .SH_W(SH_W)
     ) u_acc (
         .clk(clk), .rst(rst), .ce(post_ce),
-        .in_valid(mg_valid), .in_row(mg_row), .in_data({mag_b, mag_a}),
-        .in_first(mg_first), .in_last(mg_last), .in_shift(mg_shift),
-        .out_valid(out_valid), .out_row(out_row), .out_data(out_hm), .sat_o(sat_o));
+        .in_valid_i(mg_valid), .in_row_i(mg_row), .in_data_i({mag_b, mag_a}),
+        .in_first_i(mg_first), .in_last_i(mg_last), .in_shift_i(mg_shift),
+        .out_valid_o(out_valid_o), .out_row_o(out_row_o), .out_data_o(out_hm_o), .sat_o(sat_o));
 
     // the frame's last row is the row whose pair completes last (a constant)
     `include "fmt_rx_last_row.vh"
     localparam LAST_ROW = last_row_f(0);
-    assign out_last_row = (out_row == LAST_ROW[ROW_W-1:0]);
+    assign out_last_row_o = (out_row_o == LAST_ROW[ROW_W-1:0]);
 
 endmodule
 
