@@ -247,14 +247,19 @@ async def readback_trials(tb, rng, off, gain, n):
 
 
 # ---- pytest entry ------------------------------------------------------------------
+def sensor_params(cfg) -> dict:
+    """The sensor parameters of fmt_flatten from ``cfg`` (SensorConfig.verilog_params)."""
+    p = cfg.verilog_params()
+    return {k: p[k] for k in ("ROWS", "COLS", "HM_W")}
+
+
 # CAL_BRAM = 0: the LUT-RAM variant of the column memories (same behaviour)
 @pytest.mark.parametrize("cfg, cal_bram", [(params.SMALL, 1), (params.MEDIUM, 1), (params.SMALL, 0)],
                          ids=["SMALL", "MEDIUM", "SMALL-lutram"])
 def test_fmt_flatten(sim, cfg, cal_bram):
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
-               parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
-                           "CAL_BRAM": cal_bram},
+               parameters={**sensor_params(cfg), "CAL_BRAM": cal_bram},
                extra_env={"FMT_CFG": cfg.name, "SEED": 1})
 
 
@@ -266,5 +271,5 @@ def test_fmt_flatten_default(sim):
     cfg = params.DEFAULT
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
-               parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width},
+               parameters=sensor_params(cfg),
                extra_env={"FMT_CFG": cfg.name, "SEED": 2})
