@@ -135,14 +135,15 @@ def test_fmt_channel_sim(sim, cfg):
     hexf, npyf = out / f"{cfg.name}.hex", out / f"{cfg.name}.npy"
     dds.write_noise_hex(hexf, noise, NOISE_BITS)
     np.save(npyf, noise)
+    p = cfg.verilog_params()
     run_cocotb(
         sim=sim,
         toplevel="fmt_channel_sim",
         sources=[ROOT / "bench" / "core" / "fmt_channel_sim.v"],
         test_module="test_fmt_channel_sim",
         test_dir=Path(__file__).parent,
-        parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "DAC_BITS": cfg.dac_bits,
-                    "ADC_BITS": cfg.adc_bits, "COUP_BITS": COUP_BITS, "COUP_FRAC": COUP_FRAC,
+        parameters={**{k: p[k] for k in ("ROWS", "COLS", "DAC_BITS", "ADC_BITS")},
+                    "COUP_BITS": COUP_BITS, "COUP_FRAC": COUP_FRAC,
                     "NOISE_BITS": NOISE_BITS, "NOISE_FRAC": NOISE_FRAC, "NOISE_LEN": NOISE_LEN,
                     "NOISE_FILE": f'"{hexf}"'},
         extra_env={"CFG": cfg.name, "NOISE_NPY": npyf},
