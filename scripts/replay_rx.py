@@ -44,10 +44,9 @@ def main(argv=None) -> int:
     ap.add_argument("--check", action="store_true", help="compare with rx_fixed (bit-exact)")
     a = ap.parse_args(argv)
 
-    from common.runner import run_cocotb, rtl_sources
+    from common.runner import run_cocotb, sources
     from fmt import params, rx_fixed
-    sys.path.insert(0, str(ROOT / "tb" / "fmt_rx_array"))
-    from test_fmt_rx_array import RTL_FILES, VERILATOR_ARGS
+    from fmt_rx_array.rx_driver import build_args
 
     cfg = params.get(a.config)
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
@@ -58,16 +57,16 @@ def main(argv=None) -> int:
     run_cocotb(
         sim="verilator",
         toplevel="fmt_rx_array",
-        sources=rtl_sources(*RTL_FILES),
+        sources=sources("fmt_rx_array"),
         test_module="replay_cocotb",
         test_dir=ROOT / "tb" / "fmt_rx_array",
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n,
                     "BIN_LO": cfg.bin_lo, "BIN_STEP": cfg.bin_step, "ADC_BITS": cfg.adc_bits,
-                    "HM_W": cfg.hm_width, "TW_DIR": f'"{ROOT / "rtl"}/"',
+                    "HM_W": cfg.hm_width,
                     # a sample every cps clk; FFT_CH defaults to CLK_PER_SAMPLE (POST_CLK 1)
                     "POST_CLK": 1, "CLK_PER_SAMPLE": a.cps},
         extra_env=env,
-        build_args=VERILATOR_ARGS,
+        build_args=build_args("verilator"),
     )
     hm = np.load(out)
     info = json.loads(Path(str(out) + ".json").read_text())

@@ -9,15 +9,12 @@ from __future__ import annotations
 
 import json
 import os
-import sys
 from pathlib import Path
 
 import cocotb
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from test_fmt_rx_array import TB   # noqa: E402
+from fmt_rx_array.rx_driver import TB
 
 
 @cocotb.test()
