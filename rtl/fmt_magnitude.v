@@ -11,12 +11,19 @@
 //   GAIN_C = round(2^GAIN_BITS / K), K = prod_i sqrt(1 + 2^-2i) (= 636751 for 20 bits,
 //   relative gain error 1.9e-7).  Since 1/K > 1/2 the product is formed as
 //   (x << (GAIN_BITS-1)) + x * (GAIN_C - 2^(GAIN_BITS-1)): a 17-bit constant multiply.
+// Gain stages (after the last CORDIC register, which is the multiplier's operand
+// register): M = the partial products x[17:0] * g and x[XW-1:18] * g (g = GAIN_C -
+// 2^(GAIN_BITS-1); one 18-bit slice per product, so that each is one 18 x 18
+// multiplier on ECP5 / one DSP48E with its product registered), beside them
+// (x << (GAIN_BITS-1)) + rounding constant; P = the sum of the three, of which the
+// output keeps bits [SH +: IN_W].  No multiplier output goes through logic before a
+// register.
 // Formats: re, im signed IN_W (integers); mag unsigned OUT_W = IN_W (the largest
 // magnitude, sqrt(2) * 2^(IN_W-1), is below 2^IN_W: no overflow is possible).
 // Error (measured in sim/tests/test_rx_fixed.py over random full-scale inputs):
 // |mag - exact| <= 1.1 LSB + 2e-7 |z|, mean bias below 0.15 LSB (ITER = 12, GUARD = 3).
 // Internal width IW = IN_W + GUARD + 2 holds K * sqrt(2) * 2^(IN_W-1+GUARD) < 2^(IW-1).
-// Latency: ITER + 3 ce cycles (input register, ITER stages, product, rounding);
+// Latency: ITER + 3 ce cycles (input register, ITER stages, partial products, sum);
 // a TAG_W-bit tag and the valid bit travel with the data.  Registers advance on ce.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -42,8 +49,11 @@ module fmt_magnitude #(
 );
 
     localparam IW  = IN_W + GUARD + 2;              // CORDIC register width (signed)
-    localparam GW  = GAIN_BITS + 2;                 // gain constant width (unsigned value)
-    localparam PW  = IW + GW;                       // product width
+    localparam XW  = IW - 1;                        // final x: >= 0, below 2^(IW-1)
+    localparam GLW = GAIN_BITS - 1;                 // g = GAIN_C - 2^(GAIN_BITS-1) < 2^GLW
+    localparam ALW = (XW > 18) ? 18 : XW;           // x bits of the low partial product
+    localparam AHW = XW - ALW;                      // x bits of the high one (0: none)
+    localparam PW  = XW + GAIN_BITS + 1;            // x * GAIN_C + rounding < 2^PW
     localparam SH  = GAIN_BITS + GUARD;             // final right shift
     localparam NS  = ITER + 1;                      // stage registers 0..ITER
 
@@ -53,17 +63,20 @@ module fmt_magnitude #(
     reg [NS-1:0]        v_q;
     reg [TAG_W-1:0]     t_q [0:NS-1];
 
-    reg [PW-1:0]        prod_q;
-    reg                 pv_q;
-    reg [TAG_W-1:0]     pt_q;
+    // gain stage M: partial products and the shifted x plus the rounding constant
+    reg [ALW+GLW-1:0]   pl_q;
+    reg [PW-1:0]        c_q;
+    reg                 mv_q;
+    reg [TAG_W-1:0]     mt_q;
 
     wire signed [IW-1:0] re_ext = {{(IW-IN_W){in_re_i[IN_W-1]}}, in_re_i};
     wire signed [IW-1:0] im_ext = {{(IW-IN_W){in_im_i[IN_W-1]}}, in_im_i};
     wire signed [IW-1:0] re_abs = in_re_i[IN_W-1] ? -re_ext : re_ext;
 
-    // the constant minus its top bit, as a PW-bit unsigned operand
-    wire [PW-1:0] gain_lo = GAIN_C - (1 << (GAIN_BITS - 1));
-    wire [PW-1:0] round_w = {{(PW-1){1'b0}}, 1'b1} << (SH - 1);
+    // GAIN_C lies in [2^(GAIN_BITS-1), 2^GAIN_BITS): g is GAIN_C without its top bit
+    localparam [GAIN_BITS-1:0] GC = GAIN_C;
+    wire [GLW-1:0] gain_lo = GC[GLW-1:0];
+    wire [PW-1:0]  round_w = {{(PW-1){1'b0}}, 1'b1} << (SH - 1);
 
     always @(posedge clk) begin
         if (rst) begin
@@ -101,29 +114,53 @@ module fmt_magnitude #(
         end
     endgenerate
 
-    // x_q[ITER] >= 0 always (x0 >= 0 and x only grows in vectoring mode)
-    wire [PW-1:0] x_fin = {{(PW-IW){1'b0}}, x_q[NS-1]};
-    // the low SH bits are the rounded-away fraction and the top bits are zero by range
+    // x_q[ITER] >= 0 always (x0 >= 0 and x only grows in vectoring mode): its sign bit
+    // is not used
+    wire [XW-1:0] x_fin = x_q[NS-1][XW-1:0];
+
+    always @(posedge clk) begin
+        if (ce) begin
+            pl_q <= x_fin[ALW-1:0] * gain_lo;
+            c_q  <= ({{(PW-XW){1'b0}}, x_fin} << (GAIN_BITS - 1)) + round_w;
+            mt_q <= t_q[NS-1];
+        end
+    end
+
+    // the high partial product, already in place (<< ALW), or zero
+    wire [PW-1:0] ph_sh;
+    generate
+        if (AHW > 0) begin : g_hi
+            reg [AHW+GLW-1:0] ph_q;
+            always @(posedge clk) begin
+                if (ce) ph_q <= x_fin[XW-1:ALW] * gain_lo;
+            end
+            assign ph_sh = {{(PW-AHW-GLW){1'b0}}, ph_q} << ALW;
+        end else begin : g_no_hi
+            assign ph_sh = {PW{1'b0}};
+        end
+    endgenerate
+
+    // gain stage P; the low SH bits are the rounded-away fraction and the top bits
+    // are zero by range
     /* verilator lint_off UNUSEDSIGNAL */
-    wire [PW-1:0] prod_rnd = prod_q + round_w;
+    wire [PW-1:0] sum_w = {{(PW-ALW-GLW){1'b0}}, pl_q} + ph_sh + c_q;
+    wire          unused_sign = x_q[NS-1][IW-1];
     /* verilator lint_on UNUSEDSIGNAL */
 
     always @(posedge clk) begin
         if (rst) begin
-            pv_q        <= 1'b0;
+            mv_q        <= 1'b0;
             out_valid_o <= 1'b0;
         end else if (ce) begin
-            pv_q        <= v_q[NS-1];
-            out_valid_o <= pv_q;
+            mv_q        <= v_q[NS-1];
+            out_valid_o <= mv_q;
         end
     end
 
     always @(posedge clk) begin
         if (ce) begin
-            prod_q  <= (x_fin << (GAIN_BITS - 1)) + x_fin * gain_lo;
-            pt_q    <= t_q[NS-1];
-            out_mag_o <= prod_rnd[SH +: IN_W];
-            out_tag_o <= pt_q;
+            out_mag_o <= sum_w[SH +: IN_W];
+            out_tag_o <= mt_q;
         end
     end
 
