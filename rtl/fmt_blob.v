@@ -29,8 +29,9 @@
 //       writes the run, ADD combines the run, MERGE combines label B into A (B is free
 //       again).
 //   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
-//       inserted into a sorted list of MAX_BLOBS entries (area descending, ties by the
-//       raster index of the region's first cell ascending); the smallest falls off.  The
+//       inserted into a sorted list of MAX_BLOBS entries (fmt_sorted_list: area
+//       descending, ties by the raster index of the region's first cell ascending); the
+//       smallest falls off.  The
 //       list holds the keys and a slot number; the entries sit in distributed RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
@@ -171,11 +172,10 @@ module fmt_blob #(
     localparam [ROW_IDX_W:0]   ROWS_R   = ROWS_I[ROW_IDX_W:0];
     localparam [AREA_W-1:0]    MB_A     = MB_I[AREA_W-1:0];
     localparam [CNT_W-1:0]     MB_C     = MB_I[CNT_W-1:0];
-    localparam [$clog2(MAX_BLOBS+1)-1:0] MB_S = MB_I[$clog2(MAX_BLOBS+1)-1:0];
     localparam integer LAST_ROW_I = ROWS - 1;
     localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
 
-    integer i, g, b;
+    // (loop variables are declared in their always block: one driver each, no latch)
 
     // ---- combine two partial regions: X precedes Y's peak in ties unless Y's peak cell
     // comes first in raster order; first cell = the smaller raster key
@@ -250,7 +250,8 @@ module fmt_blob #(
         if (fetch) nx_z_q <= mem[rd_addr];
     end
     reg [COLS-1:0] nx_on;
-    always @(*) begin
+    always @(*) begin : c_nx_on
+        integer i;
         for (i = 0; i < COLS; i = i + 1)
             nx_on[i] = (nx_z_q[i*HM_W +: HM_W] >= blob_threshold_i);
     end
@@ -269,7 +270,8 @@ module fmt_blob #(
 
     reg [LBL_W-1:0] la, lb, lfree;
     reg [NL:1] lb_bit, lfree_bit;
-    always @(*) begin
+    always @(*) begin : c_runlbl
+        integer i;
         la = {LBL_W{1'b0}};
         for (i = COLS - 1; i >= 0; i = i - 1)
             if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) la = p_q[i*LBL_W +: LBL_W];
@@ -298,7 +300,9 @@ module fmt_blob #(
     // next label vectors and live masks of this cycle's step
     reg [COLS*LBL_W-1:0] p_nx, c_nx;
     reg [NL:1]           livep_nx, livec_nx;
-    always @(*) begin
+    always @(*) begin : c_step
+        integer i;
+        i = 0;                                // the loops run conditionally: no latch for i
         p_nx = p_q;
         c_nx = c_q;
         livep_nx = livep_q;
@@ -328,7 +332,8 @@ module fmt_blob #(
     // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
     // by the merges of row r+1).
     reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
-    always @(*) begin
+    always @(*) begin : c_alias
+        integer i;
         for (i = 1; i <= NL; i = i + 1) begin
             alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
             alias_nx[(i-1)*LBL_W +: LBL_W] =
@@ -358,7 +363,8 @@ module fmt_blob #(
     reg [ROW_IDX_W-1:0] x1_row_q;
     reg [NL:1]          x1_k_q;
     reg [RW-1:0]        zm;
-    always @(*) begin
+    always @(*) begin : c_zm
+        integer i;
         for (i = 0; i < COLS; i = i + 1)
             zm[i*HM_W +: HM_W] = run_m[i] ? cur_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
     end
@@ -392,7 +398,8 @@ module fmt_blob #(
     reg [GS*HM_W-1:0]   gz;
     reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
     reg [HM_W+1:0]      gv0, gv1, go;
-    always @(*) begin
+    always @(*) begin : c_x2
+        integer i, g;
         gs = {(NG*GSZ_W){1'b0}};
         gx = {(NG*GSX_W){1'b0}};
         gm = {(NG*HM_W){1'b0}};
@@ -459,7 +466,8 @@ module fmt_blob #(
     reg [SX_W-1:0]      tx;
     reg [HM_W-1:0]      tpk;
     reg [COL_IDX_W-1:0] tpc;
-    always @(*) begin
+    always @(*) begin : c_x3
+        integer g, b;
         ts = {SZ_W{1'b0}};
         tx = {SX_W{1'b0}};
         tpk = {HM_W{1'b0}};
@@ -515,7 +523,8 @@ module fmt_blob #(
     assign acc_y = (x4_op_q == OP_MERGE) ? acc_b : x4_e_q;
     reg [LBL_W-1:0] cpick;
     reg [NL:1]      cpick_bit;
-    always @(*) begin
+    always @(*) begin : c_cpick
+        integer i;
         cpick = {LBL_W{1'b0}};
         for (i = NL; i >= 1; i = i - 1)
             if (pend_q[i]) cpick = i[LBL_W-1:0];
@@ -544,11 +553,22 @@ module fmt_blob #(
     localparam SL_W = $clog2(MB + 1);
     localparam PE_W = SZ_W + SX_W + SY_W;
     localparam PO_W = AREA_W + 2 * ROW_IDX_W + 2 * COL_IDX_W + HM_W + IDX_W;
-    reg [MB-1:0]     l_v_q;
-    reg [AREA_W-1:0] l_area_q [0:MB-1];
-    reg [IDX_W-1:0]  l_key_q  [0:MB-1];
-    reg [SL_W-1:0]   l_slot_q [0:MB-1];
-    reg [SL_W-1:0]   spare_q;
+    wire               releasing;
+    /* verilator lint_off UNUSEDSIGNAL */     // the emission reads the slots only
+    wire [MB-1:0]        l_v;
+    wire [MB*AREA_W-1:0] l_area;
+    wire [MB*IDX_W-1:0]  l_key;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [MB*SL_W-1:0]   l_slots;
+    wire [SL_W-1:0]      spare_q;              // the free slot (drop_pay_o, a register)
+    // entry i's slot (an array for the indexed reads below)
+    wire [SL_W-1:0]      l_slot_q [0:MB-1];
+    genvar gs_i;
+    generate
+        for (gs_i = 0; gs_i < MB; gs_i = gs_i + 1) begin : g_slot
+            assign l_slot_q[gs_i] = l_slots[gs_i*SL_W +: SL_W];
+        end
+    endgenerate
     (* ram_style = "distributed" *)
     reg [PE_W-1:0]   pe_mem [0:MB];
     (* ram_style = "distributed" *)
@@ -562,12 +582,14 @@ module fmt_blob #(
                                 cl_e_q[O_RMIN +: ROW_IDX_W], cl_area};
         end
     end
-    reg [MB-1:0]  better;
-    always @(*) begin
-        for (i = 0; i < MB; i = i + 1)
-            // area descending, ties by raster key ascending: one compare of {area, ~key}
-            better[i] = l_v_q[i] && ({l_area_q[i], ~l_key_q[i]} > {cl_area, ~cl_key});
-    end
+    // area descending, ties by raster key ascending; the slots are the payloads
+    // (reset to 0..MB-1, spare MB); a closed blob is inserted with the spare slot
+    fmt_sorted_list #(.K(MB), .KEY_W(AREA_W), .TIE_W(IDX_W), .PAY_W(SL_W), .PAY_RST_IDX(1),
+                      .HAS_POP(0)) u_list (
+        .clk(clk), .rst(rst), .clear_i(releasing),
+        .ins_i(cl_blob), .ins_key_i(cl_area), .ins_tie_i(cl_key), .ins_pay_i(spare_q),
+        .pop_i(1'b0), .valid_o(l_v), .key_o(l_area), .tie_o(l_key), .pay_o(l_slots),
+        .drop_pay_o(spare_q));
     reg [AREA_W-1:0] found_q;
     reg              lab_done_q;              // the last row's command has been applied
 
@@ -656,7 +678,8 @@ module fmt_blob #(
     reg [NL:1]      bw_s;
     reg [LBL_W-1:0] la_r;
     reg [NLP-1:0]   sn_pad;
-    always @(*) begin
+    always @(*) begin : c_bw_s
+        integer g;
         sn_pad = {NLP{1'b0}};
         sn_pad[NL:1] = sn_q;
         for (g = 1; g <= NL; g = g + 1) begin
@@ -705,10 +728,11 @@ module fmt_blob #(
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
     wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
                    && fr_in && !arr_p[fr_row];
-    wire releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
+    assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
-    always @(posedge clk) begin
+    always @(posedge clk) begin : s_main
+        integer i;
         // ---- datapath registers (no reset needed) ----
         if (take) begin
             cur_z_q   <= nx_z_q;
@@ -793,9 +817,6 @@ module fmt_blob #(
             x3_v_q   <= 1'b0;
             x4_v_q   <= 1'b0;
             cl_v_q   <= 1'b0;
-            l_v_q    <= {MB{1'b0}};
-            for (i = 0; i < MB; i = i + 1) l_slot_q[i] <= i[SL_W-1:0];
-            spare_q  <= MB_S;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
             em_i_q   <= {CNT_W{1'b0}};
@@ -874,26 +895,8 @@ module fmt_blob #(
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
-            // ---- sorted insertion of a closed blob ----
-            if (cl_blob) begin
-                if (found_q != {AREA_W{1'b1}}) found_q <= found_q + 1'b1;
-                for (i = 0; i < MB; i = i + 1) begin
-                    if (!better[i]) begin
-                        if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
-                            l_v_q[i]    <= 1'b1;
-                            l_area_q[i] <= cl_area;
-                            l_key_q[i]  <= cl_key;
-                            l_slot_q[i] <= spare_q;
-                        end else begin
-                            l_v_q[i]    <= l_v_q[(i == 0) ? 0 : i - 1];
-                            l_area_q[i] <= l_area_q[(i == 0) ? 0 : i - 1];
-                            l_key_q[i]  <= l_key_q[(i == 0) ? 0 : i - 1];
-                            l_slot_q[i] <= l_slot_q[(i == 0) ? 0 : i - 1];
-                        end
-                    end
-                end
-                if (!better[MB-1]) spare_q <= l_slot_q[MB-1];   // the last entry falls off
-            end
+            // ---- a closed blob: counted (u_list inserts it) ----
+            if (cl_blob && found_q != {AREA_W{1'b1}}) found_q <= found_q + 1'b1;
 
             // ---- finish, emit, release ----
             if (fin_ok || fin_abort) begin
@@ -962,8 +965,7 @@ module fmt_blob #(
             end
             if (releasing) begin
                 state_q      <= S_RUN;
-                tok_q        <= 1'b0;
-                l_v_q        <= {MB{1'b0}};
+                tok_q        <= 1'b0;         // u_list is cleared
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};

@@ -18,7 +18,7 @@
 //   E1: compare every cell of row r with its neighbours -> maxima mask (COLS bits)
 //   E2: serialise the maxima, one per cycle (lowest column first)
 //   E3: insert (z, row, col) into a sorted list of MAX_TOUCHES entries (z descending,
-//       ties by raster index ascending); the weakest falls off the end.
+//       ties by raster index ascending; fmt_sorted_list); the weakest falls off the end.
 // After the frame's hm_eof, once every row is evaluated, the list is emitted, one
 // candidate per cycle: the same three read ports fetch the candidate's rows and a
 // column select forms its 3x3 neighbourhood (by column mod 3: three ceil((COLS+2)/3):1
@@ -117,15 +117,17 @@ module fmt_localmax #(
     // ready rows of the processing buffer
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
     reg  [ROWS-1:0] ready;
-    integer i;
-    always @(*) begin
+    // (loop variables are local to their always block: one driver each, no latch)
+    always @(*) begin : c_ready
+        integer i;
         for (i = 0; i < ROWS; i = i + 1)
             ready[i] = arr_p[i] & ~done_q[i]
                      & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
                      & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
     end
     reg [ROW_IDX_W-1:0] pick;
-    always @(*) begin
+    always @(*) begin : c_pick
+        integer i;
         pick = {ROW_IDX_W{1'b0}};
         for (i = ROWS - 1; i >= 0; i = i - 1)
             if (ready[i]) pick = i[ROW_IDX_W-1:0];
@@ -142,14 +144,14 @@ module fmt_localmax #(
     wire e1_adv  = e1_v_q && e2_free;
     wire issue   = (state_q == S_RUN) && (|ready) && (!e1_v_q || e1_adv);
 
-    // ---- the sorted list (z, raster index) --------------------------------------------
-    reg [K-1:0]       l_v_q;
-    reg [HM_W-1:0]    l_z_q   [0:K-1];
-    reg [IDX_W-1:0]   l_idx_q [0:K-1];
+    // ---- the sorted list (z, raster index): fmt_sorted_list, below ------------------------
+    /* verilator lint_off UNUSEDSIGNAL */     // only entry 0's raster index is read
+    wire [K*IDX_W-1:0] l_idx;                 // raster index {row, col} of entry i
+    /* verilator lint_on UNUSEDSIGNAL */
     reg [FOUND_W-1:0] found_q;
     reg [LIM_W-1:0]   left_q;                 // candidates still to emit
     wire              em_issue = (state_q == S_EMIT) && (left_q != {LIM_W{1'b0}});
-    wire [ROW_IDX_W-1:0] l_row0 = l_idx_q[0][COL_IDX_W +: ROW_IDX_W];
+    wire [ROW_IDX_W-1:0] l_row0 = l_idx[COL_IDX_W +: ROW_IDX_W];
 
     // ---- E0 -> E1: three synchronous reads (evaluation, or a candidate's 3x3 at emission)
     reg [RW-1:0]        ra_q, rb_q, rc_q;       // rows r-1, r, r+1
@@ -215,7 +217,8 @@ module fmt_localmax #(
     reg [RW-1:0]        wrow_q;                 // the evaluated row (values for sorting)
     reg [ROW_IDX_W-1:0] r2_q;
     reg [COL_IDX_W-1:0] sel;                    // lowest set bit of mask_q
-    always @(*) begin
+    always @(*) begin : c_sel
+        integer i;
         sel = {COL_IDX_W{1'b0}};
         for (i = COLS - 1; i >= 0; i = i - 1)
             if (mask_q[i]) sel = i[COL_IDX_W-1:0];
@@ -226,13 +229,21 @@ module fmt_localmax #(
     reg [HM_W-1:0]  n_z_q;
     reg [IDX_W-1:0] n_idx_q;
 
-    // ---- E3: insertion ----------------------------------------------------------------
-    reg [K-1:0] better;                       // entry i stays ahead of the new candidate
-    always @(*) begin
-        for (i = 0; i < K; i = i + 1)
-            better[i] = l_v_q[i] && ((l_z_q[i] > n_z_q) ||
-                                     ((l_z_q[i] == n_z_q) && (l_idx_q[i] < n_idx_q)));
-    end
+    // ---- E3: insertion into the list (z descending, raster index ascending); the
+    // emission pops entry 0, one per candidate; the frame's release clears the list
+    wire releasing;
+    /* verilator lint_off UNUSEDSIGNAL */     // the emission reads entry 0's index only
+    wire [K-1:0]      l_v;
+    wire [K*HM_W-1:0] l_z;
+    wire [K-1:0]      l_pay;                  // no payload (PAY_W = 0: constant 0)
+    wire              l_drop;
+    /* verilator lint_on UNUSEDSIGNAL */
+    fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(0), .PAY_RST_IDX(0),
+                      .HAS_POP(1)) u_list (
+        .clk(clk), .rst(rst), .clear_i(releasing),
+        .ins_i(e3_v_q), .ins_key_i(n_z_q), .ins_tie_i(n_idx_q), .ins_pay_i(1'b0),
+        .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_pay),
+        .drop_pay_o(l_drop));
 
     // ---- emission: 3x3 of the candidate read back in E1, column select ---------------
     reg                 em_v_q, em_eof_q;
@@ -296,7 +307,7 @@ module fmt_localmax #(
     wire [HM_W-1:0] sb0 = gb0[gi0], sb1 = gb1[gi1], sb2 = gb2[em_q_q];
     wire [HM_W-1:0] sc0 = gc0[gi0], sc1 = gc1[gi1], sc2 = gc2[em_q_q];
     // quotient and remainder by 3 of a column index (for em_q_q, em_m_q)
-    wire [COL_IDX_W-1:0] nx_col = l_idx_q[0][0 +: COL_IDX_W];
+    wire [COL_IDX_W-1:0] nx_col = l_idx[0 +: COL_IDX_W];
     reg  [QI_W-1:0]      nx_q;
     reg  [1:0]           nx_m;
     integer k3, colv, qv;
@@ -332,7 +343,7 @@ module fmt_localmax #(
     wire             finish   = (state_q == S_RUN) && eofs_q[pb_q] && !(|ready)
                               && !e1_v_q && !e2_v_q && !e3_v_q;
     wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
-    wire             releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
+    assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
     wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
 
     always @(posedge clk) begin
@@ -361,7 +372,6 @@ module fmt_localmax #(
             e2_v_q   <= 1'b0;
             e3_v_q   <= 1'b0;
             mask_q   <= {COLS{1'b0}};
-            l_v_q    <= {K{1'b0}};
             found_q  <= {FOUND_W{1'b0}};
             left_q   <= {LIM_W{1'b0}};
             em_v_q   <= 1'b0;
@@ -407,23 +417,8 @@ module fmt_localmax #(
                 mask_q <= mask_q & (mask_q - 1'b1);      // clear the lowest set bit
             end
 
-            // ---- E3: sorted insertion ----
-            if (e3_v_q) begin
-                found_q <= found_q + 1'b1;
-                for (i = 0; i < K; i = i + 1) begin
-                    if (!better[i]) begin
-                        if (i == 0 || better[(i == 0) ? 0 : i - 1]) begin
-                            l_v_q[i]   <= 1'b1;
-                            l_z_q[i]   <= n_z_q;
-                            l_idx_q[i] <= n_idx_q;
-                        end else begin
-                            l_v_q[i]   <= l_v_q[(i == 0) ? 0 : i - 1];
-                            l_z_q[i]   <= l_z_q[(i == 0) ? 0 : i - 1];
-                            l_idx_q[i] <= l_idx_q[(i == 0) ? 0 : i - 1];
-                        end
-                    end
-                end
-            end
+            // ---- E3: count (the list inserts) ----
+            if (e3_v_q) found_q <= found_q + 1'b1;
 
             // ---- finish and emit ----
             if (finish) begin
@@ -450,17 +445,10 @@ module fmt_localmax #(
                 em_col_q <= nx_col;
                 em_q_q   <= nx_q;
                 em_m_q   <= nx_m;
-                left_q   <= left_q - 1'b1;
-                for (i = 0; i < K - 1; i = i + 1) begin
-                    l_v_q[i]   <= l_v_q[i + 1];
-                    l_z_q[i]   <= l_z_q[i + 1];
-                    l_idx_q[i] <= l_idx_q[i + 1];
-                end
-                l_v_q[K-1] <= 1'b0;
+                left_q   <= left_q - 1'b1;      // the list pops entry 0
             end
             if (releasing) begin
-                state_q      <= S_RUN;
-                l_v_q        <= {K{1'b0}};
+                state_q      <= S_RUN;      // the list is cleared
                 found_q      <= {FOUND_W{1'b0}};
                 done_q       <= {ROWS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};

@@ -484,7 +484,8 @@ async def latency(dut):
 
 # ---- pytest entry ---------------------------------------------------------------------
 def _run(sim, cfg, seed, testcase=None):
-    run_cocotb(sim=sim, toplevel="fmt_blob", sources=rtl_sources("fmt_blob", "fmt_div"),
+    run_cocotb(sim=sim, toplevel="fmt_blob",
+               sources=rtl_sources("fmt_blob", "fmt_div", "fmt_sorted_list"),
                test_module="test_fmt_blob", test_dir=Path(__file__).parent,
                parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                            "MAX_BLOBS": MAX_BLOBS},

@@ -297,7 +297,8 @@ async def latency(dut):
 
 # ---- pytest entry ------------------------------------------------------------------
 def _run(sim, cfg, seed):
-    run_cocotb(sim=sim, toplevel="fmt_localmax", sources=rtl_sources("fmt_localmax"),
+    run_cocotb(sim=sim, toplevel="fmt_localmax",
+               sources=rtl_sources("fmt_localmax", "fmt_sorted_list"),
                test_module="test_fmt_localmax", test_dir=Path(__file__).parent,
                parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                            "MAX_TOUCHES": cfg.max_touches},
