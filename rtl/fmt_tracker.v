@@ -172,8 +172,9 @@ module fmt_tracker #(
     reg [15:0]         gate;
     reg signed [PR_W:0] ddx, ddy;
     reg [PR_W:0]       dsum;
-    integer s_i;
-    always @* begin
+    // (loop variables are declared in their always block: one driver each, no latch)
+    always @* begin : c_drow
+        integer s_i;
         for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
             gate = (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}}) ? max_jump_i : hold_jump_i;
             ddx = $signed({{(PR_W-15){1'b0}}, tp_x_i}) -
@@ -205,8 +206,8 @@ module fmt_tracker #(
     reg              r_found;
     reg [DW-1:0]     r_d;
     reg [SB-1:0]     r_s;
-    integer l_i, n_i, t_i;
-    always @* begin
+    always @* begin : c_rtree
+        integer s_i, l_i, n_i;
         for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
             if (s_i < MT)
                 rk[s_i*KW +: KW] = {~(rrow[s_i*KW+DW] & ~sused_q[s_i]), rrow[s_i*KW +: DW]};
@@ -236,7 +237,8 @@ module fmt_tracker #(
     reg [MTP*SB-1:0] bs;             // its cached slot
     reg              m_found;
     reg [SB-1:0]     m_t, m_s;
-    always @* begin
+    always @* begin : c_ttree
+        integer l_i, n_i, t_i;
         for (t_i = 0; t_i < MTP; t_i = t_i + 1) begin
             if (t_i < MT) begin
                 bk[t_i*KW +: KW] = {~(kv_q[t_i] & ~tused_q[t_i]), kd_q[t_i*DW +: DW]};
@@ -266,7 +268,8 @@ module fmt_tracker #(
     end
     // the picked touch's cached slot is still free (one-hot select: no barrel shifter)
     reg m_fresh;
-    always @* begin
+    always @* begin : c_fresh
+        integer s_i;
         m_fresh = 1'b0;
         for (s_i = 0; s_i < MT; s_i = s_i + 1)
             m_fresh = m_fresh | (~sused_q[s_i] & (m_s == s_i[SB-1:0]));
@@ -276,7 +279,8 @@ module fmt_tracker #(
     reg [MT-1:0] lift_mask;
     reg          l_found;
     reg [SB-1:0] l_s;
-    always @* begin
+    always @* begin : c_lift
+        integer s_i;
         for (s_i = 0; s_i < MT; s_i = s_i + 1)
             lift_mask[s_i] = act_q[s_i] & ~sused_q[s_i] &
                 ({1'b0, miss_q[s_i*HOLD_W +: HOLD_W]} + 1'b1 >= {1'b0, hold_off_i});
@@ -290,8 +294,8 @@ module fmt_tracker #(
     reg          n_found, f_found;
     reg [SB-1:0] n_t, f_s;
     reg [SB:0]   idx;
-    integer k_i;
-    always @* begin
+    always @* begin : c_new
+        integer t_i, k_i;
         n_found = 1'b0;
         n_t = {SB{1'b0}};
         for (t_i = MT - 1; t_i >= 0; t_i = t_i - 1)
@@ -315,7 +319,8 @@ module fmt_tracker #(
     // ---- update: lowest active slot neither matched, new nor updated yet -------------
     reg          u_found;
     reg [SB-1:0] u_s;
-    always @* begin
+    always @* begin : c_upd
+        integer s_i;
         u_found = |(act_q & ~sused_q);
         u_s = {SB{1'b0}};
         for (s_i = MT - 1; s_i >= 0; s_i = s_i - 1)
@@ -341,7 +346,8 @@ module fmt_tracker #(
     wire [15:0]      s_lx  = srec[31:16];
     wire [15:0]      s_ly  = srec[15:0];
     reg  [GEN_W-1:0] s_gen;          // generation of slot sa (one-hot select)
-    always @* begin
+    always @* begin : c_sgen
+        integer s_i;
         s_gen = {GEN_W{1'b0}};
         for (s_i = 0; s_i < MT; s_i = s_i + 1)
             s_gen = s_gen | (gen_q[s_i*GEN_W +: GEN_W] & {GEN_W{sa == s_i[SB-1:0]}});
@@ -422,7 +428,8 @@ module fmt_tracker #(
     wire [PR_W-1:0]  w_pry = pred_of(pw_y_q);
     // the slot's miss counter: 0 on move / new, + 1 on update (shared incrementer)
     reg [HOLD_W-1:0] u_miss;
-    always @* begin
+    always @* begin : c_umiss
+        integer s_i;
         u_miss = {HOLD_W{1'b0}};
         for (s_i = 0; s_i < MT; s_i = s_i + 1)
             u_miss = u_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{u_s == s_i[SB-1:0]}});
@@ -449,7 +456,8 @@ module fmt_tracker #(
     // the cached key written this cycle: the row read on arrival or recomputed
     wire k_we = st_v_q | rc_q;
 
-    always @(posedge clk) begin
+    always @(posedge clk) begin : s_main
+        integer s_i, t_i;
         if (rst) begin
             state_q        <= S_IDLE;
             frame_q        <= {FRAME_W{1'b0}};
