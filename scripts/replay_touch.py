@@ -23,9 +23,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT / "sim"), str(ROOT / "tb"), str(ROOT / "tb" / "fmt_touch")]
+sys.path[:0] = [str(ROOT / "sim"), str(ROOT / "tb")]
 os.environ["PYTHONPATH"] = os.pathsep.join(
-    [str(ROOT / "sim"), str(ROOT / "tb"), str(ROOT / "tb" / "fmt_touch")]
+    [str(ROOT / "sim"), str(ROOT / "tb")]
     + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
 
 import numpy as np  # noqa: E402
@@ -40,9 +40,9 @@ def main(argv=None) -> int:
     ap.add_argument("--check", action="store_true", help="compare with process_frames (bit-exact)")
     a = ap.parse_args(argv)
 
-    from common.runner import run_cocotb, rtl_sources
+    from common.runner import run_cocotb, sources
     from fmt import params
-    from test_fmt_touch import MODULES, build_args
+    from fmt_touch.touch_driver import build_args
 
     cfg = params.get(a.config)
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
@@ -52,7 +52,7 @@ def main(argv=None) -> int:
     env = {"CFG": a.config, "REPLAY_IN": inp, "REPLAY_OUT": out,
            "REPLAY_SETTINGS": Path(a.settings).resolve() if a.settings else ""}
     run_cocotb(
-        sim="verilator", toplevel="fmt_touch", sources=rtl_sources(*MODULES),
+        sim="verilator", toplevel="fmt_touch", sources=sources("fmt_touch"),
         test_module="replay_cocotb", test_dir=ROOT / "tb" / "fmt_touch",
         parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                     "MAX_TOUCHES": cfg.max_touches, "EV_DEPTH": 256},

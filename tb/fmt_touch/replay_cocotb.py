@@ -19,8 +19,7 @@ from cocotb.triggers import RisingEdge
 
 from fmt import flatten, rx_fixed
 from fmt.settings import TouchSettings
-import test_fmt_touch as _tt
-from test_fmt_touch import TB, group
+from fmt_touch.touch_driver import TB, group
 
 TYPES = {0: "new", 1: "move", 2: "lift", 3: "blob"}
 FIELDS = ("frame", "id", "type", "x_q", "y_q", "strength", "axis_major_q", "axis_minor_q",
@@ -52,8 +51,7 @@ async def replay(dut):
                          f"(frames, {cfg.rows}, {cfg.cols}) for the '{cfg.name}' sensor")
     st = replay_settings()
     # tracking settings converted with the real frame period (one window at M = 1)
-    _tt.FRAME_PERIOD_S = float(os.environ.get("REPLAY_FRAME_PERIOD_S", cfg.window_s))
-    tb.settings(st)
+    tb.settings(st, float(os.environ.get("REPLAY_FRAME_PERIOD_S", cfg.window_s)))
     dut.blob_en_i.value = 0
     await tb.reset()
     await tb.calibrate(*flatten.identity(cfg))

@@ -24,127 +24,17 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import RisingEdge
 
-from common.runner import RTL, rtl_sources, run_cocotb
-from common.tb_util import ClockedTB, env_int, env_str
+from common.runner import run_cocotb, sources
+from common.tb_util import env_int
 from fmt import flatten, params, sensor
 from fmt.settings import TouchSettings
 from fmt.touch import process_frames
-from fmt.tracking import TrackParams
+from fmt_touch.touch_driver import FRAME_PERIOD_S, TB, build_args, group, scene_maps
 
-MODULES = ["fmt_touch", "fmt_flatten", "fmt_localmax", "fmt_interp", "fmt_interp_dly",
-           "fmt_interp_cordic", "fmt_div", "fmt_interp_lg", "fmt_interp_exp",
-           "fmt_interp_bias_rom", "fmt_tracker", "fmt_tracker_vel", "fmt_event_port",
-           "fmt_blob", "fmt_sorted_list"]
 BUDGET = 120
 BLOB_BUDGET = 200              # blobs on: + the wait for the blob mask and the replay
-FRAME_PERIOD_S = 1e-3          # scaled timeline for the tracking settings
-
-
-class TB(ClockedTB):
-    def __init__(self, dut):
-        super().__init__(dut)
-        self.cfg = params.get(env_str("CFG", "small"))
-        self.cycle = 0
-        self.events = []
-        self.row_cycles = {}
-        d = dut
-        d.hm_valid_i.value = 0
-        d.hm_eof_i.value = 0
-        d.hm_row_i.value = 0
-        d.hm_frame_i.value = 0
-        d.hm_data_i.value = 0
-        d.cal_we_i.value = 0
-        d.cal_sel_i.value = 0
-        d.cal_row_i.value = 0
-        d.cal_col_i.value = 0
-        d.cal_data_i.value = 0
-        d.cal_re_i.value = 0
-        d.sat_clr_i.value = 0
-        d.ev_ready_i.value = 1
-        d.delay_i.value = 0
-        d.report_period_i.value = 0
-        d.blob_en_i.value = 0
-        d.blob_threshold_i.value = 1
-        d.blob_min_cells_i.value = 0
-        cocotb.start_soon(self._monitor())
-
-    def settings(self, st: TouchSettings):
-        cfg, d = self.cfg, self.dut
-        tp = TrackParams.from_settings(cfg, st, FRAME_PERIOD_S)
-        d.threshold_i.value = st.threshold
-        d.moore_i.value = int(st.neighbourhood == "moore")
-        d.limit_i.value = st.max_touches if st.max_touches is not None else cfg.max_touches
-        d.bias_en_i.value = int(st.bias_correction)
-        d.max_jump_i.value = tp.max_jump_q
-        d.hold_jump_i.value = tp.hold_jump_q
-        d.hold_off_i.value = tp.hold_off_frames
-        d.vel_shift_i.value = tp.vel_shift
-        d.max_speed_i.value = tp.max_speed_v
-        d.blob_threshold_i.value = st.blob_threshold
-        d.blob_min_cells_i.value = st.blob_min_cells
-
-    async def _monitor(self):
-        d = self.dut
-        while True:
-            await RisingEdge(self.clk)
-            await ReadOnly()
-            self.cycle += 1
-            v, r = d.ev_valid_o.value, d.rst.value
-            if not (v.is_resolvable and r.is_resolvable) or int(r):
-                continue
-            if int(v) and int(d.ev_ready_i.value):
-                self.events.append((self.cycle, tuple(int(getattr(d, f).value) for f in (
-                    "ev_frame_o", "ev_id_o", "ev_type_o", "ev_x_o", "ev_y_o", "ev_strength_o",
-                    "ev_axis_major_o", "ev_axis_minor_o", "ev_angle_o", "ev_flags_o")),
-                    int(d.ev_last_o.value)))
-
-    async def calibrate(self, off, gain):
-        d, cfg = self.dut, self.cfg
-        await self.writable()
-        for sel, arr in ((0, off), (1, gain)):
-            for r in range(cfg.rows):
-                for c in range(cfg.cols):
-                    d.cal_we_i.value = 1
-                    d.cal_sel_i.value = sel
-                    d.cal_row_i.value = r
-                    d.cal_col_i.value = c
-                    d.cal_data_i.value = int(arr[r, c])
-                    await RisingEdge(self.clk)
-                    await self.writable()
-        d.cal_we_i.value = 0
-
-    async def send(self, frames, rng, period):
-        """Heat maps one row per cycle in random order, hm_eof on the next cycle, one
-        frame every `period` cycles.  Records the edge that takes each last row."""
-        d, cfg = self.dut, self.cfg
-        w = cfg.hm_width
-        await self.writable()
-        for k, hm in enumerate(frames):
-            order = list(range(cfg.rows))
-            rng.shuffle(order)
-            t0 = self.cycle
-            for r in order:
-                word = 0
-                for c in range(cfg.cols):
-                    word |= int(hm[r, c]) << (c * w)
-                d.hm_valid_i.value = 1
-                d.hm_row_i.value = r
-                d.hm_frame_i.value = k
-                d.hm_data_i.value = word
-                await RisingEdge(self.clk)
-                await self.writable()
-            self.row_cycles[k] = self.cycle          # the edge that took the last row
-            d.hm_valid_i.value = 0
-            d.hm_eof_i.value = 1
-            d.hm_frame_i.value = k
-            await RisingEdge(self.clk)
-            await self.writable()
-            d.hm_eof_i.value = 0
-            while self.cycle < t0 + period:
-                await RisingEdge(self.clk)
-                await self.writable()
 
 
 def random_maps(cfg, rng, n, top):
@@ -158,31 +48,6 @@ def random_maps(cfg, rng, n, top):
             z = rng.integers(0, top + 1, size=(cfg.rows, cfg.cols))   # many maxima, saturation
         out[k] = np.clip(z, 0, top)
     return out
-
-
-def scene_maps(cfg, n, top, rng):
-    """Two fingers moving 0.4 mm per frame, one tapping, a 3rd crossing."""
-    out = np.zeros((n, cfg.rows, cfg.cols), dtype=np.int64)
-    W, H = cfg.width_mm, cfg.height_mm
-    for k in range(n):
-        cts = [(3 + 0.4 * k % (W - 6), 0.3 * H + 0.1 * k, 8.0, 1.0)]
-        if (k // 5) % 2 == 0:
-            cts.append((0.7 * W, 0.6 * H, 7.0, 0.8))
-        cts.append((W - 3 - 0.5 * k % (W - 6), 0.5 * H, 8.0, 1.2))
-        m = sensor.contact_map(cfg, cts) * 25000 + rng.normal(0, 30, (cfg.rows, cfg.cols)) + 200
-        out[k] = np.clip(np.rint(m), 0, top)
-    return out
-
-
-def group(events):
-    fr, cur = [], []
-    for c, e, last in events:
-        cur.append((c, e))
-        if last:
-            fr.append(cur)
-            cur = []
-    assert not cur, "stream ended inside a frame"
-    return fr
 
 
 async def run_case(tb, maps, st, cal, rng, period, blobs=False):
@@ -340,13 +205,6 @@ async def blobs(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-def build_args(sim: str) -> list[str]:
-    args = [f'-DFMT_ROM_DIR="{RTL}/"']
-    if sim == "verilator":
-        args += ["--output-split", "0", "--output-split-cfuncs", "0", "-CFLAGS", "-O0"]
-    return args
-
-
 # medium by default (the Verilator build of the whole chain takes ~1 min per size);
 # FMT_TOUCH_ALL=1 adds the small sensor.
 SIZES = ["small", "medium"] if os.environ.get("FMT_TOUCH_ALL") else ["medium"]
@@ -362,7 +220,7 @@ def _run_touch(sim, cfg_name):
     run_cocotb(
         sim=sim,
         toplevel="fmt_touch",
-        sources=rtl_sources(*MODULES),
+        sources=sources("fmt_touch"),
         test_module="test_fmt_touch",
         test_dir=Path(__file__).parent,
         parameters={**{k: p[k] for k in ("ROWS", "COLS", "HM_W", "MAX_TOUCHES")}, "EV_DEPTH": 256},

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fmt import params
-from test_fmt_touch import scene_maps
+from fmt_touch.touch_driver import scene_maps
 
 ROOT = Path(__file__).resolve().parents[2]
 
