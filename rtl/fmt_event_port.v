@@ -9,14 +9,24 @@
 // (inferred block RAM, read-first).  Output: a registered valid/ready stream; the
 // fields hold while ev_valid_o is high and ev_ready_i low.
 //
-// Timing: an event arriving in cycle c is on the output in cycle c + 3 + delay_i
-// (RAM write, RAM read, output register; the dial adds exactly delay_i cycles, 0 adds
-// nothing) when the consumer is ready and nothing queues in front of it: the head
-// event leaves the RAM only when now - ev_time >= delay_i + 2 (mod 2^TIME_W).
-// Events keep their input spacing.  Largest loss-free delay: the FIFO must hold every
+// Timing: an event arriving in cycle c is on the output in cycle c + 5 + delay_i
+// (RAM write, RAM read, head register, eligibility register, output register; the dial
+// adds exactly delay_i cycles, 0 adds nothing) when the consumer is ready and nothing
+// queues in front of it: the head event leaves only when now - ev_time >= delay + 4
+// (mod 2^TIME_W).  Events keep their input spacing (one per cycle at most, any
+// frame rate).  Largest loss-free delay: the FIFO must hold every
 // event younger than the delay, (DEPTH / MAX_EV - 1) admitted frames: at every frame
 // (162.76 kHz, DEPTH 2048, MAX_EV 32) 63 frames = 387 us; at a 250 Hz report rate
 // 63 x 4 ms = 252 ms (the paper's 150 ms Pong delay fits).
+//
+// Structure: the RAM is read ahead (read enable, address = read pointer) through a
+// chain: its read register q_q, then flip-flops next_q (the read data goes straight into
+// them) and head_q; each moves when the one after it is free, so the port still takes
+// and gives one event per cycle.  The pop decision is the register elig_q, computed one
+// cycle ahead from the head's and the next entry's time stamps against now + 1, so
+// nothing decided in a cycle depends on the RAM's output of that cycle.  The admission conditions (room,
+// report period) are registers computed one cycle ahead too; delay_i and
+// report_period_i act one cycle after they change.
 //
 // Admission, decided at a frame's first event for the whole frame:
 //   report_period_i > 0 and fewer than report_period_i cycles since the last admitted
@@ -84,56 +94,90 @@ module fmt_event_port #(
     localparam integer DEPTH_I = DEPTH;
     localparam [AW:0]  ROOM    = ROOM_I[AW:0];      // count <= ROOM: a whole frame fits
     localparam [AW:0]  FULL    = DEPTH_I[AW:0];
+    localparam [TIME_W:0] NEED_EXTRA = 4;           // fixed latency 5 = NEED_EXTRA + 1
     localparam RW = FRAME_W + TIME_W + ID_W + 2 + 16 + 16 + HM_W + 16 + 16 + 8 + 8 + 1;
+    localparam TLSB = RW - FRAME_W - TIME_W;        // time stamp field: [TLSB +: TIME_W]
 
+    // read data on a read/write collision is never used (a read is issued only for an
+    // address written in an earlier cycle): no collision logic around the block RAM
+    (* no_rw_check *)
     reg [RW-1:0]     mem [0:DEPTH-1];
-    reg [TIME_W-1:0] now_q;
+    reg [TIME_W-1:0] now_q, nxt_q;                  // nxt_q = now_q + 1
+    reg [TIME_W:0]   need_q;                        // delay_i + 4 of the previous cycle
     reg [AW-1:0]     wr_ptr_q, rd_ptr_q;
-    reg [AW:0]       count_q;
-    reg              head_ok_q;
-    reg [RW-1:0]     head_q;
-    reg              in_frame_q, admit_q, have_admit_q;
-    reg [TIME_W-1:0] last_admit_q;
+    reg [AW:0]       count_q;                       // events held (RAM, read register, window)
+    reg              room_q, not_full_q;
+    reg [RW-1:0]     q_q;                           // RAM read register (in the block RAM)
+    reg [RW-1:0]     next_q, head_q;                // flip-flops after the RAM: next, head
+    reg              q_v_q, next_v_q, head_v_q;
+    reg              elig_q;                        // the head leaves this cycle if the output is free
+    reg              in_frame_q, admit_q, have_admit_q, dok_q;
+    reg [TIME_W-1:0] last_admit_m1_q;               // time of the last admitted frame - 1
 
     assign now_o = now_q;
 
-    wire [TIME_W-1:0] head_time = head_q[RW-FRAME_W-1 -: TIME_W];
-    wire [TIME_W-1:0] age       = now_q - head_time;
-    wire [TIME_W:0]   need      = {1'b0, delay_i} + {{(TIME_W-1){1'b0}}, 2'd2};  // delay + 2
-    wire              eligible  = head_ok_q && ({1'b0, age} >= need);
-    wire              pop       = eligible && (!ev_valid_o || ev_ready_i);
+    wire              pop      = elig_q && (!ev_valid_o || ev_ready_i);
+    // read pipeline RAM -> q_q -> next_q -> head_q: each moves when the one after it is free
+    wire              keep_h   = head_v_q && !pop;
+    wire              n_hold   = keep_h && next_v_q;      // next cannot move into head
+    wire              q_hold   = n_hold && q_v_q;         // q cannot move into next
+    wire              issue    = (wr_ptr_q != rd_ptr_q) && !q_hold;
+    wire [TIME_W-1:0] head_age = nxt_q - head_q[TLSB +: TIME_W];   // age in the next cycle
+    wire [TIME_W-1:0] next_age = nxt_q - next_q[TLSB +: TIME_W];
+    wire              r_head   = head_v_q && ({1'b0, head_age} >= need_q);
+    wire              r_next   = next_v_q && ({1'b0, next_age} >= need_q);
+    wire              elig_d   = keep_h ? r_head : r_next;
 
     wire              first     = in_valid_i && !in_frame_q;
-    wire              room      = (count_q <= ROOM);
-    wire [TIME_W-1:0] since     = now_q - last_admit_q;
-    wire              decim_ok  = (report_period_i == {TIME_W{1'b0}}) || !have_admit_q ||
-                                  (since >= report_period_i);
-    wire              decide    = room && decim_ok;
+    wire              decide    = room_q && dok_q;
     wire              admit_cur = first ? decide : admit_q;
-    wire              wr        = in_valid_i && admit_cur && (count_q < FULL);
-    wire [AW-1:0]     rd_addr   = rd_ptr_q + {{(AW-1){1'b0}}, pop};
+    wire              wr        = in_valid_i && admit_cur && not_full_q;
+    wire              admit_now = first && decide;
+    wire [TIME_W-1:0] since_p1  = now_q - last_admit_m1_q;         // cycles since, next cycle
+    wire              p_zero    = (report_period_i == {TIME_W{1'b0}});
+    wire              p_le1     = (report_period_i <= {{(TIME_W-1){1'b0}}, 1'b1});
+    wire              dok_d     = admit_now ? p_le1
+                                            : (p_zero || !have_admit_q || (since_p1 >= report_period_i));
+    wire [AW:0]       count_d   = count_q + {{AW{1'b0}}, wr} - {{AW{1'b0}}, pop};
     wire [RW-1:0]     din       = {in_frame_i, now_q, in_id_i, in_type_i, in_x_i, in_y_i,
                                    in_strength_i, in_axis_major_i, in_axis_minor_i,
                                    in_angle_i, in_flags_i, in_last_i};
 
-    // block RAM: write port and registered (read-first) read port, no reset
+    // block RAM: write port and registered read port with enable, no reset
     always @(posedge clk) begin
         if (wr)
             mem[wr_ptr_q] <= din;
-        head_q <= mem[rd_addr];
+        if (issue)
+            q_q <= mem[rd_ptr_q];
+    end
+
+    // the read data goes straight into flip-flops (next_q), then head_q; no reset
+    always @(posedge clk) begin
+        if (!keep_h)
+            head_q <= next_q;
+        if (!n_hold)
+            next_q <= q_q;
     end
 
     always @(posedge clk) begin
         if (rst) begin
             now_q        <= {TIME_W{1'b0}};
+            nxt_q        <= {{(TIME_W-1){1'b0}}, 1'b1};
+            need_q       <= NEED_EXTRA;
             wr_ptr_q     <= {AW{1'b0}};
             rd_ptr_q     <= {AW{1'b0}};
             count_q      <= {(AW+1){1'b0}};
-            head_ok_q    <= 1'b0;
+            room_q       <= 1'b1;
+            not_full_q   <= 1'b1;
+            q_v_q        <= 1'b0;
+            head_v_q     <= 1'b0;
+            next_v_q     <= 1'b0;
+            elig_q       <= 1'b0;
             in_frame_q   <= 1'b0;
             admit_q      <= 1'b0;
             have_admit_q <= 1'b0;
-            last_admit_q <= {TIME_W{1'b0}};
+            dok_q        <= 1'b1;
+            last_admit_m1_q <= {TIME_W{1'b1}};
             drop_count_o <= {CNT_W{1'b0}};
             skip_count_o <= {CNT_W{1'b0}};
             overflow_o   <= 1'b0;
@@ -141,29 +185,37 @@ module fmt_event_port #(
             {ev_frame_o, ev_time_o, ev_id_o, ev_type_o, ev_x_o, ev_y_o, ev_strength_o,
              ev_axis_major_o, ev_axis_minor_o, ev_angle_o, ev_flags_o, ev_last_o} <= {RW{1'b0}};
         end else begin
-            now_q <= now_q + 1'b1;
+            now_q  <= nxt_q;
+            nxt_q  <= nxt_q + 1'b1;
+            need_q <= {1'b0, delay_i} + NEED_EXTRA;
             // admission
             if (first) begin
                 admit_q <= decide;
                 if (decide) begin
-                    last_admit_q <= now_q;
-                    have_admit_q <= 1'b1;
-                end else if (decim_ok) begin
+                    last_admit_m1_q <= now_q - 1'b1;
+                    have_admit_q    <= 1'b1;
+                end else if (dok_q) begin
                     overflow_o <= 1'b1;
                     if (drop_count_o != {CNT_W{1'b1}}) drop_count_o <= drop_count_o + 1'b1;
                 end else begin
                     if (skip_count_o != {CNT_W{1'b1}}) skip_count_o <= skip_count_o + 1'b1;
                 end
             end
+            dok_q <= dok_d;
             if (in_valid_i)
                 in_frame_q <= !in_last_i;
             // FIFO
             if (wr)
                 wr_ptr_q <= wr_ptr_q + 1'b1;
-            if (pop)
+            if (issue)
                 rd_ptr_q <= rd_ptr_q + 1'b1;
-            head_ok_q <= (count_q - {{AW{1'b0}}, pop}) != {(AW+1){1'b0}};
-            count_q   <= count_q + {{AW{1'b0}}, wr} - {{AW{1'b0}}, pop};
+            count_q    <= count_d;
+            room_q     <= (count_d <= ROOM);
+            not_full_q <= (count_d < FULL);
+            q_v_q      <= issue || q_hold;
+            head_v_q   <= keep_h || next_v_q;
+            next_v_q   <= n_hold || q_v_q;
+            elig_q     <= elig_d;
             // output register
             if (pop) begin
                 ev_valid_o <= 1'b1;

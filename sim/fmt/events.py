@@ -7,18 +7,27 @@ a FIFO of ``depth`` entries (inferred block RAM) and presents it on a valid/read
 output.
 
 Fixed pipeline: an event that arrives in cycle c is on the output (``ev_valid``) in
-cycle ``c + FIXED_LATENCY`` (= 3: RAM write, RAM read, output register) when the dial
-is 0, the consumer is ready and nothing queues in front of it.
+cycle ``c + FIXED_LATENCY`` (= 5: RAM write, RAM read, head register, eligibility
+register, output register) when the dial is 0, the consumer is ready and nothing
+queues in front of it.
 
-Dial-a-latency: the head event leaves the RAM only when ``now - ev_time >= delay + 2``
+Dial-a-latency: the head event leaves only when ``now - ev_time >= delay + 4``
 (modulo 2^TIME_W), so with ``delay`` = D the event is on the output in cycle exactly
-``c + 3 + D``: the dial adds exactly D cycles, zero at D = 0.  Events keep their input
+``c + 5 + D``: the dial adds exactly D cycles, zero at D = 0.  Events keep their input
 spacing, so this holds for every event while the FIFO does not overflow.  Maximum
 delay without loss: the FIFO must hold every event younger than D, so D_max =
 (depth / max_ev - 1) admitted frames (a frame may bring up to ``max_ev`` events); at
 the default depth 2048, max_ev 32 that is 63 frames: 387 us at every frame
 (162.76 kHz); with a report period (at most one frame per ``report_period`` cycles
 enters the FIFO) of 4 ms (250 Hz) it is 252 ms, enough for the paper's 150 ms.
+
+Structure (the RTL's registers): the RAM is read ahead through a chain of registers,
+its read register ``q`` (in the block RAM), ``next`` (the flip-flops the read data goes
+into) and ``head``; each moves when the one after it is free.  The decision that the
+head leaves (``elig``) is a register computed one cycle ahead from the head's and the
+next entry's time stamps against ``now + 1``, so nothing decided in a cycle depends on
+the RAM's output.
+The settings ``delay`` and ``report_period`` act one cycle after they change.
 
 Admission (decided at a frame's first event, applied to the whole frame):
   * report-rate decimation: if ``report_period`` > 0 and fewer than ``report_period``
@@ -35,9 +44,11 @@ a frame cut by a port-only reset for a whole frame).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-FIXED_LATENCY = 3
+FIXED_LATENCY = 5
+NEED_EXTRA = FIXED_LATENCY - 1        # the head leaves the RAM when age >= delay + 4
+
 
 
 @dataclass(frozen=True)
@@ -61,22 +72,34 @@ class EventPort:
 
     def __init__(self, p: PortParams = PortParams()):
         self.p = p
+        self.mem = [None] * p.depth    # the RAM (no reset)
         self.reset()
 
     def reset(self):
+        p = self.p
+        tmask = (1 << p.time_w) - 1
         self.now = 0
-        self.mem = [None] * self.p.depth
+        self.nxt = 1                   # now + 1
+        self.need = NEED_EXTRA         # delay + 4 of the previous cycle (delay 0 at reset)
         self.wr_ptr = 0
-        self.rd_ptr = 0
-        self.count = 0
-        self.head_ok = False
-        self.head = None           # (event, time, last)
+        self.rd_ptr = 0                # next RAM address to read
+        self.count = 0                 # events held (RAM, read register, window)
+        self.room = True               # count <= depth - max_ev
+        self.not_full = True           # count < depth
+        self.q = None                  # RAM read register: (event, time, last)
+        self.q_v = False
+        self.n = None                  # next register (the RAM read data's first flip-flops)
+        self.n_v = False
+        self.h = None                  # head register
+        self.h_v = False
+        self.elig = False              # the head may leave this cycle (its age >= need)
         self.out_valid = False
         self.out = None
         self.in_frame = False
         self.admit = False
         self.have_admit = False
-        self.last_admit = 0
+        self.last_admit_m1 = tmask     # last admitted first event's time - 1
+        self.dok = True                # report-rate condition for a first event this cycle
         self.drop_count = 0
         self.skip_count = 0
         self.overflow = False
@@ -95,44 +118,66 @@ class EventPort:
         if self.out_valid and ready:
             ev, t, last = self.out
             fired = PortOut(self.now, ev, t, last)
-        eligible = self.head_ok and ((self.now - self.head[1]) & tmask) >= delay + 2
-        pop = eligible and (not self.out_valid or ready)
+        pop = self.elig and (not self.out_valid or ready)
+        # read pipeline: RAM -> read register q -> next -> head (each moves when the one
+        # after it is free)
+        keep_h = self.h_v and not pop
+        n_hold = keep_h and self.n_v                   # next cannot move into head
+        q_hold = n_hold and self.q_v                   # read register cannot move into next
+        issue = self.wr_ptr != self.rd_ptr and not q_hold
+        # eligibility of the next cycle's head, from registers only
+        r_h = self.h_v and ((self.nxt - self.h[1]) & tmask) >= self.need
+        r_n = self.n_v and ((self.nxt - self.n[1]) & tmask) >= self.need
+        elig = r_h if keep_h else r_n
         # input side
         first = in_valid and not self.in_frame
-        room = (p.depth - self.count) >= p.max_ev
-        decim_ok = (report_period == 0 or not self.have_admit
-                    or ((self.now - self.last_admit) & tmask) >= report_period)
-        decide = room and decim_ok
+        decide = self.room and self.dok
         admit_cur = decide if first else self.admit
-        wr = in_valid and admit_cur and self.count < p.depth
+        wr = in_valid and admit_cur and self.not_full
+        admit_now = first and decide
+        if admit_now:
+            dok = report_period <= 1
+        else:
+            dok = (report_period == 0 or not self.have_admit
+                   or ((self.now - self.last_admit_m1) & tmask) >= report_period)
         # next state
-        old_mem_rd = self.mem[(self.rd_ptr + (1 if pop else 0)) % p.depth]
         if first:
             if decide:
-                self.last_admit = self.now
+                self.last_admit_m1 = (self.now - 1) & tmask
                 self.have_admit = True
-            elif decim_ok:
+            elif self.dok:
                 self.drop_count = min(cmax, self.drop_count + 1)
                 self.overflow = True
             else:
                 self.skip_count = min(cmax, self.skip_count + 1)
             self.admit = decide
+        self.dok = dok
         if in_valid:
             self.in_frame = not in_last
         if pop:
-            self.out = self.head
+            self.out = self.h
             self.out_valid = True
         elif ready:
             self.out_valid = False
+        if not keep_h:
+            self.h = self.n
+        if not n_hold:
+            self.n = self.q
+        self.h_v, self.n_v = keep_h or self.n_v, n_hold or self.q_v
+        if issue:
+            self.q = self.mem[self.rd_ptr]
+            self.rd_ptr = (self.rd_ptr + 1) % p.depth
+        self.q_v = issue or q_hold
+        self.elig = elig
         if wr:
             self.mem[self.wr_ptr] = (in_event, self.now, bool(in_last))
             self.wr_ptr = (self.wr_ptr + 1) % p.depth
-        self.head_ok = (self.count - (1 if pop else 0)) > 0
-        self.head = old_mem_rd
-        if pop:
-            self.rd_ptr = (self.rd_ptr + 1) % p.depth
         self.count += (1 if wr else 0) - (1 if pop else 0)
+        self.room = self.count <= p.depth - p.max_ev
+        self.not_full = self.count < p.depth
+        self.need = delay + NEED_EXTRA
         self.now = (self.now + 1) & tmask
+        self.nxt = (self.nxt + 1) & tmask
         return fired
 
 

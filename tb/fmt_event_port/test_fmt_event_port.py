@@ -2,7 +2,7 @@
 
 Every handshake (cycle, all fields, ev_time, ev_last) and the final drop / skip
 counters must equal the model's, for: dial delays 0, 1, 37, large and the loss-free
-maximum (exact c + 3 + delay checked), report-rate decimation, random and long
+maximum (exact c + 5 + delay checked), report-rate decimation, random and long
 consumer stalls with whole-frame drops, and a reset in the middle of a frame.  While
 ev_valid is high and ev_ready low the output must hold.
 """
@@ -116,7 +116,8 @@ async def check(tb, beats, n, ready=None, delay=0, period=0, reset_at=()):
 
 @cocotb.test()
 async def exact_delays(dut):
-    """Dial 0, 1, 37 and large: bit-exact, and every event leaves at c + 3 + delay."""
+    """Dial 0, 1, 37 and large: bit-exact, and every event leaves at c + 5 + delay
+    (c + FIXED_LATENCY + delay)."""
     tb = TB(dut)
     rng = random.Random(env_int("SEED", 1))
     frames = rand_frames(rng, 30, tb.p.max_ev, tb.hm_w)
