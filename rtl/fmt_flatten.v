@@ -2,12 +2,14 @@
 //
 // One heat-map row per beat (docs/ARCHITECTURE.md heat-map stream), all COLS columns
 // in parallel (COLS multipliers), a beat may come on every cycle.  Output is the same
-// stream format, delayed by exactly LATENCY = 4 cycles (valid, row, frame, data, eof
+// stream format, delayed by exactly LATENCY = 5 cycles (valid, row, frame, data, eof
 // all delayed alike):
 //   s1: offset/gain RAM read (synchronous, address = row), input registered
-//   s2: d = z - offset, clamped at 0 (a cell below its baseline is noise, not flagged)
-//   s3: p = d * gain                          (HM_W + 16 bits, one DSP48E per column)
-//   s4: q = (p + 2^13) >> 14 (round half up); q > 2^HM_W - 1 -> 2^HM_W - 1, flagged
+//   s2: RAM output register (the block RAM's own), input delayed
+//   s3: d = z - offset, clamped at 0 (a cell below its baseline is noise, not flagged)
+//   s4: p = d * gain                          (HM_W + 16 bits, one DSP48E per column,
+//       operands and product registered)
+//   s5: q = (p + 2^13) >> 14 (round half up); q > 2^HM_W - 1 -> 2^HM_W - 1, flagged
 // Formats: z, offset, z' unsigned HM_W bits; gain unsigned 16-bit Q2.14 (1.0 = 16384).
 // Bit-exact twin: sim/fmt/flatten.py flatten_fixed().
 //
@@ -27,8 +29,10 @@
 // {sel, row, col}, written with the column memories, read-first; block RAM at the
 // default size) instead of a COLS:1 multiplexer over the column memories' read
 // registers: 2 RAMB36 at 30 x 40 instead of ~510 LUT6.
-// Saturation: sat_flag_o is sticky (cleared by rst or sat_clr_i), sat_count_o counts
-// saturated cells (saturating counter), one cycle behind the output beat.
+// Saturation: sat_flag_o is sticky (cleared by rst or sat_clr_i), one cycle behind the
+// output beat; sat_count_o counts saturated cells (saturating counter), three cycles
+// behind the output beat (population count in two registered stages: groups of 16
+// cells, then their sum; sat_clr_i also clears the counts in flight).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -52,7 +56,7 @@ module fmt_flatten #(
     input  wire [FRAME_W-1:0]      hm_frame_i,   // frame number
     input  wire [COLS*HM_W-1:0]    hm_data_i,    // column c at [c*HM_W +: HM_W]
     input  wire                    hm_eof_i,     // end of frame marker
-    // heat-map stream out (LATENCY = 4 cycles)
+    // heat-map stream out (LATENCY = 5 cycles)
     output reg                     hm_valid_o,   // flattened row
     output reg  [ROW_IDX_W-1:0]    hm_row_o,     // row index
     output reg  [FRAME_W-1:0]      hm_frame_o,   // frame number
@@ -79,18 +83,22 @@ module fmt_flatten #(
     localparam P_W = HM_W + GAIN_W;
     localparam [P_W-1:0] HALF = {{(P_W-1){1'b0}}, 1'b1} << (GAIN_FRAC - 1);
     localparam POP_W = $clog2(COLS + 1);
+    localparam PG    = 16;                                  // cells per population-count group
+    localparam NG    = (COLS + PG - 1) / PG;                // groups
+    localparam PGW   = 5;                                   // count of one group (0 .. 16)
+    localparam PSW   = (POP_W > PGW) ? POP_W : PGW;         // count of a beat
 
     // ---- pipeline control -----------------------------------------------------------
-    reg                   v1_q, v2_q, v3_q;
-    reg                   e1_q, e2_q, e3_q;
-    reg [ROW_IDX_W-1:0]   r1_q, r2_q, r3_q;
-    reg [FRAME_W-1:0]     f1_q, f2_q, f3_q;
-    reg [COLS*HM_W-1:0]   z1_q;
-    reg [COLS*HM_W-1:0]   d2_q;
-    reg [COLS*GAIN_W-1:0] g2_q;
-    reg [COLS*P_W-1:0]    p3_q;
-    wire [COLS*HM_W-1:0]  q4;
-    wire [COLS-1:0]       sat4;
+    reg                   v1_q, v2_q, v3_q, v4_q;
+    reg                   e1_q, e2_q, e3_q, e4_q;
+    reg [ROW_IDX_W-1:0]   r1_q, r2_q, r3_q, r4_q;
+    reg [FRAME_W-1:0]     f1_q, f2_q, f3_q, f4_q;
+    reg [COLS*HM_W-1:0]   z1_q, z2_q;
+    reg [COLS*HM_W-1:0]   d3_q;
+    reg [COLS*GAIN_W-1:0] g3_q;
+    reg [COLS*P_W-1:0]    p4_q;
+    wire [COLS*HM_W-1:0]  q5;
+    wire [COLS-1:0]       sat5;
 
     // read-back request, served in a cycle without a heat-map beat
     reg                  rd_pend_q, rd_go_q, rd_sel_q;
@@ -105,8 +113,9 @@ module fmt_flatten #(
             // {gain, offset} of this column's cells; read-first (a write is seen by the
             // beats of the following cycles); no reset (block RAM has none)
             wire [HM_W+GAIN_W-1:0] cal_rd;           // read register (s1)
-            wire [HM_W-1:0]   off_rd_q  = cal_rd[HM_W-1:0];
-            wire [GAIN_W-1:0] gain_rd_q = cal_rd[HM_W +: GAIN_W];
+            reg  [HM_W+GAIN_W-1:0] cal_rd2_q;        // output register (s2)
+            wire [HM_W-1:0]   off_rd_q  = cal_rd2_q[HM_W-1:0];
+            wire [GAIN_W-1:0] gain_rd_q = cal_rd2_q[HM_W +: GAIN_W];
             wire we_off  = cal_we_i && (cal_col_i == c) && !cal_sel_i;
             wire we_gain = cal_we_i && (cal_col_i == c) &&  cal_sel_i;
             if (CAL_BRAM != 0) begin : g_bram
@@ -141,33 +150,58 @@ module fmt_flatten #(
                 assign cal_rd = rd_q;
             end
 
-            // s2: subtract, clamp at zero
-            wire [HM_W:0] diff = {1'b0, z1_q[c*HM_W +: HM_W]} - {1'b0, off_rd_q};
+            // s3: subtract, clamp at zero
+            wire [HM_W:0] diff = {1'b0, z2_q[c*HM_W +: HM_W]} - {1'b0, off_rd_q};
             always @(posedge clk) begin
-                d2_q[c*HM_W +: HM_W]     <= diff[HM_W] ? {HM_W{1'b0}} : diff[HM_W-1:0];
-                g2_q[c*GAIN_W +: GAIN_W] <= gain_rd_q;
-                // s3: multiply
-                p3_q[c*P_W +: P_W] <= d2_q[c*HM_W +: HM_W] * g2_q[c*GAIN_W +: GAIN_W];
+                cal_rd2_q <= cal_rd;
+                d3_q[c*HM_W +: HM_W]     <= diff[HM_W] ? {HM_W{1'b0}} : diff[HM_W-1:0];
+                g3_q[c*GAIN_W +: GAIN_W] <= gain_rd_q;
+                // s4: multiply
+                p4_q[c*P_W +: P_W] <= d3_q[c*HM_W +: HM_W] * g3_q[c*GAIN_W +: GAIN_W];
             end
-            // s4: round half up, saturate (p + HALF cannot overflow P_W: p <= (2^HM_W-1)(2^16-1))
+            // s5: round half up, saturate (p + HALF cannot overflow P_W: p <= (2^HM_W-1)(2^16-1))
             /* verilator lint_off UNUSEDSIGNAL */ // the 14 fraction bits are dropped by the rounding
-            wire [P_W-1:0] rnd = p3_q[c*P_W +: P_W] + HALF;
+            wire [P_W-1:0] rnd = p4_q[c*P_W +: P_W] + HALF;
             /* verilator lint_on UNUSEDSIGNAL */
             wire [P_W-GAIN_FRAC-1:0] qfull = rnd[P_W-1:GAIN_FRAC];
-            assign sat4[c] = |qfull[P_W-GAIN_FRAC-1:HM_W];
-            assign q4[c*HM_W +: HM_W] = sat4[c] ? {HM_W{1'b1}} : qfull[HM_W-1:0];
+            assign sat5[c] = |qfull[P_W-GAIN_FRAC-1:HM_W];
+            assign q5[c*HM_W +: HM_W] = sat5[c] ? {HM_W{1'b1}} : qfull[HM_W-1:0];
         end
     endgenerate
 
-    // population count of the saturated cells of the output beat
-    reg [POP_W-1:0] pop;
+    // population count of the saturated cells of the output beat: stage 1 counts each
+    // group of 16 cells (4-cell counts in logic, then two levels of small adders), stage
+    // 2 adds the group counts, then the counter adds the total
+    function [2:0] pop4;
+        input [3:0] b;
+        reg s01, s23, c01, c23, k;
+        begin
+            s01 = b[0] ^ b[1];  c01 = b[0] & b[1];
+            s23 = b[2] ^ b[3];  c23 = b[2] & b[3];
+            k   = s01 & s23;
+            pop4 = {(c01 & c23) | ((c01 ^ c23) & k), c01 ^ c23 ^ k, s01 ^ s23};
+        end
+    endfunction
+
+    reg  [NG*PG-1:0]  sat_pad;                  // hm_sat_o, zero-padded to NG groups
+    reg  [NG*PSW-1:0] pg_q;                     // group counts (stage 1)
+    reg  [PSW-1:0]    pop_q;                    // beat count (stage 2)
+    reg  [NG*PSW-1:0] pg_d;
+    reg  [PSW-1:0]    pop_d;
     integer k;
     always @(*) begin
-        pop = {POP_W{1'b0}};
-        for (k = 0; k < COLS; k = k + 1)
-            pop = pop + {{(POP_W-1){1'b0}}, hm_sat_o[k]};
+        sat_pad = {(NG*PG){1'b0}};
+        sat_pad[COLS-1:0] = hm_sat_o;
+        for (k = 0; k < NG; k = k + 1)
+            pg_d[k*PSW +: PSW] = ({{(PSW-3){1'b0}}, pop4(sat_pad[k*PG      +: 4])} +
+                                  {{(PSW-3){1'b0}}, pop4(sat_pad[k*PG +  4 +: 4])}) +
+                                 ({{(PSW-3){1'b0}}, pop4(sat_pad[k*PG +  8 +: 4])} +
+                                  {{(PSW-3){1'b0}}, pop4(sat_pad[k*PG + 12 +: 4])});
+        pop_d = {PSW{1'b0}};
+        for (k = 0; k < NG; k = k + 1)
+            pop_d = pop_d + pg_q[k*PSW +: PSW];
     end
-    wire [CNT_W:0] cnt_sum = {1'b0, sat_count_o} + {{(CNT_W+1-POP_W){1'b0}}, pop};
+    wire [CNT_W:0] cnt_sum = {1'b0, sat_count_o} + {{(CNT_W+1-PSW){1'b0}}, pop_q};
 
     // read-back: shadow copy of the calibration, address {sel, row, col}, holding the
     // word as it is read back (offset: low HM_W bits, gain: low 16 bits, zero-extended)
@@ -214,27 +248,34 @@ module fmt_flatten #(
     end
 
     always @(posedge clk) begin
-        z1_q <= hm_data_i;
+        z1_q <= hm_data_i;  z2_q <= z1_q;
         r1_q <= hm_row_i;   f1_q <= hm_frame_i;
         r2_q <= r1_q;       f2_q <= f1_q;
         r3_q <= r2_q;       f3_q <= f2_q;
-        hm_row_o   <= r3_q;
-        hm_frame_o <= f3_q;
-        hm_data_o  <= q4;
+        r4_q <= r3_q;       f4_q <= f3_q;
+        hm_row_o   <= r4_q;
+        hm_frame_o <= f4_q;
+        hm_data_o  <= q5;
         if (rst) begin
-            v1_q <= 1'b0; v2_q <= 1'b0; v3_q <= 1'b0; hm_valid_o <= 1'b0;
-            e1_q <= 1'b0; e2_q <= 1'b0; e3_q <= 1'b0; hm_eof_o   <= 1'b0;
+            v1_q <= 1'b0; v2_q <= 1'b0; v3_q <= 1'b0; v4_q <= 1'b0; hm_valid_o <= 1'b0;
+            e1_q <= 1'b0; e2_q <= 1'b0; e3_q <= 1'b0; e4_q <= 1'b0; hm_eof_o   <= 1'b0;
             hm_sat_o    <= {COLS{1'b0}};
+            pg_q        <= {(NG*PSW){1'b0}};
+            pop_q       <= {PSW{1'b0}};
             sat_flag_o  <= 1'b0;
             sat_count_o <= {CNT_W{1'b0}};
         end else begin
-            v1_q <= hm_valid_i; v2_q <= v1_q; v3_q <= v2_q; hm_valid_o <= v3_q;
-            e1_q <= hm_eof_i;   e2_q <= e1_q; e3_q <= e2_q; hm_eof_o   <= e3_q;
-            hm_sat_o <= v3_q ? sat4 : {COLS{1'b0}};
+            v1_q <= hm_valid_i; v2_q <= v1_q; v3_q <= v2_q; v4_q <= v3_q; hm_valid_o <= v4_q;
+            e1_q <= hm_eof_i;   e2_q <= e1_q; e3_q <= e2_q; e4_q <= e3_q; hm_eof_o   <= e4_q;
+            hm_sat_o <= v4_q ? sat5 : {COLS{1'b0}};
             if (sat_clr_i) begin
+                pg_q        <= {(NG*PSW){1'b0}};
+                pop_q       <= {PSW{1'b0}};
                 sat_flag_o  <= 1'b0;
                 sat_count_o <= {CNT_W{1'b0}};
             end else begin
+                pg_q  <= pg_d;
+                pop_q <= pop_d;
                 if (|hm_sat_o) sat_flag_o <= 1'b1;
                 sat_count_o <= cnt_sum[CNT_W] ? {CNT_W{1'b1}} : cnt_sum[CNT_W-1:0];
             end

@@ -2,7 +2,7 @@
 
 Checks: power-on identity (offset 0, gain 1.0), bit-exact output for random offsets
 and gains loaded through the calibration port, random row orders, beats on consecutive
-cycles and with gaps, back-to-back frames, the fixed latency of 4 cycles for every
+cycles and with gaps, back-to-back frames, the fixed latency of 5 cycles for every
 beat and end-of-frame marker, per-cell saturation bits, the sticky flag and the
 saturated-cell counter (and its clear), reset in the middle of a frame.
 """
@@ -22,7 +22,7 @@ from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.flatten import GAIN_MAX, GAIN_ONE, flatten_fixed, identity
 
-LATENCY = 4
+LATENCY = 5
 
 
 class TB(ClockedTB):
