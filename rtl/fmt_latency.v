@@ -18,14 +18,21 @@
 // saturate at their maximum instead of wrapping; `sat_o` is sticky.
 // The histogram is read through a window: `hist_sel_i` (0 = first-event, 1 = last-event)
 // and `hist_addr_i` -> `hist_data_o` (registered, one cycle).
+// Pipeline: stage 0 (the event's cycle) measures the latency (now - stamp, or
+// now - trigger time); stage 1 (+1 cycle) updates last/min/max/count and sat_o and reads
+// the histogram bin; stage 2 (+2 cycles) writes bin + 1 back, forwarding the value of a
+// write to the same bin in the previous cycle, so back-to-back updates of one bin are
+// exact.  The statistics outputs thus show an event 1 cycle after it (sat_o 1 or 2
+// cycles), the histograms 2 cycles after it.  clear_i also drops the events of its own
+// cycle and of the cycle before (still in stages 0 and 1): the same counts as clearing
+// after them.  One event per cycle at most, no stall: any frame rate is fine.
 // Implementation: each histogram is a small distributed RAM (asynchronous read, one
-// write port) with ONE read-modify-write incrementer at the event's bin, read in the
-// same cycle, so back-to-back updates are exact.  A per-bin "holds data" bit (BINS
-// flip-flops, cleared by rst/clear_i in one cycle, set by the bin's first update)
-// masks the RAM word to 0: after a clear every bin reads 0 at once, without a sweep
-// and without a reset on the RAM (which would prevent the RAM inference).  The
-// frame-end time-stamp table is a distributed RAM too, with a per-slot bit (cleared
-// by rst only) that makes a slot's stamp read 0 until its first frame end.
+// write port).  A per-bin "holds data" bit (BINS flip-flops, cleared by rst/clear_i in
+// one cycle, set by the bin's first update) masks the RAM word to 0: after a clear every
+// bin reads 0 at once, without a sweep and without a reset on the RAM (which would
+// prevent the RAM inference).  The frame-end time-stamp table is a distributed RAM too,
+// with a per-slot bit (cleared by rst only) that makes a slot's stamp read 0 until its
+// first frame end.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -69,7 +76,6 @@ module fmt_latency #(
     localparam SLOTS = 1 << FRAME_SLOTS_W;
     localparam BINS  = 1 << HIST_BINS_W;
     localparam [CNT_W-1:0] CNT_MAX = {CNT_W{1'b1}};
-    localparam [NUM_W-1:0] NUM_MAX = {NUM_W{1'b1}};
 
     reg  [TIME_W-1:0]  now_q;
     reg  [TIME_W-1:0]  stamp_mem [0:SLOTS-1];  // frame-end time stamps, distributed RAM
@@ -81,34 +87,68 @@ module fmt_latency #(
     reg  [BINS-1:0]    hist_last_ok_q;
     reg  [2:0]         trig_sync_q;      // 2-FF synchroniser + edge detector
     reg  [TIME_W-1:0]  trig_start_q;
+    // stage 1: the measured event (from stage 0)
+    reg                s1_first_q, s1_last_q, s1_trig_q;
+    reg  [CNT_W-1:0]   s1_age_q, s1_tage_q;
+    reg                s1_big_q, s1_tbig_q;
+    reg                s1_over_q;            // age (below the saturation) beyond the top bin
+    // stage 2: histogram write-back
+    reg                s2_first_q, s2_last_q;
+    reg  [HIST_BINS_W-1:0] s2_bin_q;
+    reg  [NUM_W-1:0]   s2_hf_q, s2_hl_q;     // bin contents read in stage 1
+    // forwarding: stage 2 takes the value written in the previous cycle when that write
+    // was to its bin (the select is decided one cycle ahead)
+    reg                fw_f_q, fw_l_q;
+    reg  [NUM_W-1:0]   fw_f_val_q, fw_l_val_q;
 
     integer i;
 
-    // latency of the current event, saturated to CNT_W bits
+    // ---- stage 0: the event of this cycle is measured
     wire [FRAME_SLOTS_W-1:0] ev_slot  = ev_slot_i;
     wire [TIME_W-1:0]        ev_stamp = stamp_ok_q[ev_slot] ? stamp_mem[ev_slot] : {TIME_W{1'b0}};
     wire [TIME_W-1:0]        ev_age   = now_q - ev_stamp;
     wire                     ev_big   = (ev_age > {{(TIME_W-CNT_W){1'b0}}, CNT_MAX});
-    wire [CNT_W-1:0]         ev_lat   = ev_big ? CNT_MAX : ev_age[CNT_W-1:0];
+    wire [CNT_W-1:0]         ev_sh    = ev_age[CNT_W-1:0] >> HIST_SHIFT;
+    wire                     ev_over  = (ev_sh > BINS - 1);
     wire                     is_first = ev_fire_i && !seen_first_q[ev_slot];
     wire                     is_last  = ev_fire_i && ev_last_i;
-    wire [CNT_W-1:0]         hist_idx_full = ev_lat >> HIST_SHIFT;
-    wire [HIST_BINS_W-1:0]   hist_idx = (hist_idx_full > BINS - 1) ? BINS[HIST_BINS_W-1:0] - 1'b1
-                                                                  : hist_idx_full[HIST_BINS_W-1:0];
-
-    // current contents of the event's bin (0 when not written since the clear)
-    wire [NUM_W-1:0]         hf_cur = hist_first_ok_q[hist_idx] ? hist_first_mem[hist_idx]
-                                                                 : {NUM_W{1'b0}};
-    wire [NUM_W-1:0]         hl_cur = hist_last_ok_q[hist_idx] ? hist_last_mem[hist_idx]
-                                                                : {NUM_W{1'b0}};
-    wire                     hf_we  = is_first && hf_cur != NUM_MAX && !rst && !clear_i;
-    wire                     hl_we  = is_last  && hl_cur != NUM_MAX && !rst && !clear_i;
 
     wire                     trig_rise = trig_sync_q[1] && !trig_sync_q[2];
     wire [TIME_W-1:0]        trig_age  = now_q - trig_start_q;
     wire                     trig_big  = (trig_age > {{(TIME_W-CNT_W){1'b0}}, CNT_MAX});
-    wire [CNT_W-1:0]         trig_lat  = trig_big ? CNT_MAX : trig_age[CNT_W-1:0];
     wire                     trig_done = trig_armed_o && ev_fire_i && ev_new_i;
+
+    // ---- stage 1: statistics, histogram bin and its read
+    wire [CNT_W-1:0]         lat      = s1_big_q  ? CNT_MAX : s1_age_q;
+    wire [CNT_W-1:0]         trig_lat = s1_tbig_q ? CNT_MAX : s1_tage_q;
+    // bin: lat >> HIST_SHIFT, the top bin for everything above (saturated: CNT_MAX's bin)
+    localparam [CNT_W-1:0]   MAX_SH  = CNT_MAX >> HIST_SHIFT;
+    localparam [HIST_BINS_W-1:0] MAX_BIN = (MAX_SH > BINS - 1) ? BINS[HIST_BINS_W-1:0] - 1'b1
+                                                               : MAX_SH[HIST_BINS_W-1:0];
+    // only the low HIST_BINS_W bits of the shifted age are a bin (the rest is s1_over_q)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [CNT_W-1:0]         age_sh   = s1_age_q >> HIST_SHIFT;
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [HIST_BINS_W-1:0]   hist_idx = s1_big_q  ? MAX_BIN :
+                                        s1_over_q ? BINS[HIST_BINS_W-1:0] - 1'b1
+                                                  : age_sh[HIST_BINS_W-1:0];
+    wire [NUM_W-1:0]         hf_rd = hist_first_ok_q[hist_idx] ? hist_first_mem[hist_idx]
+                                                                : {NUM_W{1'b0}};
+    wire [NUM_W-1:0]         hl_rd = hist_last_ok_q[hist_idx] ? hist_last_mem[hist_idx]
+                                                               : {NUM_W{1'b0}};
+    wire [NUM_W:0]           first_cnt_inc = {1'b0, first_count_o} + 1'b1;  // carry = saturated
+    wire [NUM_W:0]           last_cnt_inc  = {1'b0, last_count_o} + 1'b1;
+    wire [NUM_W:0]           trig_cnt_inc  = {1'b0, trig_count_o} + 1'b1;
+
+    // ---- stage 2: bin + 1, saturating (the carry out is the saturation), written back
+    wire [NUM_W-1:0]         hf_cur = fw_f_q ? fw_f_val_q : s2_hf_q;
+    wire [NUM_W-1:0]         hl_cur = fw_l_q ? fw_l_val_q : s2_hl_q;
+    wire [NUM_W:0]           hf_inc = {1'b0, hf_cur} + 1'b1;
+    wire [NUM_W:0]           hl_inc = {1'b0, hl_cur} + 1'b1;
+    wire [NUM_W-1:0]         hf_new = hf_inc[NUM_W-1:0] | {NUM_W{hf_inc[NUM_W]}};
+    wire [NUM_W-1:0]         hl_new = hl_inc[NUM_W-1:0] | {NUM_W{hl_inc[NUM_W]}};
+    wire                     hf_we  = s2_first_q && !rst && !clear_i;
+    wire                     hl_we  = s2_last_q  && !rst && !clear_i;
 
     always @(posedge clk) begin
         if (rst) begin
@@ -119,6 +159,13 @@ module fmt_latency #(
             trig_armed_o  <= 1'b0;
             sat_o         <= 1'b0;
             stamp_ok_q    <= {SLOTS{1'b0}};
+            s1_first_q    <= 1'b0;
+            s1_last_q     <= 1'b0;
+            s1_trig_q     <= 1'b0;
+            s2_first_q    <= 1'b0;
+            s2_last_q     <= 1'b0;
+            fw_f_q        <= 1'b0;
+            fw_l_q        <= 1'b0;
         end else begin
             now_q       <= now_q + 1'b1;
             trig_sync_q <= {trig_sync_q[1:0], trig_i};
@@ -137,16 +184,40 @@ module fmt_latency #(
             end else if (trig_done) begin
                 trig_armed_o <= 1'b0;
             end
-            if ((is_first || is_last) && ev_big) sat_o <= 1'b1;
-            if (trig_done && trig_big) sat_o <= 1'b1;
-            if ((is_first && (first_count_o == NUM_MAX || hf_cur == NUM_MAX)) ||
-                (is_last  && (last_count_o  == NUM_MAX || hl_cur == NUM_MAX)) ||
-                (trig_done && trig_count_o == NUM_MAX))
+            // pipeline valid bits: a clear drops what it finds in stages 0 and 1
+            s1_first_q <= is_first  && !clear_i;
+            s1_last_q  <= is_last   && !clear_i;
+            s1_trig_q  <= trig_done && !clear_i;
+            s2_first_q <= s1_first_q && !clear_i;
+            s2_last_q  <= s1_last_q  && !clear_i;
+            fw_f_q     <= hf_we && (hist_idx == s2_bin_q);
+            fw_l_q     <= hl_we && (hist_idx == s2_bin_q);
+            // sticky saturation: stage 1 (values, counters), stage 2 (bins)
+            if ((s1_first_q || s1_last_q) && s1_big_q) sat_o <= 1'b1;
+            if (s1_trig_q && s1_tbig_q) sat_o <= 1'b1;
+            if ((s1_first_q && first_cnt_inc[NUM_W]) || (s1_last_q && last_cnt_inc[NUM_W]) ||
+                (s1_trig_q && trig_cnt_inc[NUM_W]))
+                sat_o <= 1'b1;
+            if ((s2_first_q && hf_inc[NUM_W]) || (s2_last_q && hl_inc[NUM_W]))
                 sat_o <= 1'b1;
         end
     end
 
-    // statistics (cleared by rst or clear_i)
+    // pipeline data (no reset needed: qualified by the valid bits)
+    always @(posedge clk) begin
+        s1_age_q   <= ev_age[CNT_W-1:0];
+        s1_big_q   <= ev_big;
+        s1_over_q  <= ev_over;
+        s1_tage_q  <= trig_age[CNT_W-1:0];
+        s1_tbig_q  <= trig_big;
+        s2_bin_q   <= hist_idx;
+        s2_hf_q    <= hf_rd;
+        s2_hl_q    <= hl_rd;
+        fw_f_val_q <= hf_new;
+        fw_l_val_q <= hl_new;
+    end
+
+    // statistics (cleared by rst or clear_i), from stage 1
     always @(posedge clk) begin
         if (rst || clear_i) begin
             first_last_o  <= {CNT_W{1'b0}};
@@ -164,35 +235,35 @@ module fmt_latency #(
             hist_first_ok_q <= {BINS{1'b0}};
             hist_last_ok_q  <= {BINS{1'b0}};
         end else begin
-            if (is_first) begin
-                first_last_o <= ev_lat;
-                if (ev_lat < first_min_o) first_min_o <= ev_lat;
-                if (ev_lat > first_max_o) first_max_o <= ev_lat;
-                if (first_count_o != NUM_MAX) first_count_o <= first_count_o + 1'b1;
-                hist_first_ok_q[hist_idx] <= 1'b1;
+            if (s1_first_q) begin
+                first_last_o <= lat;
+                if (lat < first_min_o) first_min_o <= lat;
+                if (lat > first_max_o) first_max_o <= lat;
+                if (!first_cnt_inc[NUM_W]) first_count_o <= first_cnt_inc[NUM_W-1:0];
             end
-            if (is_last) begin
-                last_last_o <= ev_lat;
-                if (ev_lat < last_min_o) last_min_o <= ev_lat;
-                if (ev_lat > last_max_o) last_max_o <= ev_lat;
-                if (last_count_o != NUM_MAX) last_count_o <= last_count_o + 1'b1;
-                hist_last_ok_q[hist_idx] <= 1'b1;
+            if (s1_last_q) begin
+                last_last_o <= lat;
+                if (lat < last_min_o) last_min_o <= lat;
+                if (lat > last_max_o) last_max_o <= lat;
+                if (!last_cnt_inc[NUM_W]) last_count_o <= last_cnt_inc[NUM_W-1:0];
             end
-            if (trig_done) begin
+            if (s1_trig_q) begin
                 trig_last_o <= trig_lat;
                 if (trig_lat < trig_min_o) trig_min_o <= trig_lat;
                 if (trig_lat > trig_max_o) trig_max_o <= trig_lat;
-                if (trig_count_o != NUM_MAX) trig_count_o <= trig_count_o + 1'b1;
+                if (!trig_cnt_inc[NUM_W]) trig_count_o <= trig_cnt_inc[NUM_W-1:0];
             end
+            if (hf_we) hist_first_ok_q[s2_bin_q] <= 1'b1;
+            if (hl_we) hist_last_ok_q[s2_bin_q]  <= 1'b1;
         end
     end
 
-    // histogram RAMs: one read-modify-write port (the event's bin) + the readout port;
-    // time-stamp RAM: written at frame ends, read at the event's slot
+    // histogram RAMs: one write port (stage 2), the stage-1 read port and the readout
+    // port; time-stamp RAM: written at frame ends, read at the event's slot
     always @(posedge clk) begin
         if (frame_end_i && !rst) stamp_mem[frame_end_slot_i] <= now_q;
-        if (hf_we) hist_first_mem[hist_idx] <= hf_cur + 1'b1;
-        if (hl_we) hist_last_mem[hist_idx]  <= hl_cur + 1'b1;
+        if (hf_we) hist_first_mem[s2_bin_q] <= hf_new;
+        if (hl_we) hist_last_mem[s2_bin_q]  <= hl_new;
     end
 
     always @(posedge clk) begin

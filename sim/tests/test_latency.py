@@ -3,9 +3,10 @@ from fmt.latency import LatencyCounters
 
 
 def run(m, events):
-    """events: {cycle: kwargs}; returns outputs after the last cycle."""
+    """events: {cycle: kwargs}; returns outputs 3 cycles after the last one (the
+    statistics follow an event by 1 cycle, the histograms by 2)."""
     out = None
-    for c in range(max(events) + 1):
+    for c in range(max(events) + 4):
         out = m.step(**events.get(c, {}))
     return out
 
@@ -34,3 +35,20 @@ def test_trigger_includes_synchroniser():
     m = LatencyCounters()
     o = run(m, {10: dict(trig=1), 11: dict(trig=1), 40: dict(ev_fire=1, ev_new=1)})
     assert o["trig_last"] == 30 and o["trig_count"] == 1 and o["trig_armed"] == 0
+
+
+def test_back_to_back_same_bin_and_clear():
+    """Pipelined read-modify-write: events on consecutive cycles into one bin all count
+    (forwarding); a clear drops the events still in the pipeline."""
+    m = LatencyCounters()
+    ev = {f: dict(frame_end=1, frame_end_slot=f) for f in range(4)}
+    ev.update({100 + f: dict(ev_fire=1, ev_slot=f, ev_last=1) for f in range(4)})
+    run(m, ev)
+    assert m.hist["first"][3] == 4 and m.hist["last"][3] == 4
+    assert m.out["first_count"] == 4 and m.out["last_min"] == 100
+    ev = {f: dict(frame_end=1, frame_end_slot=f) for f in range(4)}
+    ev.update({100: dict(ev_fire=1, ev_slot=0, ev_last=1), 101: dict(ev_fire=1, ev_slot=1),
+               102: dict(clear=1), 110: dict(ev_fire=1, ev_slot=2)})
+    o = run(m, ev)
+    assert o["first_count"] == 1 and o["last_count"] == 0 and o["first_min"] == 108   # slot 2 ended at cycle 2
+    assert sum(m.hist["first"]) == 1 and sum(m.hist["last"]) == 0

@@ -132,8 +132,8 @@ async def check_hists(tb, what: str):
 
 @cocotb.test()
 async def histogram_back_to_back_and_clear(dut):
-    """The histograms are RAMs with one read-modify-write port: first/last events of
-    four frames on four consecutive cycles into the same bin (and the next cycle into
+    """The histograms are RAMs with a pipelined read-modify-write (forwarding): first/last
+    events of four frames on four consecutive cycles into the same bin (and the next cycle into
     another bin) must all count; a clear makes every bin read 0 at once (read right
     after the clear cycle), and bins count from 0 again afterwards.  The frame-end
     time stamps (also a RAM) read 0 after a reset until their slot's frame end."""
@@ -189,6 +189,7 @@ async def saturation_is_flagged(dut):
     dut.ev_last_i.value = 1
     await tb.writable()
     dut.ev_fire_i.value = 0
+    await RisingEdge(tb.clk)       # the statistics take the event one cycle after it
     await ReadOnly()
     assert int(dut.first_last_o.value) == cmax and int(dut.last_last_o.value) == cmax
     assert int(dut.sat_o.value) == 1
