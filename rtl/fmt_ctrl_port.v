@@ -8,7 +8,8 @@
 // reply has CMD 0xFF and payload {code, request CMD}; event frames have CMD 0xE0.
 //
 // Receive path: fmt_uart_rx -> a 2^FIFO_AW-byte FIFO (bytes arriving while a reply is
-// sent are kept) -> the parser.  The request payload is buffered (PAYLOAD_MAX bytes,
+// sent are kept; distributed RAM) -> a head register (one more byte) -> the parser,
+// which sees only flip-flops: a byte reaches the parser 2 cycles after valid_o.  The request payload is buffered (PAYLOAD_MAX bytes,
 // distributed RAM) and nothing is executed before the CRC has been checked, so a bad
 // frame never writes a register.  Errors (each counted in err_count_o, saturating, and
 // answered by one ERROR reply):
@@ -124,18 +125,26 @@ module fmt_ctrl_port #(
         .clk(clk), .rst(rst), .data_i(tx_data), .valid_i(tx_valid),
         .ready_o(tx_ready), .txd_o(txd_o));
 
-    // ---- receive FIFO ({frame error, byte}) -----------------------------------------------
+    // ---- receive FIFO ({frame error, byte}) and its head register ---------------------------
+    // The head register takes the oldest byte of the RAM whenever it is empty or being
+    // consumed (pop); the parser reads only the head.
+    (* ram_style = "distributed" *)
     reg [8:0]       fifo_mem [0:(1 << FIFO_AW) - 1];
     reg [FIFO_AW:0] wp_q, rp_q;
-    wire            fifo_empty = (wp_q == rp_q);
+    reg [8:0]       head_q;               // oldest byte, valid with hv_q
+    reg             hv_q;
+    wire            ram_empty  = (wp_q == rp_q);
     wire            fifo_full  = (wp_q[FIFO_AW] != rp_q[FIFO_AW]) &&
                                  (wp_q[FIFO_AW-1:0] == rp_q[FIFO_AW-1:0]);
-    wire [8:0]      fifo_dout  = fifo_mem[rp_q[FIFO_AW-1:0]];
-    wire [7:0]      rbyte      = fifo_dout[7:0];
-    wire            rferr      = fifo_dout[8];
+    wire            fifo_empty = !hv_q && ram_empty;    // no byte waiting at all
+    wire [7:0]      rbyte      = head_q[7:0];
+    wire            rferr      = head_q[8];
+    wire            pop;
+    wire            head_load  = !ram_empty && (!hv_q || pop);
 
     always @(posedge clk) begin
         if (rx_valid && !fifo_full) fifo_mem[wp_q[FIFO_AW-1:0]] <= {rx_ferr, rx_data};
+        if (head_load) head_q <= fifo_mem[rp_q[FIFO_AW-1:0]];
     end
 
     // ---- request payload buffer -------------------------------------------------------
@@ -178,7 +187,7 @@ module fmt_ctrl_port #(
 
     wire in_frame  = (state_q >= S_LENH) && (state_q <= S_CRCL);
     wire parsing   = (state_q <= S_DISCARD);
-    wire pop       = parsing && !fifo_empty && !ovf_q;
+    assign pop     = parsing && hv_q && !ovf_q;
     wire tmo_run   = fifo_empty && (in_frame || (state_q == S_DISCARD) ||
                                     ((state_q == S_HUNT) && junk_q));
     wire tmo_hit   = tmo_run && ({{(32-TW){1'b0}}, tmo_q} == TMO_LAST);
@@ -262,6 +271,7 @@ module fmt_ctrl_port #(
         if (rst) begin
             wp_q <= {(FIFO_AW+1){1'b0}};
             rp_q <= {(FIFO_AW+1){1'b0}};
+            hv_q <= 1'b0;
             state_q <= S_HUNT;
             after_q <= S_HUNT;
             junk_q <= 1'b0;
@@ -305,7 +315,9 @@ module fmt_ctrl_port #(
             blk_req_o   <= 1'b0;
             err_pulse_o <= 1'b0;
             if (rx_valid && !fifo_full) wp_q <= wp_q + 1'b1;
-            if (pop) rp_q <= rp_q + 1'b1;
+            if (head_load) rp_q <= rp_q + 1'b1;
+            if (head_load) hv_q <= 1'b1;
+            else if (pop) hv_q <= 1'b0;
             if (pop || !tmo_run) tmo_q <= {TW{1'b0}};
             else if (!tmo_hit) tmo_q <= tmo_q + 1'b1;
 
