@@ -11,7 +11,7 @@ ECP5 (routed): the block inside a generated registered wrapper (every block inpu
   critical path's first and last cell (with the net that names the RTL register),
   LUT4 / FF / MULT18X18D / DP16KD use of the block (the wrapper's own cells taken off).
   Target: Fmax >= 125 MHz.
-xc5v (mapped, not placed): `synth_xilinx -family xc5v -top <block> -noiopad`, then a
+xc5v (mapped, not placed): `synth_xilinx -family xc5v -top <block> -flatten -noiopad`, then a
   topological walk over the mapped netlist (depth_walk below).  Reported: the worst
   LUT levels and the longest carry chain on any register-to-register path (top-level
   ports count as registers), and the DSP48E / block RAM whose product or read data is
@@ -113,9 +113,10 @@ def load_blocks(cfg_path: Path = CFG) -> list[dict]:
 def block_ports(block: dict, d: Path) -> dict:
     """{port: {direction, width}} of the block at its parameters (Yosys portlist)."""
     top, params = block["module"], block.get("params", {})
-    chp = " ".join(f"-chparam {k} {v}" for k, v in params.items())
+    chp = " ".join(f"-set {k} {v}" for k, v in params.items())
     txt = d / "ports.txt"
-    yosys(read_cmd(top) + f"hierarchy -top {top} {chp}; tee -q -o {rel(txt)} portlist {top}",
+    yosys(read_cmd(top) + (f"chparam {chp} {top}; " if chp else "")
+          + f"hierarchy -top {top}; tee -q -o {rel(txt)} portlist {top}",
           d / "ports.log", f"yosys portlist ({block['label']})")
     ports = {}
     for line in txt.read_text().splitlines():
@@ -130,9 +131,10 @@ def block_ports(block: dict, d: Path) -> dict:
 def synth_xc5v(block: dict, d: Path) -> Path:
     top, params = block["module"], block.get("params", {})
     net = d / "xc5v.json"
-    chp = " ".join(f"-chparam {k} {v}" for k, v in params.items())
-    script = (read_cmd(top) + f"hierarchy -top {top} {chp}; "
-              f"synth_xilinx -family xc5v -top {top} -noiopad; "
+    chp = " ".join(f"-set {k} {v}" for k, v in params.items())
+    # -flatten: one netlist for the walk (XST flattens too by default)
+    script = (read_cmd(top) + (f"chparam {chp} {top}; " if chp else "")
+              + f"synth_xilinx -family xc5v -top {top} -flatten -noiopad; "
               f"tee -q -o {rel(d / 'xc5v_stat.json')} stat -json; write_json {rel(net)}")
     if not (REUSE and net.exists()):
         yosys(script, d / "xc5v.log", f"yosys synth_xilinx ({block['label']})")
@@ -562,11 +564,15 @@ def depth_walk(netlist: dict, top: str | None = None, ns: dict = VIRTEX5_NS) -> 
 def xc5v_block(block: dict, d: Path) -> dict:
     net = synth_xc5v(block, d)
     nl = json.loads(net.read_text())
-    r = depth_walk(nl, block["module"])
+    # the top (named $paramod$...\<module> after chparam): the module marked top
+    top = next((n for n, m in nl["modules"].items()
+                if int(m.get("attributes", {}).get("top", "0") or 0)), block["module"])
+    r = depth_walk(nl, top)
+    r["top"] = block["module"]
     st = json.loads((d / "xc5v_stat.json").read_text())
     r["cells"] = st["design"].get("num_cells_by_type", {})
     r["ports"] = {pn: {"direction": p["direction"], "width": len(p["bits"])}
-                  for pn, p in nl["modules"][block["module"]]["ports"].items()}
+                  for pn, p in nl["modules"][top]["ports"].items()}
     return r
 
 
