@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 
 LANES = 2
@@ -133,7 +133,7 @@ def test_fmt_accum(sim, rows, d_w):
     run_cocotb(
         sim=sim,
         toplevel="fmt_accum",
-        sources=rtl_sources("fmt_accum"),
+        sources=sources("fmt_accum"),
         test_module="test_fmt_accum",
         test_dir=Path(__file__).parent,
         parameters=p,

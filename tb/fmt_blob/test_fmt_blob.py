@@ -29,7 +29,7 @@ import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.blobs import blob_mask_fixed, blob_stream_fixed, label_regions
@@ -485,7 +485,7 @@ async def latency(dut):
 # ---- pytest entry ---------------------------------------------------------------------
 def _run(sim, cfg, seed, testcase=None):
     run_cocotb(sim=sim, toplevel="fmt_blob",
-               sources=rtl_sources("fmt_blob", "fmt_div", "fmt_sorted_list"),
+               sources=sources("fmt_blob"),
                test_module="test_fmt_blob", test_dir=Path(__file__).parent,
                parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                            "MAX_BLOBS": MAX_BLOBS},

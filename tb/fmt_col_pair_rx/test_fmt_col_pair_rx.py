@@ -19,15 +19,13 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fmt_rx_array"))
 
-from common.runner import rtl_sources, run_cocotb        # noqa: E402
+from common.runner import run_cocotb, sources            # noqa: E402
 from common.sources import rom_define                     # noqa: E402
 from common.tb_util import ClockedTB, env_str             # noqa: E402
 from fmt import params                                    # noqa: E402
 from fmt import rx_fixed as R                             # noqa: E402
 import rx_stim                                            # noqa: E402
 
-RTL_FILES = ["fmt_col_pair_rx", "fmt_rx_pair_front", "fmt_rx_frame_win", "fmt_despread", "fmt_fft_r22sdf", "fmt_fft_bf", "fmt_fft_delay",
-             "fmt_fft_twiddle", "fmt_pair_split", "fmt_magnitude", "fmt_accum"]
 
 
 class TB(ClockedTB):
@@ -153,7 +151,7 @@ def test_fmt_col_pair_rx(sim, cfg_name):
     run_cocotb(
         sim=sim,
         toplevel="fmt_col_pair_rx",
-        sources=rtl_sources(*RTL_FILES),
+        sources=sources("fmt_col_pair_rx"),
         test_module="test_fmt_col_pair_rx",
         test_dir=Path(__file__).parent,
         parameters={k: p[k] for k in ("LOG2_N", "ROWS", "BIN_LO", "BIN_STEP", "ADC_BITS", "HM_W")},

@@ -23,7 +23,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params, protocol as P, regmap
 from fmt_uart.uart_bfm import UartBfm
@@ -395,7 +395,7 @@ def test_fmt_ctrl_port(sim, cfg_name, div):
     run_cocotb(
         sim=sim,
         toplevel="fmt_ctrl_tb_top",
-        sources=rtl_sources("fmt_uart_rx", "fmt_uart_tx", "fmt_crc16", "fmt_ctrl_port", "fmt_regfile")
+        sources=sources("fmt_ctrl_port") + sources("fmt_regfile")
         + [HERE / "fmt_ctrl_tb_top.v"],
         test_module="test_fmt_ctrl_port",
         test_dir=HERE,

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.dds import despread_fixed
@@ -97,7 +97,7 @@ def test_fmt_despread(sim, adc_bits):
     run_cocotb(
         sim=sim,
         toplevel="fmt_despread",
-        sources=rtl_sources("fmt_despread"),
+        sources=sources("fmt_despread"),
         test_module="test_fmt_despread",
         test_dir=Path(__file__).parent,
         parameters={"ADC_BITS": adc_bits},

@@ -11,7 +11,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt.interp import div_fixed
 
@@ -80,7 +80,7 @@ async def random_stream(dut):
 @pytest.mark.parametrize("widths", [(51, 42, 9), (12, 6, 4)], ids=lambda w: "x".join(map(str, w)))
 def test_fmt_div(sim, widths):
     nw, dw, qw = widths
-    run_cocotb(sim, "fmt_div", rtl_sources("fmt_div"), "test_fmt_div",
+    run_cocotb(sim, "fmt_div", sources("fmt_div"), "test_fmt_div",
                parameters={"NUM_W": nw, "DEN_W": dw, "QW": qw},
                extra_env={"NUM_W": nw, "DEN_W": dw, "QW": qw},
                test_dir=Path(__file__).parent,

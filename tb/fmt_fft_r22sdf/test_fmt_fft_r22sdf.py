@@ -21,13 +21,12 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import fft_fixed as F
 from fmt import params
 
-SOURCES = ["fmt_fft_r22sdf", "fmt_fft_bf", "fmt_fft_delay", "fmt_fft_twiddle"]
 
 
 class TB(ClockedTB):
@@ -292,7 +291,7 @@ def _run(sim, cfg, out_w=None, comb_min=95.0, testcase=None, ch=1):
     # leaves empty)
     args = [rom_define()] + (["--output-split", "0"] if sim == "verilator" else [])
     run_cocotb(
-        sim=sim, toplevel="fmt_fft_r22sdf", sources=rtl_sources(*SOURCES),
+        sim=sim, toplevel="fmt_fft_r22sdf", sources=sources("fmt_fft_r22sdf"),
         test_module="test_fmt_fft_r22sdf", test_dir=Path(__file__).parent,
         parameters=prm, extra_env=env, testcase=testcase, build_args=args)
 

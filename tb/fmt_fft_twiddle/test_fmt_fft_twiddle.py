@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int
 from fmt import fft_fixed as F
@@ -105,6 +105,6 @@ async def overflow_and_sticky_flag(dut):
 @pytest.mark.parametrize("log2_m", [6])
 def test_fmt_fft_twiddle(sim, log2_m):
     prm = {"LOG2_N": 6, "LOG2_M": log2_m, "DW": 15, "OW": 12, "SH": 13, "TW_W": 18}
-    run_cocotb(sim=sim, toplevel="fmt_fft_twiddle", sources=rtl_sources("fmt_fft_twiddle"),
+    run_cocotb(sim=sim, toplevel="fmt_fft_twiddle", sources=sources("fmt_fft_twiddle"),
                test_module="test_fmt_fft_twiddle", test_dir=Path(__file__).parent,
                parameters=prm, extra_env=prm, build_args=[rom_define()])

@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params, protocol as P, regmap
 from fmt_uart.uart_bfm import UartBfm
@@ -219,7 +219,7 @@ def test_fmt_fmtctl(sim, tmp_path):
     run_cocotb(
         sim=sim,
         toplevel="fmt_ctrl_tb_top",
-        sources=rtl_sources("fmt_uart_rx", "fmt_uart_tx", "fmt_crc16", "fmt_ctrl_port", "fmt_regfile") + [TOP],
+        sources=sources("fmt_ctrl_port") + sources("fmt_regfile") + [TOP],
         test_module="test_fmt_fmtctl",
         test_dir=HERE,
         parameters={"DIV": 4, "TIMEOUT_BITS": 20, "PAYLOAD_MAX": 64, "REGMAP_ID": regmap.regmap_id(),

@@ -12,7 +12,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt.interp import CORDIC_K, cordic_fixed
 
@@ -80,7 +80,7 @@ async def bit_exact_stream(dut):
 
 @pytest.mark.parametrize("iw", [21])
 def test_fmt_interp_cordic(sim, iw):
-    run_cocotb(sim, "fmt_interp_cordic", rtl_sources("fmt_interp_cordic"), "test_fmt_interp_cordic",
+    run_cocotb(sim, "fmt_interp_cordic", sources("fmt_interp_cordic"), "test_fmt_interp_cordic",
                parameters={"IW": iw, "N": N}, extra_env={"IW": iw},
                test_dir=Path(__file__).parent,
                build_args=["--output-split", "0", "-CFLAGS", "-O0"] if sim == "verilator" else [])

@@ -20,7 +20,7 @@ import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.localmax import local_maxima, maxima_mask
@@ -298,7 +298,7 @@ async def latency(dut):
 # ---- pytest entry ------------------------------------------------------------------
 def _run(sim, cfg, seed):
     run_cocotb(sim=sim, toplevel="fmt_localmax",
-               sources=rtl_sources("fmt_localmax", "fmt_sorted_list"),
+               sources=sources("fmt_localmax"),
                test_module="test_fmt_localmax", test_dir=Path(__file__).parent,
                parameters={"ROWS": cfg.rows, "COLS": cfg.cols, "HM_W": cfg.hm_width,
                            "MAX_TOUCHES": cfg.max_touches},

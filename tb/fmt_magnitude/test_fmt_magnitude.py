@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import rx_fixed as R
 
@@ -123,7 +123,7 @@ def test_fmt_magnitude(sim, in_w):
     run_cocotb(
         sim=sim,
         toplevel="fmt_magnitude",
-        sources=rtl_sources("fmt_magnitude"),
+        sources=sources("fmt_magnitude"),
         test_module="test_fmt_magnitude",
         test_dir=Path(__file__).parent,
         parameters={"IN_W": in_w, "ITER": R.MAG_ITER, "GUARD": R.MAG_GUARD,

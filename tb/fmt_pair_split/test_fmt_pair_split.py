@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt import rx_fixed as R
@@ -206,7 +206,7 @@ def test_fmt_pair_split(sim, cfg_name, ch=1):
     run_cocotb(
         sim=sim,
         toplevel="fmt_pair_split",
-        sources=rtl_sources("fmt_pair_split"),
+        sources=sources("fmt_pair_split"),
         test_module="test_fmt_pair_split",
         test_dir=Path(__file__).parent,
         parameters={**{k: p[k] for k in ("LOG2_N", "ROWS", "BIN_LO", "BIN_STEP")},

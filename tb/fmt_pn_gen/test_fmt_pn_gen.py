@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.pn import MAXIMAL_TAPS, pn_signs
@@ -165,7 +165,7 @@ def test_fmt_pn_gen(sim, pn_bits):
     run_cocotb(
         sim=sim,
         toplevel="fmt_pn_gen",
-        sources=rtl_sources("fmt_pn_gen"),
+        sources=sources("fmt_pn_gen"),
         test_module="test_fmt_pn_gen",
         test_dir=Path(__file__).parent,
         parameters={"PN_BITS": pn_bits, "TAPS": MAXIMAL_TAPS[pn_bits],

@@ -18,7 +18,7 @@ import cocotb
 import pytest
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 
 
@@ -171,6 +171,6 @@ async def random_ops(dut):
 def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop):
     p = {"K": k, "KEY_W": 4, "TIE_W": 3, "PAY_W": pay_w, "PAY_RST_IDX": pay_rst_idx,
          "HAS_POP": has_pop}
-    run_cocotb(sim=sim, toplevel="fmt_sorted_list", sources=rtl_sources("fmt_sorted_list"),
+    run_cocotb(sim=sim, toplevel="fmt_sorted_list", sources=sources("fmt_sorted_list"),
                test_module="test_fmt_sorted_list", test_dir=Path(__file__).parent,
                parameters=p, extra_env={**p, "SEED": 1})

@@ -23,7 +23,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.tracking import Touch, Tracker, TrackParams, lazy_greedy, tail_cycles
@@ -361,7 +361,7 @@ def test_fmt_tracker(sim, cfg_name, max_touches):
     run_cocotb(
         sim=sim,
         toplevel="fmt_tracker",
-        sources=rtl_sources("fmt_tracker", "fmt_tracker_vel"),
+        sources=sources("fmt_tracker"),
         test_module="test_fmt_tracker",
         test_dir=Path(__file__).parent,
         parameters={"MAX_TOUCHES": max_touches, "HM_W": cfg.hm_width},

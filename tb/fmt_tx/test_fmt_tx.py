@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import env_int
 from fmt import dds, params
 from fmt.pn import MAXIMAL_TAPS, lfsr_chips
@@ -136,7 +136,7 @@ def test_fmt_tx(sim, cfg, rpe):
     run_cocotb(
         sim=sim,
         toplevel="fmt_tx",
-        sources=rtl_sources("fmt_tx", "fmt_pn_gen", "fmt_dds_bank", "fmt_dds_chan", "fmt_dds_rom2"),
+        sources=sources("fmt_tx"),
         test_module="test_fmt_tx",
         test_dir=Path(__file__).parent,
         parameters=parameters,

@@ -17,7 +17,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt_uart.uart_bfm import UartBfm
 
@@ -165,7 +165,7 @@ def test_fmt_uart(sim, div):
     run_cocotb(
         sim=sim,
         toplevel="fmt_uart_tb_top",
-        sources=rtl_sources("fmt_uart_tx", "fmt_uart_rx") + [HERE / "fmt_uart_tb_top.v"],
+        sources=sources("fmt_uart_tx") + sources("fmt_uart_rx") + [HERE / "fmt_uart_tb_top.v"],
         test_module="test_fmt_uart",
         test_dir=HERE,
         parameters={"DIV": div},
