@@ -15,7 +15,7 @@ import cocotb
 import pytest
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
 from fmt.events import FIXED_LATENCY, PortParams, frames_to_beats, run_port
@@ -196,7 +196,7 @@ def test_fmt_event_port(sim, cfg_name, depth, max_ev):
     run_cocotb(
         sim=sim,
         toplevel="fmt_event_port",
-        sources=rtl_sources("fmt_event_port"),
+        sources=sources("fmt_event_port"),
         test_module="test_fmt_event_port",
         test_dir=Path(__file__).parent,
         parameters={"DEPTH": depth, "MAX_EV": max_ev, "HM_W": cfg.hm_width},

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.flatten import GAIN_MAX, GAIN_ONE, flatten_fixed, identity
@@ -257,7 +257,7 @@ def sensor_params(cfg) -> dict:
 @pytest.mark.parametrize("cfg, cal_bram", [(params.SMALL, 1), (params.MEDIUM, 1), (params.SMALL, 0)],
                          ids=["SMALL", "MEDIUM", "SMALL-lutram"])
 def test_fmt_flatten(sim, cfg, cal_bram):
-    run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),
+    run_cocotb(sim=sim, toplevel="fmt_flatten", sources=sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
                parameters={**sensor_params(cfg), "CAL_BRAM": cal_bram},
                extra_env={"FMT_CFG": cfg.name, "SEED": 1})
@@ -269,7 +269,7 @@ def test_fmt_flatten(sim, cfg, cal_bram):
                            "SMALL and MEDIUM cover it)")
 def test_fmt_flatten_default(sim):
     cfg = params.DEFAULT
-    run_cocotb(sim=sim, toplevel="fmt_flatten", sources=rtl_sources("fmt_flatten"),
+    run_cocotb(sim=sim, toplevel="fmt_flatten", sources=sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
                parameters=sensor_params(cfg),
                extra_env={"FMT_CFG": cfg.name, "SEED": 2})

@@ -15,7 +15,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import rtl_sources, run_cocotb
+from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt.latency import LatencyCounters
 
@@ -198,7 +198,7 @@ async def saturation_is_flagged(dut):
 # num_w = 3: event counters and histogram bins saturate at 7 (sticky flag, no wrap)
 @pytest.mark.parametrize("cnt_w, num_w", [(8, 32), (16, 32), (8, 3)])
 def test_fmt_latency(sim, cnt_w, num_w):
-    run_cocotb(sim=sim, toplevel="fmt_latency", sources=rtl_sources("fmt_latency"),
+    run_cocotb(sim=sim, toplevel="fmt_latency", sources=sources("fmt_latency"),
                test_module="test_fmt_latency", test_dir=Path(__file__).parent,
                parameters={"CNT_W": cnt_w, "NUM_W": num_w},
                extra_env={"CNT_W": cnt_w, "NUM_W": num_w})
