@@ -4,7 +4,7 @@
 // docstring is the full arithmetic specification; summary below).
 //
 // Fully pipelined: one candidate per clock in, touches out in the same order after
-// LAT = 23 clock cycles (cand_valid_i -> tp_valid_o, cand_eof_i -> tp_eof_o likewise).
+// LAT = 24 clock cycles (cand_valid_i -> tp_valid_o, cand_eof_i -> tp_eof_o likewise).
 //
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
@@ -69,7 +69,7 @@ module fmt_interp #(
     localparam integer LC_MIN = 45608;
     localparam integer ZN  = 10;        // normalised cell width of the ellipse path
     localparam integer QW  = 9;         // offset quotient bits
-    localparam integer LAT = 23;        // total latency
+    localparam integer LAT = 24;        // total latency
 
     // ---- widths ---------------------------------------------------------------------
     localparam Z    = HM_W;
@@ -218,7 +218,7 @@ module fmt_interp #(
         s3_b <= $signed({{(CW-Z-1){1'b0}}, s2_dg}) - $signed({{(CW-Z-1){1'b0}}, s2_ad});
         s3_d <= cs2s - cs0s;
         s3_e <= rs2s - rs0s;
-        s3_f <= z4f * 20 + (edgf <<< 3) - (crnf <<< 2);
+        s3_f <= (z4f <<< 4) + (z4f <<< 2) + (edgf <<< 3) - (crnf <<< 2);   // 20 z00 + 8 edg - 4 crn
         s3_nvx <= s2_nvx; s3_dvx <= s2_dvx; s3_nvy <= s2_nvy; s3_dvy <= s2_dvy;
         s3_mxl <= s2_mxl; s3_mxh <= s2_mxh; s3_myl <= s2_myl; s3_myh <= s2_myh;
         s3_znx <= s2_znx; s3_zny <= s2_zny; s3_z4 <= s2_z4;
@@ -261,7 +261,8 @@ module fmt_interp #(
     // CORDIC on (2 (an - cn), 3 bn) << 4: magnitude at s17, angle at s17
     wire signed [NW-1:0] amc = s4_an - s4_cn;      // |an - cn| <= 12288 fits NW bits
     wire signed [IW-1:0] cu = {{(IW-NW-1){amc[NW-1]}}, amc, 1'b0} <<< 4;
-    wire signed [IW-1:0] cv = ({{(IW-NW){s4_bn[NW-1]}}, s4_bn} * 3) <<< 4;
+    wire signed [IW-1:0] bn_i = {{(IW-NW){s4_bn[NW-1]}}, s4_bn};
+    wire signed [IW-1:0] cv = ((bn_i <<< 1) + bn_i) <<< 4;   // 3 bn << 4 (no multiplier)
     wire [IW+1:0] cor_mag;
     wire [15:0]   cor_ang;
     /* verilator lint_off PINCONNECTEMPTY */ // the LAT-long control delay carries valid
@@ -289,9 +290,10 @@ module fmt_interp #(
     reg                  s5_mxl, s5_mxh, s5_myl, s5_myh, s5_edge, s5_sat, s5_moore, s5_bias, s5_aneg;
     reg [Z-1:0]          s5_znx, s5_zny, s5_z4;
     always @(posedge clk) begin
-        s5_nmx <= (be_w * 6) - (cd_w <<< 3);
-        s5_nmy <= (bd_w * 6) - (ae_w <<< 3);
-        s5_dm  <= (ac_w <<< 4) - (bb_w * 9);
+        // constant factors as shifts and adds (a multiplier would be an unregistered DSP)
+        s5_nmx <= (be_w <<< 2) + (be_w <<< 1) - (cd_w <<< 3);
+        s5_nmy <= (bd_w <<< 2) + (bd_w <<< 1) - (ae_w <<< 3);
+        s5_dm  <= (ac_w <<< 4) - (bb_w <<< 3) - bb_w;
         s5_acn <= s4_an * s4_cn;
         s5_bbn <= s4_bn * s4_bn;
         s5_ddn <= s4_dn * s4_dn;
@@ -361,7 +363,7 @@ module fmt_interp #(
         s6_bias <= s5_bias;
         s6_ex   <= ex;
         s6_ey   <= ey;
-        s6_dmn  <= (acn_w <<< 4) - (bbn_w * 9);
+        s6_dmn  <= (acn_w <<< 4) - (bbn_w <<< 3) - bbn_w;
         s6_cdd  <= s5_cn * s5_ddn;
         s6_bde  <= s5_bn * s5_den;
         s6_aee  <= s5_an * s5_een;
@@ -395,18 +397,20 @@ module fmt_interp #(
     wire signed [QNW-1:0] bde_w = {{(QNW-N3W){s6_bde[N3W-1]}}, s6_bde};
     wire signed [QNW-1:0] aee_w = {{(QNW-N3W){s6_aee[N3W-1]}}, s6_aee};
     reg signed [QNW-1:0] s7_qn;
+    wire signed [GW-1:0]  q12_w;
     reg signed [DMW-1:0] s7_dmn;
     reg signed [FNW-1:0] s7_fn;
     reg signed [GW-1:0]  s8_fdm, s8_q12;
     reg signed [DMW-1:0] s8_dmn;
     reg signed [GW-1:0]  s9_g;
     reg signed [DMW-1:0] s9_dmn;
+    assign q12_w = {{(GW-QNW){s7_qn[QNW-1]}}, s7_qn};
     always @(posedge clk) begin
-        s7_qn  <= (cdd_w <<< 1) - (bde_w * 3) + (aee_w <<< 1);
+        s7_qn  <= (cdd_w <<< 1) - (bde_w <<< 1) - bde_w + (aee_w <<< 1);
         s7_dmn <= s6_dmn;
         s7_fn  <= s6_fn;
         s8_fdm <= s7_fn * s7_dmn;
-        s8_q12 <= s7_qn * 12;
+        s8_q12 <= (q12_w <<< 3) + (q12_w <<< 2);
         s8_dmn <= s7_dmn;
         s9_g   <= s8_fdm - s8_q12;
         s9_dmn <= s8_dmn;
@@ -414,67 +418,71 @@ module fmt_interp #(
     wire g_pos9  = ~s9_g[GW-1] & (|s9_g);
     wire dm_pos9 = ~s9_dmn[DMW-1] & (|s9_dmn);
 
-    wire [$clog2(GW)+11:0]  lg_g11;
-    wire [$clog2(DMW)+11:0] lg_dm11;
-    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(s9_g), .lg_o(lg_g11));
-    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(s9_dmn), .lg_o(lg_dm11));
-    wire [$clog2(GW)+11:0]  lg_g20;
-    wire [$clog2(DMW)+11:0] lg_dm20;
+    wire [$clog2(GW)+11:0]  lg_g12;
+    wire [$clog2(DMW)+11:0] lg_dm12;
+    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(s9_g), .lg_o(lg_g12));
+    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(s9_dmn), .lg_o(lg_dm12));
+    wire [$clog2(GW)+11:0]  lg_g21;
+    wire [$clog2(DMW)+11:0] lg_dm21;
     fmt_interp_dly #(.W($clog2(GW) + 12 + $clog2(DMW) + 12), .N(9), .RST(0)) u_dly_lg (
-        .clk(clk), .rst(rst), .d_i({lg_g11, lg_dm11}), .q_o({lg_g20, lg_dm20}));
-    wire pos_ok20;
-    fmt_interp_dly #(.W(1), .N(11), .RST(0)) u_dly_pos9 (
-        .clk(clk), .rst(rst), .d_i(g_pos9 & dm_pos9), .q_o(pos_ok20));
+        .clk(clk), .rst(rst), .d_i({lg_g12, lg_dm12}), .q_o({lg_g21, lg_dm21}));
+    wire pos_ok21;
+    fmt_interp_dly #(.W(1), .N(12), .RST(0)) u_dly_pos9 (
+        .clk(clk), .rst(rst), .d_i(g_pos9 & dm_pos9), .q_o(pos_ok21));
 
     // ---- pp = p * KQ + (|s| K << 8) at s18 ----
-    wire signed [NW+2:0] p17;
-    fmt_interp_dly #(.W(NW + 3), .N(12), .RST(0)) u_dly_p (
-        .clk(clk), .rst(rst), .d_i(s5_p), .q_o(p17));
-    reg signed [PPW-1:0] s18_pp;
+    // p * KQ beside the CORDIC: operand s15, product s16, result s17 (the registers XST
+    // packs into one DSP48E), then one adder at s18
+    wire signed [NW+2:0] p14;
+    fmt_interp_dly #(.W(NW + 3), .N(9), .RST(0)) u_dly_p (
+        .clk(clk), .rst(rst), .d_i(s5_p), .q_o(p14));
+    reg signed [NW+2:0]  s15_p;
+    reg signed [PPW-1:0] s16_pkq, s17_pkq, s18_pp;
     /* verilator lint_off WIDTHTRUNC */ // pp < 3.4e8 fits PPW bits
-    always @(posedge clk)
-        s18_pp <= {{(PPW-NW-3){p17[NW+2]}}, p17} * KQ
-                + $signed({{(PPW-IW-2){1'b0}}, cor_mag} << 8);
+    always @(posedge clk) begin
+        s15_p   <= p14;
+        s16_pkq <= {{(PPW-NW-3){s15_p[NW+2]}}, s15_p} * KQ;
+        s17_pkq <= s16_pkq;
+        s18_pp  <= s17_pkq + $signed({{(PPW-IW-2){1'b0}}, cor_mag} << 8);
+    end
     /* verilator lint_on WIDTHTRUNC */
     wire pp_pos18 = ~s18_pp[PPW-1] & (|s18_pp);
-    wire [$clog2(PPW)+11:0] lg_pp20;
-    fmt_interp_lg #(.X_W(PPW)) u_lg_pp (.clk(clk), .x_i(s18_pp), .lg_o(lg_pp20));
-    reg pp_pos19, pp_pos20;
-    always @(posedge clk) begin
-        pp_pos19 <= pp_pos18;
-        pp_pos20 <= pp_pos19;
-    end
+    wire [$clog2(PPW)+11:0] lg_pp21;
+    fmt_interp_lg #(.X_W(PPW)) u_lg_pp (.clk(clk), .x_i(s18_pp), .lg_o(lg_pp21));
+    wire pp_pos21;
+    fmt_interp_dly #(.W(1), .N(3), .RST(0)) u_dly_ppp (
+        .clk(clk), .rst(rst), .d_i(pp_pos18), .q_o(pp_pos21));
 
-    // ---- s21: log2 of the squared semi-axes ----
-    wire signed [LW-1:0] lgg = {{(LW-$clog2(GW)-12){1'b0}}, lg_g20};
-    wire signed [LW-1:0] lgd = {{(LW-$clog2(DMW)-12){1'b0}}, lg_dm20};
-    wire signed [LW-1:0] lgp = {{(LW-$clog2(PPW)-12){1'b0}}, lg_pp20};
+    // ---- s22: log2 of the squared semi-axes ----
+    wire signed [LW-1:0] lgg = {{(LW-$clog2(GW)-12){1'b0}}, lg_g21};
+    wire signed [LW-1:0] lgd = {{(LW-$clog2(DMW)-12){1'b0}}, lg_dm21};
+    wire signed [LW-1:0] lgp = {{(LW-$clog2(PPW)-12){1'b0}}, lg_pp21};
     localparam signed [LW-1:0] LCMAJ_W = LC_MAJ[LW-1:0];
     localparam signed [LW-1:0] LCMIN_W = LC_MIN[LW-1:0];
-    reg signed [LW-1:0] s21_lmaj, s21_lmin;
-    reg                 s21_ok;
+    reg signed [LW-1:0] s22_lmaj, s22_lmin;
+    reg                 s22_ok;
     always @(posedge clk) begin
-        s21_lmaj <= lgg + lgp - (lgd <<< 1) - LCMAJ_W;
-        s21_lmin <= lgg - lgd - lgp + LCMIN_W;
-        s21_ok   <= pos_ok20 & pp_pos20;
+        s22_lmaj <= lgg + lgp - (lgd <<< 1) - LCMAJ_W;
+        s22_lmin <= lgg - lgd - lgp + LCMIN_W;
+        s22_ok   <= pos_ok21 & pp_pos21;
     end
-    wire [15:0] ax_maj23, ax_min23;
-    fmt_interp_exp #(.LW(LW)) u_exp_maj (.clk(clk), .l_i(s21_lmaj), .axis_o(ax_maj23));
-    fmt_interp_exp #(.LW(LW)) u_exp_min (.clk(clk), .l_i(s21_lmin), .axis_o(ax_min23));
-    wire ell_ok23;
+    wire [15:0] ax_maj24, ax_min24;
+    fmt_interp_exp #(.LW(LW)) u_exp_maj (.clk(clk), .l_i(s22_lmaj), .axis_o(ax_maj24));
+    fmt_interp_exp #(.LW(LW)) u_exp_min (.clk(clk), .l_i(s22_lmin), .axis_o(ax_min24));
+    wire ell_ok24;
     fmt_interp_dly #(.W(1), .N(2), .RST(0)) u_dly_eok (
-        .clk(clk), .rst(rst), .d_i(s21_ok), .q_o(ell_ok23));
+        .clk(clk), .rst(rst), .d_i(s22_ok), .q_o(ell_ok24));
 
-    // ---- angle: ((z + 128) >> 8) mod 256 at s17 -> s23 ----
+    // ---- angle: ((z + 128) >> 8) mod 256 at s17 -> s24 ----
     /* verilator lint_off UNUSEDSIGNAL */ // the low byte only rounds
     wire [15:0] ang_r = cor_ang + 16'd128;
     /* verilator lint_on UNUSEDSIGNAL */
-    wire [7:0] ang23;
-    fmt_interp_dly #(.W(8), .N(6), .RST(0)) u_dly_ang (
-        .clk(clk), .rst(rst), .d_i(ang_r[15:8]), .q_o(ang23));
+    wire [7:0] ang24;
+    fmt_interp_dly #(.W(8), .N(7), .RST(0)) u_dly_ang (
+        .clk(clk), .rst(rst), .d_i(ang_r[15:8]), .q_o(ang24));
 
     // =================================================================================
-    // position s17: round / clamp; s18: bias table; s19: coordinates
+    // position s17: round / clamp; s18: bias table; s19: offset; s20: coordinates
     // =================================================================================
     // clamp (fit offsets only); the edge estimate indexes its table by q >> 1 (255 on
     // overflow, ratio >= 1)
@@ -512,35 +520,46 @@ module fmt_interp #(
     wire [COL_W-1:0] col18;
     fmt_interp_dly #(.W(ROW_W + COL_W), .N(17), .RST(0)) u_dly_rc (
         .clk(clk), .rst(rst), .d_i({s1_row, s1_col}), .q_o({row18, col18}));
-    wire [7:0] ox = (s18_bias | s18_ex) ? bx18 : s18_rx;
-    wire [7:0] oy = (s18_bias | s18_ey) ? by18 : s18_ry;
-    wire signed [18:0] colq = {{(11-COL_W){1'b0}}, col18, 8'd0};
-    wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, row18, 8'd0};
-    wire signed [18:0] oxs  = {11'd0, ox};
-    wire signed [18:0] oys  = {11'd0, oy};
-    wire signed [18:0] xs = s18_sgx ? colq - oxs : colq + oxs;
-    wire signed [18:0] ys = s18_sgy ? rowq - oys : rowq + oys;
+    // s19: the offsets (table or rounded quotient) and their cells; s20: coordinates
+    reg [7:0]        s19_ox, s19_oy;
+    reg              s19_sgx, s19_sgy;
+    reg [ROW_W-1:0]  s19_row;
+    reg [COL_W-1:0]  s19_col;
+    always @(posedge clk) begin
+        s19_ox  <= (s18_bias | s18_ex) ? bx18 : s18_rx;
+        s19_oy  <= (s18_bias | s18_ey) ? by18 : s18_ry;
+        s19_sgx <= s18_sgx;
+        s19_sgy <= s18_sgy;
+        s19_row <= row18;
+        s19_col <= col18;
+    end
+    wire signed [18:0] colq = {{(11-COL_W){1'b0}}, s19_col, 8'd0};
+    wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, s19_row, 8'd0};
+    wire signed [18:0] oxs  = {11'd0, s19_ox};
+    wire signed [18:0] oys  = {11'd0, s19_oy};
+    wire signed [18:0] xs = s19_sgx ? colq - oxs : colq + oxs;
+    wire signed [18:0] ys = s19_sgy ? rowq - oys : rowq + oys;
     localparam signed [18:0] XMAX = (COLS - 1) * 256;
     localparam signed [18:0] YMAX = (ROWS - 1) * 256;
-    reg [15:0] s19_x, s19_y;
+    reg [15:0] s20_x, s20_y;
     /* verilator lint_off WIDTHTRUNC */ // clamped values fit 16 bits
     always @(posedge clk) begin
-        s19_x <= xs[18] ? 19'sd0 : (xs > XMAX ? XMAX : xs);
-        s19_y <= ys[18] ? 19'sd0 : (ys > YMAX ? YMAX : ys);
+        s20_x <= xs[18] ? 19'sd0 : (xs > XMAX ? XMAX : xs);
+        s20_y <= ys[18] ? 19'sd0 : (ys > YMAX ? YMAX : ys);
     end
     /* verilator lint_on WIDTHTRUNC */
     fmt_interp_dly #(.W(32), .N(4), .RST(0)) u_dly_xy (
-        .clk(clk), .rst(rst), .d_i({s19_x, s19_y}), .q_o({tp_x_o, tp_y_o}));
-    wire [3:0] flags23;
-    fmt_interp_dly #(.W(4), .N(6), .RST(0)) u_dly_flg (
-        .clk(clk), .rst(rst), .d_i(s17_flags), .q_o(flags23));
+        .clk(clk), .rst(rst), .d_i({s20_x, s20_y}), .q_o({tp_x_o, tp_y_o}));
+    wire [3:0] flags24;
+    fmt_interp_dly #(.W(4), .N(7), .RST(0)) u_dly_flg (
+        .clk(clk), .rst(rst), .d_i(s17_flags), .q_o(flags24));
     fmt_interp_dly #(.W(Z), .N(LAT - 1), .RST(0)) u_dly_str (
         .clk(clk), .rst(rst), .d_i(s1_z[4]), .q_o(tp_strength_o));
 
-    wire ell23 = flags23[3] & ell_ok23;
-    assign tp_flags_o      = {4'd0, flags23};
-    assign tp_axis_major_o = ell23 ? ax_maj23 : 16'd0;
-    assign tp_axis_minor_o = ell23 ? ax_min23 : 16'd0;
-    assign tp_angle_o      = ell23 ? ang23 : 8'd0;
+    wire ell24 = flags24[3] & ell_ok24;
+    assign tp_flags_o      = {4'd0, flags24};
+    assign tp_axis_major_o = ell24 ? ax_maj24 : 16'd0;
+    assign tp_axis_minor_o = ell24 ? ax_min24 : 16'd0;
+    assign tp_angle_o      = ell24 ? ang24 : 8'd0;
 endmodule
 `default_nettype wire

@@ -17,14 +17,12 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import RTL, rtl_sources, run_cocotb
+from common.runner import rom_define, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import interp, params, sensor
 from fmt.localmax import Candidate
 
-LAT = 23
-MODULES = ["fmt_interp", "fmt_interp_dly", "fmt_interp_cordic", "fmt_div", "fmt_interp_lg",
-           "fmt_interp_exp", "fmt_interp_bias_rom"]
+LAT = 24
 
 
 def random_z(rng: random.Random, cfg, kind: str):
@@ -226,7 +224,7 @@ async def back_to_back_and_reset(dut):
 def build_args(sim: str) -> list[str]:
     """The ROMs' folder for $readmemh (simulators resolve paths from their working
     directory); Verilator: one C++ file, -O0 (short runs: the compile dominates)."""
-    args = [f'-DFMT_ROM_DIR="{RTL}/"']
+    args = [rom_define()]
     if sim == "verilator":
         args += ["--output-split", "0", "-CFLAGS", "-O0"]
     return args
@@ -237,7 +235,7 @@ def test_fmt_interp(sim, cfg):
     c = params.get(cfg)
     p = c.verilog_params()
     run_cocotb(
-        sim, "fmt_interp", rtl_sources(*MODULES), "test_fmt_interp",
+        sim, "fmt_interp", sources("fmt_interp"), "test_fmt_interp",
         parameters={k: p[k] for k in ("ROWS", "COLS", "HM_W")},
         extra_env={"CFG": cfg, "SEED": 1 if cfg == "small" else 2},
         test_dir=Path(__file__).parent, build_args=build_args(sim), tag=cfg)
