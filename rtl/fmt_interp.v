@@ -5,6 +5,9 @@
 //
 // Fully pipelined: one candidate per clock in, touches out in the same order after
 // LAT = 24 clock cycles (cand_valid_i -> tp_valid_o, cand_eof_i -> tp_eof_o likewise).
+// No stall and no per-frame state: a frame of n candidates (n <= the contact limit)
+// occupies the input for n cycles, far below 768 clk per frame.  Constant factors are
+// shifts and adds (no DSP).
 //
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
