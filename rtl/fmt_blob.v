@@ -1,5 +1,5 @@
 // fmt_blob -- blob detection: 4-connected regions of z >= blob_threshold_i with at least
-// blob_min_cells_i cells, streamed out largest first (twin: sim/fmt/blobs.py,
+// blob_min_cells_i cells, streamed out largest first (twin: sim/fmt/blob.py,
 // blob_stream_fixed).
 //
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,

@@ -4,7 +4,7 @@
 // +2^(ADC_BITS-1) is exact (no saturation exists or is needed).  Formats: x is
 // ADC_BITS two's complement, y is ADC_BITS + 1 two's complement, same LSB.
 // Timing: one register, advancing only when ce = 1 (latency 1 sample); reset clears y.
-// Twin: sim/fmt/dds.py despread_fixed.
+// Twin: sim/fmt/dds_bank.py despread_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

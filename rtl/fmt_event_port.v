@@ -1,7 +1,7 @@
 // fmt_event_port -- the touch-event port: time stamps, dial-a-latency, report-rate
 // decimation and whole-frame drops, in front of a valid/ready event stream.
 //
-// Twin: sim/fmt/events.py (EventPort.tick, cycle-exact).
+// Twin: sim/fmt/event_port.py (EventPort.tick, cycle-exact).
 //
 // Input: the tracker's events (one per cycle at most, no back-pressure, in_last_i on a
 // frame's last event).  Each event is stamped with the free-running cycle counter

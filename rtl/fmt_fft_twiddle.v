@@ -4,7 +4,7 @@
 // multiplied by W_M^e(i), e(i) = r(q) n, q = i div (M/4), n = i mod (M/4),
 // r = (0, 2, 1, 3), W_M = exp(-j 2 pi / M).  The ROM holds {cos, -sin} of W_M^e(i) per i
 // (TW_W bits each, scale 2^(TW_W-2), so +1 and -1 are exact), read from the hex file
-// fmt_fft_twMMMM.hex that sim/fmt/fft_fixed.py generates (folder: the macro FMT_ROM_DIR
+// fmt_fft_twMMMM.hex that sim/fmt/fft_r22sdf.py generates (folder: the macro FMT_ROM_DIR
 // when defined, e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\", else the name alone, as fmt_dds_rom2).
 //
 // Arithmetic: four DW x TW_W products (one DSP48E each, DW <= 25), each truncated

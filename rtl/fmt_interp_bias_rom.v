@@ -3,7 +3,7 @@
 // 1 Moore bias correction (index = fitted |offset| in 1/256 cell, 0..128), 2 one-sided
 // edge estimate (index = floor(256 * neighbour / centre), 0..255), 3 unused (zeros);
 // data = |offset| in 1/256 cell (0..128).  Contents rtl/fmt_interp_bias.hex from
-// `python -m fmt.interp --write-hex` (inverse curves of an 8 mm disk contact on the
+// `python -m fmt.generate` (inverse curves of an 8 mm disk contact on the
 // 5 mm pitch; see sim/fmt/interp.py).  Twin: fmt.interp.bias_table / edge_table.
 `default_nettype none
 `include "fmt_defaults.vh"

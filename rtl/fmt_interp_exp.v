@@ -4,8 +4,8 @@
 // k = t >>> 12, j = t[11:4]; m = EXP_ROM[j] = round(32768 * 2^((j + 0.5)/256)) (16 bit);
 // axis = 0 for k < 0, m for k = 15, 0xFFFF (saturated) for k > 15, else
 // (m + 2^(14-k)) >> (15 - k) (round half up).  Relative error <= 0.0014 + 1/2 LSB.
-// ROM rtl/fmt_interp_exp.hex (256 x 16 bit) is written by `python -m fmt.interp
-// --write-hex`.  Latency: 2 clock cycles.  Twin: fmt.interp.exp_axis_fixed.
+// ROM rtl/fmt_interp_exp.hex (256 x 16 bit) is written by `python -m fmt.generate`.
+// Latency: 2 clock cycles.  Twin: fmt.interp.exp_axis_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

@@ -5,8 +5,8 @@
 // n < 8 the missing bits are zeros), LOG_ROM[m] = round(4096 * log2(1 + (m + 0.5)/256))
 // (12 fractional bits, < 4096).  Error |lg_o/4096 - log2 x| <= 0.0028 + 1/8192.
 // x = 0 gives n = 0 and an undefined fraction (callers check x > 0).
-// ROM rtl/fmt_interp_log.hex (256 x 12 bit) is written by `python -m fmt.interp
-// --write-hex`.  Latency: 3 clock cycles.  Twin: fmt.interp.lg_fixed.
+// ROM rtl/fmt_interp_log.hex (256 x 12 bit) is written by `python -m fmt.generate`.
+// Latency: 3 clock cycles.  Twin: fmt.interp.lg_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

@@ -2,7 +2,7 @@
 // one input per ce cycle, by CORDIC vectoring (shift-add only) plus one constant
 // multiply for the CORDIC gain compensation.
 //
-// Algorithm (bit-exact twin: sim/fmt/rx_fixed.py magnitude_fixed):
+// Algorithm (bit-exact twin: sim/fmt/rx_array.py magnitude_fixed):
 //   x0 = |re| << GUARD, y0 = im << GUARD            (reflect into the right half plane)
 //   for i = 0 .. ITER-1:                            (one pipeline stage each)
 //     y >= 0: x += y >>> i, y -= x >>> i
@@ -20,7 +20,7 @@
 // register.
 // Formats: re, im signed IN_W (integers); mag unsigned OUT_W = IN_W (the largest
 // magnitude, sqrt(2) * 2^(IN_W-1), is below 2^IN_W: no overflow is possible).
-// Error (measured in sim/tests/test_rx_fixed.py over random full-scale inputs):
+// Error (measured in sim/tests/test_rx_array.py over random full-scale inputs):
 // |mag - exact| <= 1.1 LSB + 2e-7 |z|, mean bias below 0.15 LSB (ITER = 12, GUARD = 3).
 // Internal width IW = IN_W + GUARD + 2 holds K * sqrt(2) * 2^(IN_W-1+GUARD) < 2^(IW-1).
 // Latency: ITER + 3 ce cycles (input register, ITER stages, partial products, sum);

@@ -11,7 +11,7 @@
 // The first of a pair to arrive is held in a ROWS-entry memory (distributed RAM, with
 // a bit saying whether it was k or N-k); when its partner arrives, (2A, 2B) of row r
 // leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
-// clears it.  Twin: sim/fmt/rx_fixed.py pair_split_fixed.
+// clears it.  Twin: sim/fmt/rx_array.py pair_split_fixed.
 // Channels (CH > 1): the input interleaves CH FFT streams in lockstep (fmt_fft_r22sdf
 // CH, in_ch_i = its out_ch_o): every bin arrives for channel 0, 1, .., CH-1 in turn, all
 // channels in the same bin order.  The held memory is per {channel, row} (CH x 2^ROW_W

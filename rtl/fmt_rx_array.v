@@ -32,7 +32,7 @@
 //           last group hm_valid_o is high for one clk with the whole row
 // A "step" is a clk (POST_CLK = 1) or a ce cycle (POST_CLK = 0); rows complete at most
 // one per ce, in the FFT's bit-reversed order (bursts of two then >= 7 slots at N = 256;
-// sim/fmt/rx_fixed.py row_order).
+// sim/fmt/rx_array.py row_order).
 // MAG_UNITS rule: steps per FFT slot C = CLK_PER_SAMPLE (POST_CLK = 1) or 1 (POST_CLK =
 // 0).  The comb's rows complete at most two in any 8 consecutive slots, so with
 // P <= 4 C (default K = ceil(COLS / (4 C))) a row waits at most for its burst partner:
@@ -63,7 +63,7 @@
 // heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
 // before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
 // cannot overflow).
-// Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (values), rx_row_beats (timing).
+// Twin: sim/fmt/rx_array.py rx_heatmaps_fixed (values), rx_row_beats (timing).
 `default_nettype none
 `include "fmt_defaults.vh"
 

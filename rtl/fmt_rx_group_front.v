@@ -26,7 +26,7 @@
 // LATENCY0 (G - 1) clk (the register stages count clk cycles, not samples).
 // Formats: FFT output W = FFT_OUT_W bits = X * 2^-FFT_SHIFT (see fmt_col_pair_rx);
 // split outputs 2A, 2B exact, W + 1 bits signed.  Flags: fft_ovf_o, seq_ovf_o sticky.
-// Twin: sim/fmt/rx_fixed.py (values rx_heatmaps_fixed, timing rx_row_beats).
+// Twin: sim/fmt/rx_array.py (values rx_heatmaps_fixed, timing rx_row_beats).
 `default_nettype none
 `include "fmt_defaults.vh"
 

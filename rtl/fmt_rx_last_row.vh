@@ -2,7 +2,7 @@
 // (fmt_rx_array, fmt_col_pair_rx), which must have LOG2_N, ROWS, BIN_LO and BIN_STEP in
 // scope.  last_row_f(0) is the comb row that completes last in a window: rows come out
 // of the pair split when the later of their two bins k and N - k leaves the FFT, in
-// bit-reversed order (twin: sim/fmt/rx_fixed.py row_order).
+// bit-reversed order (twin: sim/fmt/rx_array.py row_order).
 function integer bitrev_f;
     input integer v;
     integer j;

@@ -1,6 +1,6 @@
 // fmt_tracker -- frame matching: stable contact IDs, new / move / lift events.
 //
-// Twin: sim/fmt/tracking.py (Tracker.step), bit-exact (same events, same order); the
+// Twin: sim/fmt/tracker.py (Tracker.step), bit-exact (same events, same order); the
 // cycle count of the match is modelled by tracking.lazy_greedy (see MATCH below).
 //
 // Contact table: MAX_TOUCHES slots.  In flip-flops (read by all slots in parallel):

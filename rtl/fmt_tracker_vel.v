@@ -4,7 +4,7 @@
 //   e     = (meas << VF) - p                (prediction error, P_W + 1 bits signed)
 //   v_new = clamp(v + (e >>> shift), -vmax, +vmax)   (arithmetic shift = floor)
 //   p_new = (meas << VF) + v_new            (prediction for the next frame)
-// Twin: sim/fmt/tracking.py (Tracker.step, "update matched slots").
+// Twin: sim/fmt/tracker.py (Tracker.step, "update matched slots").
 // The clamp is the max-speed setting (by design, not an overflow).
 `default_nettype none
 

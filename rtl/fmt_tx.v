@@ -13,7 +13,7 @@
 // which needs exactly that ce spacing) "sample k" above is the k-th ce edge: DDS sample
 // k carries PN chip floor((k - 1) / L) for chip length L samples, and chip_len_i and
 // rx_delay_i are in samples whatever C is.
-// Twin: sim/fmt/dds.py fmt_tx_fixed.
+// Twin: sim/fmt/dds_bank.py tx_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

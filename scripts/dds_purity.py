@@ -24,7 +24,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "sim"), str(ROOT / "tb")]
 
-from fmt import dds, params  # noqa: E402
+from fmt import dds_bank, params  # noqa: E402
 from fmt_dds_bank.dds_driver import run  # noqa: E402
 
 
@@ -53,12 +53,12 @@ def main(argv=None) -> int:
     runs = [(b, b + cfg.amp_bits) for b in a.bits] + [(cfg.sine_bits, cfg.dac_bits)]
     rows = []
     for s_bits, d_bits in runs:
-        if (dds.TABLE_ADDR, s_bits) not in dds.HEX_TABLES:
+        if (dds_bank.TABLE_ADDR, s_bits) not in dds_bank.HEX_TABLES:
             print(f"no committed table for SINE_BITS {s_bits}; skipped", file=sys.stderr)
             continue
         rows.append(measure(a.sim, cfg, s_bits, d_bits, a.rpe))
     print(f"\nDDS purity from the RTL ({a.sim}), sensor '{cfg.name}': {cfg.rows} rows, N = {cfg.n_fft}, "
-          f"bins {cfg.bin_lo}..{cfg.bin_hi}, table 2^{dds.TABLE_ADDR} entries, full amplitude, PN off")
+          f"bins {cfg.bin_lo}..{cfg.bin_hi}, table 2^{dds_bank.TABLE_ADDR} entries, full amplitude, PN off")
     print("| SINE_BITS | DAC_BITS | worst row spur (dBc) | bound -6B | comb: worst non-comb bin (dBc) "
           "| bound -6B+10log10(rows) | max abs(rtl - float) (LSB) |")
     print("|---|---|---|---|---|---|---|")

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Accuracy of the fixed-point FFT (sim/fmt/fft_fixed.py = rtl/fmt_fft_r22sdf.v bit for
+"""Accuracy of the fixed-point FFT (sim/fmt/fft_r22sdf.py = rtl/fmt_fft_r22sdf.v bit for
 bit) against a floating-point FFT of the SAME integer samples, per N.
 
 SQNR = 10 log10(sum |X_float|^2 / sum |X_fixed - X_float|^2), X_float scaled by 2^-SHIFT
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sim"))
-from fmt import fft_fixed as F  # noqa: E402
+from fmt import fft_r22sdf as F  # noqa: E402
 
 IN_W = 13
 

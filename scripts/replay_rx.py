@@ -10,7 +10,7 @@ captures.npy: (samples, COLS) integers in the ADC range, sample 0 = the first sa
 after reset.  --sign: (samples,) 0/1 receive PN signs (default: PN off).  --m: windows
 per frame (1, 2, 4, 8).  Writes heatmaps.npy (frames, ROWS, COLS) uint32 and
 heatmaps.npy.json (frames, sticky flags).  --check compares with the bit-exact model
-sim/fmt/rx_fixed.py and exits 1 on a difference.  --cps: the build's CLK_PER_SAMPLE:
+sim/fmt/rx_array.py and exits 1 on a difference.  --cps: the build's CLK_PER_SAMPLE:
 1 (default, fastest: a sample every clk, one FFT engine per column pair) or 2..4 (the
 core's structure: CLK_PER_SAMPLE column pairs per time-multiplexed FFT engine, a
 sample every CLK_PER_SAMPLE clk).
@@ -45,12 +45,12 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
 
     from common.runner import run_cocotb, sources
-    from fmt import params, rx_fixed
+    from fmt import params, rx_array
     from fmt_rx_array.rx_driver import build_args
 
     cfg = params.get(a.config)
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
-    fft_ch = rx_fixed.rx_fft_ch_default(1, a.cps)
+    fft_ch = rx_array.rx_fft_ch_default(1, a.cps)
     env = {"CFG": a.config, "M": a.m, "REPLAY_IN": inp, "REPLAY_OUT": out,
            "REPLAY_SIGN": Path(a.sign).resolve() if a.sign else "",
            "FFT_CH": fft_ch, "CE_EVERY": a.cps}
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
     if a.check:
         adc = np.load(inp)
         sign = np.load(a.sign) if a.sign else np.zeros(len(adc), dtype=np.uint8)
-        exp, _, _ = rx_fixed.rx_heatmaps_fixed(adc, sign, cfg, m=a.m)
+        exp, _, _ = rx_array.rx_heatmaps_fixed(adc, sign, cfg, m=a.m)
         if not np.array_equal(hm, exp):
             print(f"MISMATCH: {int(np.sum(hm != exp))} cells differ from rx_fixed")
             return 1

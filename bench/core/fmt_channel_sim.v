@@ -10,7 +10,7 @@
 // G[r][c] is unsigned COUP_BITS with COUP_FRAC fractional bits (in ADC LSB per DAC
 // LSB); noise words are signed NOISE_BITS with NOISE_FRAC fractional bits (ADC LSB),
 // NOISE_LEN x COLS words, row-major (sample, column), from the $readmemh file
-// NOISE_FILE (written by sim/fmt/dds.py write_noise_hex; "" = no noise).
+// NOISE_FILE (written by sim/fmt/channel.py write_noise_hex; "" = no noise).
 // Output registered: adc_o / clip_o after ce edge k belong to sample k (latency 1).
 // clip_sticky_o stays 1 from the first clipped sample until reset.
 //
@@ -21,7 +21,7 @@
 //   the new G (so a touch can start on its exact onset sample).  One armed copy at a
 //   time (a new commit replaces an armed one).  Reset clears the sample counter, the
 //   armed copy, the outputs and the sticky flag; G and G_pending keep their contents
-//   (both are 0 at time 0).  Twin: sim/fmt/dds.py channel_sim_fixed.
+//   (both are 0 at time 0).  Twin: sim/fmt/channel.py channel_sim_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

@@ -22,7 +22,7 @@ player + loggers; nothing in Python is on the per-sample path:
    into the later one; the model uses the same list, so this costs no exactness.  Noise:
    white Gaussian words with the scene's sigma, 4 fraction bits, NOISE_LEN samples per
    column repeating.
-2. The model reference (:func:`model_reference`): ``fmt_tx_fixed`` (DDS + PN) ->
+2. The model reference (:func:`model_reference`): ``tx_fixed`` (DDS + PN) ->
    3-sample DAC delay -> :func:`channel_fixed` (int64 twin of ``channel_sim_fixed``) ->
    1-sample ADC register -> ``rx_heatmaps_fixed`` (PN receive delay 4 samples) ->
    ``touch.process_frames(fixed=True)`` with the scene's calibration.
@@ -76,13 +76,13 @@ import numpy as np
 
 from common.sources import INCLUDE_DIRS, rom_define, sources
 from fmt import channel as _channel
-from fmt import dds as _dds
-from fmt import pn as _pn
-from fmt import rx_fixed as _rx
+from fmt import dds_bank as _dds
+from fmt import pn_gen as _pn
+from fmt import rx_array as _rx
 from fmt import scene as _scene
 from fmt import sensor as _sensor
 from fmt.settings import TouchSettings
-from fmt.tracking import TrackParams
+from fmt.tracker import TrackParams
 
 ROOT = Path(__file__).resolve().parents[2]
 BENCH = Path(__file__).resolve().parent
@@ -197,7 +197,7 @@ def make_noise(scene: _scene.Scene, length: int) -> np.ndarray:
 
 
 def channel_fixed(dac, g0, updates, noise, adc_bits: int = 12):
-    """int64 twin of ``fmt_channel_sim`` / ``dds.channel_sim_fixed`` (same formula:
+    """int64 twin of ``fmt_channel_sim`` / ``channel.channel_sim_fixed`` (same formula:
     round half up of sum_r dac*G + noise << 12, >> 16, clip); int64 is exact here
     (|dac| < 2^11, G < 2^16, ROWS <= 64).  Returns (adc, clipped samples)."""
     dac = np.asarray(dac, dtype=np.int64)
@@ -235,7 +235,7 @@ def model_reference(scene: _scene.Scene, g0, updates, noise, frames: int, settin
     spf = scene.samples_per_frame
     n = frames * spf
     enable, chip_len = pn_of(scene)
-    dds = _dds.fmt_tx_fixed(n, cfg, pn_enable=enable, chip_len=chip_len)
+    dds = _dds.tx_fixed(n, cfg, pn_enable=enable, chip_len=chip_len)
     dac = np.zeros_like(dds)
     dac[DAC_DELAY:] = dds[:n - DAC_DELAY]
     adc_ch, clipped = channel_fixed(dac, g0, updates, noise, cfg.adc_bits)
@@ -421,7 +421,7 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
             try:
                 from fmt import flatten as _flatten
                 from fmt import plots as _plots
-                flat = _flatten.flatten(rtl_hm, cal[0], cal[1], cfg) if cal is not None else rtl_hm
+                flat = _flatten.flatten_float(rtl_hm, cal[0], cal[1], cfg) if cal is not None else rtl_hm
                 _plots.heatmap_with_tracks(flat, scene.replace(frames=n_rtl),
                                            _run_sim.tracks(frame_events, cfg), od / "heatmap.png")
                 rep["png"] = str(od / "heatmap.png")
@@ -635,7 +635,7 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
         raise ValueError(f"{len(rec)} update records > capacity {upd_len(cfg)}: fewer frames")
     write_records(d / "upd.hex", rec)
     noise = make_noise(scene, noise_len(cfg))
-    _dds.write_noise_hex(d / "noise.hex", noise, NOISE_BITS)
+    _channel.write_noise_hex(d / "noise.hex", noise, NOISE_BITS)
     if cal == "scene":
         cal = _run_sim.calibration(scene)
         cal = (np.asarray(cal[0], dtype=np.int64), np.asarray(cal[1], dtype=np.int64))

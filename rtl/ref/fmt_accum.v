@@ -15,7 +15,7 @@
 // output LSBs, averaged over M).  Per-cell storage: ROWS x LANES*SUM_W bits, an
 // inferred distributed RAM (read asynchronously, written at the beat).
 // Latency: 2 ce cycles from the beat to out_valid_o (only for in_last_i beats).
-// Twin: sim/fmt/rx_fixed.py accum_fixed.
+// Twin: sim/fmt/rx_array.py accum_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

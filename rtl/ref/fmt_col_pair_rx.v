@@ -17,7 +17,7 @@
 // reset (the FFT is held in reset for that ce while the despreaders fill); a frame
 // is M = 2^m_log2_i consecutive windows (m_log2_i sampled at the first window of each
 // frame, values above M_LOG2_MAX are clamped).  Rows leave in the order their pair
-// completes in the FFT's bit-reversed output (sim/fmt/rx_fixed.py row_order), only in
+// completes in the FFT's bit-reversed output (sim/fmt/rx_array.py row_order), only in
 // the last window of a frame.
 // Latency (M = 1), from the ce edge that takes a window's last ADC sample: the pair
 // split takes slot s of the window on the ce edge LATENCY0 + s + 1 ce cycles later
@@ -31,7 +31,7 @@
 // Structure: fmt_rx_pair_front (despread, FFT, bookkeeping, split) + this pair's own
 // magnitude units and accumulator.  fmt_rx_array uses the front only and shares a few
 // magnitude units and one accumulator memory among all pairs.
-// Twin: sim/fmt/rx_fixed.py rx_heatmaps_fixed (columns of one pair).
+// Twin: sim/fmt/rx_array.py rx_heatmaps_fixed (columns of one pair).
 `default_nettype none
 `include "fmt_defaults.vh"
 

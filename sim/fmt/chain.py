@@ -1,7 +1,7 @@
 """The model chain: scene -> ADC streams -> heat maps -> touch events (floating point).
 
 * :func:`heatmaps_float` -- the full path: ``channel.adc_streams`` (tones, coupling,
-  PN, delay, effects, 12-bit ADC) then ``receiver.receive`` (despread, FFT, comb bins,
+  PN, delay, effects, 12-bit ADC) then ``rx_array.receive`` (despread, FFT, comb bins,
   magnitude, mean over M), chunked over frames so memory stays bounded.
 * :func:`render_heatmaps` -- the scene straight to heat maps WITHOUT signal synthesis, for
   post-processing tests:  cell = |S + n| averaged over the frame's M windows, where S is
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import channel as _ch
-from . import receiver as _rx
+from . import rx_array as _rx
 from . import sensor as _sensor
 from .scene import Scene
 
@@ -138,7 +138,7 @@ def render_heatmaps(scene: Scene, cfg=None, frames: int | None = None, noise: bo
         sq = np.sqrt(var * cfg.n_fft / 2.0) * _rx.hm_scale(cfg)
         rng = np.random.default_rng(scene.seed + 7919) if rng is None else rng
         X = X + sq * (rng.standard_normal(X.shape) + 1j * rng.standard_normal(X.shape))
-    return _rx.accumulate(np.abs(X), scene.m)
+    return _rx.accum_float(np.abs(X), scene.m)
 
 
 def noiseless(scene: Scene) -> Scene:

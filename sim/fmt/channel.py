@@ -10,7 +10,7 @@ Column c at ADC sample n (before quantisation, in LSB):
 * Row tones: exact FFT bins k_r = cfg.bins[r], equal amplitude, phase phi_r = 0 (the DDS
   starts every row at phase 0 and sends a sine) or Schroeder phases ("tone_phases").
   Every window of N samples of a tone is identical (exact bins).
-* PN: p = +1/-1 from ``fmt.pn.pn_signs`` (tx sign 1 = invert), common to all rows; the
+* PN: p = +1/-1 from ``fmt.pn_gen.pn_signs`` (tx sign 1 = invert), common to all rows; the
   channel delays the modulated row signals by d = ``delay_samples``; before the first
   sample the delayed sign is +1 (the convention of the receiver's delay line, which also
   outputs 0 = +1 before its first sample), so a matched receive delay despreads exactly.
@@ -27,10 +27,11 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from . import pn as _pn
+from . import pn_gen as _pn
 from . import sensor as _sensor
 from .params import SensorConfig
 from .scene import DEFAULT_SNR_DB, FINGER_MM, Scene
@@ -193,7 +194,7 @@ def pn_settings(scene: Scene) -> tuple[bool, int, int, int]:
 
 @functools.lru_cache(maxsize=8)
 def _pn_period(bits: int, seed: int) -> np.ndarray:
-    """One full period (2**bits - 1 chips) of the LFSR (``fmt.pn.lfsr_chips``), cached."""
+    """One full period (2**bits - 1 chips) of the LFSR (``fmt.pn_gen.lfsr_chips``), cached."""
     return _pn.lfsr_chips((1 << bits) - 1, bits, None, seed)
 
 
@@ -201,7 +202,7 @@ def pn_stream(n0: int, n1: int, chip_len: int = 1, enable: bool = True, delay: i
               bits: int = 15, seed: int = _pn.DEFAULT_SEED) -> np.ndarray:
     """PN sign bits (uint8, 1 = invert) of samples n0 .. n1-1 delayed by ``delay``:
     chips[(n - delay) // chip_len], 0 for n < delay -- the same values as
-    ``fmt.pn.pn_signs`` (checked in the tests) but from a cached LFSR period, so long
+    ``fmt.pn_gen.pn_signs`` (checked in the tests) but from a cached LFSR period, so long
     streams cost no Python loop."""
     if not enable:
         return np.zeros(n1 - n0, dtype=np.uint8)
@@ -290,3 +291,47 @@ def adc_streams(scene: Scene, cfg: SensorConfig | None = None, n_samples: int | 
     return AdcResult(adc=out[:n_samples], tx_sign=tx[:n_samples], rx_sign=rx[:n_samples],
                      clipped=clipped, noise_sigma=sigma,
                      coupling=None if coup is None else coup[:n_samples])
+
+
+# ---- simulation-only channel (bench/core/fmt_channel_sim.v) ------------------------
+def write_noise_hex(path, noise: np.ndarray, noise_bits: int = 16) -> None:
+    """Noise words (shape (NOISE_LEN, cols), signed noise_bits) for $readmemh,
+    row-major (sample, column)."""
+    a = np.asarray(noise, dtype=np.int64)
+    lim = 1 << (noise_bits - 1)
+    if a.min() < -lim or a.max() >= lim:
+        raise ValueError("noise word out of range")
+    digits = (noise_bits + 3) // 4
+    mask = (1 << noise_bits) - 1
+    Path(path).write_text("".join(f"{int(v) & mask:0{digits}x}\n" for v in a.ravel()))
+
+
+def channel_sim_fixed(dac: np.ndarray, g0: np.ndarray, updates=(), noise=None,
+                      adc_bits: int = 12, coup_frac: int = 16, noise_frac: int = 4):
+    """Bit-exact twin of ``fmt_channel_sim``.  ``dac``: (n, rows) row words of samples
+    0..n-1; ``g0``: (rows, cols) coupling in effect from sample 0 (unsigned integers,
+    coup_frac fractional bits); ``updates``: (stamp, G) pairs in commit order, each in
+    effect from sample ``stamp`` on (a later commit must have a later stamp);
+    ``noise``: (L, cols) signed words with noise_frac fractional bits, sample k uses
+    row k mod L.  Returns (adc (n, cols) int64, clip (n,) bool): round half up of
+    sum_r dac*G + noise, then clip to the ADC range."""
+    dac = np.asarray(dac, dtype=np.int64)
+    n = dac.shape[0]
+    g_of = np.empty(n, dtype=np.int64)
+    mats = [np.asarray(g0, dtype=np.int64)] + [np.asarray(g, dtype=np.int64) for _, g in updates]
+    g_of[:] = 0
+    for i, (stamp, _) in enumerate(updates):
+        g_of[int(stamp):] = i + 1
+    acc = np.zeros((n, mats[0].shape[1]), dtype=object)
+    for i, g in enumerate(mats):
+        sel = g_of == i
+        if sel.any():
+            acc[sel] = (dac[sel].astype(object)) @ g.astype(object)
+    if noise is not None:
+        nz = np.asarray(noise, dtype=np.int64)
+        acc = acc + (nz[np.arange(n) % nz.shape[0]].astype(object) << (coup_frac - noise_frac))
+    half = (1 << (coup_frac - 1)) if coup_frac > 0 else 0
+    y = np.array((acc + half) >> coup_frac, dtype=np.int64)
+    lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
+    clip = ((y < lo) | (y > hi)).any(axis=1)
+    return np.clip(y, lo, hi), clip

@@ -17,7 +17,7 @@ Fixed-point rule (``flatten_fixed``, bit-exact with the RTL):
 4. ``q > 2^HM_W - 1`` -> ``q = 2^HM_W - 1`` and the cell's saturation bit is set (the RTL
    raises a sticky flag and counts saturated cells).
 
-The float model ``flatten`` computes ``max(z - offset, 0) * gain / 2^14`` with the same
+The float model ``flatten_float`` computes ``max(z - offset, 0) * gain / 2^14`` with the same
 clamps, no rounding; ``|fixed - float| <= 0.5`` LSB for every non-saturated cell.
 
 Calibration (``calibrate``): the offset of a cell is the (rounded) mean of untouched
@@ -69,7 +69,7 @@ def flatten_fixed(hm, offset, gain, cfg: SensorConfig) -> tuple[np.ndarray, np.n
     return np.minimum(q, top), sat
 
 
-def flatten(hm, offset, gain, cfg: SensorConfig) -> np.ndarray:
+def flatten_float(hm, offset, gain, cfg: SensorConfig) -> np.ndarray:
     """Floating-point reference: ``max(z - offset, 0) * gain / 2^14`` clipped to full scale.
     ``gain`` is the Q2.14 integer word (so the two models see the same gain)."""
     top = float((1 << cfg.hm_width) - 1)

@@ -9,11 +9,11 @@ The files and their generators:
 * ``rtl/fmt_defaults.vh``  -- default parameters of every RTL module (:mod:`fmt.params`)
 * ``rtl/fmt_regmap.vh``, ``rtl/fmt_regfile.v``, ``docs/REGISTERS.md`` -- the register
   map (:mod:`fmt.regmap`)
-* ``rtl/fmt_fft_twMMMM.hex`` -- FFT twiddle ROMs (:mod:`fmt.fft_fixed`)
-* ``rtl/fmt_sine_rom_aAA_sSS.hex`` -- DDS sine ROMs (:mod:`fmt.dds`)
+* ``rtl/fmt_fft_twMMMM.hex`` -- FFT twiddle ROMs (:mod:`fmt.fft_r22sdf`)
+* ``rtl/fmt_sine_rom_aAA_sSS.hex`` -- DDS sine ROMs (:mod:`fmt.dds_bank`)
 * ``rtl/fmt_interp_log.hex``, ``fmt_interp_exp.hex``, ``fmt_interp_bias.hex`` -- the
   interpolator's ROMs (:mod:`fmt.interp`)
-* ``rtl/fmt_recip.hex`` -- the receive's 1/M ROM (:mod:`fmt.rx_fixed`)
+* ``rtl/fmt_recip.hex`` -- the receive's 1/M ROM (:mod:`fmt.rx_array`)
 
 ``--check`` renders every file in memory and compares it with the file on disk; nothing
 is written.
@@ -26,7 +26,7 @@ from functools import partial
 from pathlib import Path
 from typing import Callable
 
-from . import dds, fft_fixed, interp, params, regmap, rx_fixed
+from . import dds_bank, fft_r22sdf, interp, params, regmap, rx_array
 
 ROOT = Path(__file__).resolve().parents[2]
 COMMAND = "python -m fmt.generate"
@@ -36,14 +36,14 @@ def generated() -> dict[Path, Callable[[], str]]:
     """Generated file -> function returning its text."""
     out: dict[Path, Callable[[], str]] = {params.VH_PATH: params.render_vh}
     out.update(regmap.GENERATED)
-    for m in fft_fixed.ALL_TWIDDLE_BLOCKS:
-        out[fft_fixed.RTL / fft_fixed.twiddle_hex_name(m)] = partial(fft_fixed.twiddle_hex_text, m)
-    for a, s in dds.HEX_TABLES:
-        out[dds.RTL / dds.hex_name(a, s)] = partial(dds.render_hex, a, s)
+    for m in fft_r22sdf.ALL_TWIDDLE_BLOCKS:
+        out[fft_r22sdf.RTL / fft_r22sdf.twiddle_hex_name(m)] = partial(fft_r22sdf.twiddle_hex_text, m)
+    for a, s in dds_bank.HEX_TABLES:
+        out[dds_bank.RTL / dds_bank.hex_name(a, s)] = partial(dds_bank.render_hex, a, s)
     out[interp.LOG_HEX] = interp.render_log_hex
     out[interp.EXP_HEX] = interp.render_exp_hex
     out[interp.BIAS_HEX] = interp.render_bias_hex
-    out[rx_fixed.RTL / rx_fixed.RECIP_HEX] = rx_fixed.render_recip_hex
+    out[rx_array.RTL / rx_array.RECIP_HEX] = rx_array.render_recip_hex
     return out
 
 

@@ -526,5 +526,5 @@ def interp_frame_fixed(cands, cfg, moore=True, bias=True, frame=0):
     return [interp_fixed(c, cfg, moore, bias, frame) for c in cands]
 
 
-def interp_frame(cands, cfg, moore=True, bias=True, frame=0):
+def interp_frame_float(cands, cfg, moore=True, bias=True, frame=0):
     return [interp_float(c, cfg, moore, bias, frame) for c in cands]

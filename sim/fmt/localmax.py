@@ -102,7 +102,7 @@ def neighbourhood3x3(hm, r: int, c: int) -> tuple[np.ndarray, int]:
     return z3, missing
 
 
-def local_maxima(hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16):
+def local_maxima_fixed(hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16):
     """Coarse touches of one heat map: ``(candidates, n_found, overflow)``.
 
     ``candidates``: at most ``max_touches`` :class:`Candidate`, strongest first (ties by
@@ -121,8 +121,3 @@ def local_maxima(hm, threshold: int, neighbourhood: str = "moore", max_touches: 
         z3, missing = neighbourhood3x3(z, int(rr[i]), int(cc[i]))
         cands.append(Candidate(int(rr[i]), int(cc[i]), z3, missing))
     return cands, n_found, n_found > max_touches
-
-
-def local_maxima_fixed(hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16):
-    """Fixed-point twin (identical: the heat map is already integer)."""
-    return local_maxima(hm, threshold, neighbourhood, max_touches)

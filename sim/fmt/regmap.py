@@ -38,7 +38,7 @@ from pathlib import Path
 
 from . import params, protocol
 from .settings import TouchSettings
-from .tracking import TrackParams
+from .tracker import TrackParams
 
 ROOT = Path(__file__).resolve().parents[2]
 REGFILE_PATH = ROOT / "rtl" / "fmt_regfile.v"

@@ -75,10 +75,10 @@ from pathlib import Path
 import numpy as np
 
 from . import chain as _chain
-from . import fft_fixed as _fft
+from . import fft_r22sdf as _fft
 from . import params as _params
 from . import run_sim as _run_sim
-from . import rx_fixed as _rx
+from . import rx_array as _rx
 from . import scene as _scene
 from . import touch as _touch
 from .settings import TouchSettings

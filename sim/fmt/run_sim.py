@@ -247,7 +247,7 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
         if plot:
             from . import plots as _plots
             from . import flatten as _flatten
-            flat = _flatten.flatten(res.heatmaps, cal[0], cal[1], cfg)
+            flat = _flatten.flatten_float(res.heatmaps, cal[0], cal[1], cfg)
             png = d / "heatmap.png"
             _plots.heatmap_with_tracks(flat, scene, tracks(evs, cfg), png)
             rep["png"] = str(png)

@@ -20,7 +20,7 @@ class TouchSettings:
     hold_off_us: float = 200.0     # a contact missing for less than this keeps its ID
     velocity_window_us: float = 2000.0  # time base of the velocity estimate
     max_speed_mm_s: float = 3000.0 # clamp of the predicted velocity
-    # blobs (the paper's future work; defined in fmt.blobs)
+    # blobs (the paper's future work; defined in fmt.blob)
     blobs: bool = False            # blob detection on: fingers inside blobs dropped, blob events
     blob_threshold: int = 1000     # cells above this belong to a connected region
     blob_min_cells: int = 12       # a region of at least this many cells is a blob

@@ -1,8 +1,8 @@
 """The touch-processing pipeline: heat maps -> touch events (twin of ``rtl/fmt_touch.v``).
 
     flatten (fmt.flatten) -> 3x3 local maxima above the threshold (fmt.localmax)
-    [-> blobs (fmt.blobs), off by default] -> paraboloid fits (fmt.interp)
-    -> frame matching (fmt.tracking)
+    [-> blobs (fmt.blob), off by default] -> paraboloid fits (fmt.interp)
+    -> frame matching (fmt.tracker)
 
 ``fixed=True`` runs the bit-exact twins of the RTL blocks (integer heat maps); the
 events then equal the RTL's event stream (without time stamps).  ``fixed=False`` runs
@@ -21,7 +21,7 @@ from . import interp as _interp
 from . import localmax as _localmax
 from .params import SensorConfig
 from .settings import TouchSettings
-from .tracking import Touch, TouchEvent, Tracker, TrackParams
+from .tracker import Touch, TouchEvent, Tracker, TrackParams
 
 MAX_BLOBS = 8          # blob events per frame (rtl/fmt_touch.v: fmt_blob MAX_BLOBS)
 
@@ -74,7 +74,7 @@ class TouchPipeline:
                                                    self.max_touches)
         blobs = []
         if self.blobs:
-            from . import blobs as _blobs
+            from . import blob as _blobs
             # finger removal after the contact limit, by every blob (also those beyond
             # the MAX_BLOBS reported); events for the first MAX_BLOBS blobs only
             cands, blobs = _blobs.split_touches(zi, cands, s.blob_threshold, s.blob_min_cells)
@@ -86,7 +86,7 @@ class TouchPipeline:
         for c in cands:
             fc.append(_localmax.Candidate(c.row, c.col, _float3x3(hm_flat, c.row, c.col),
                                           c.missing))
-        tps = _interp.interp_frame(fc, self.cfg, self.moore, s.bias_correction, frame)
+        tps = _interp.interp_frame_float(fc, self.cfg, self.moore, s.bias_correction, frame)
         return [_touch_from_float(t) for t in tps], blobs
 
     def flatten(self, heatmaps):
@@ -94,7 +94,7 @@ class TouchPipeline:
             out, _ = _flatten.flatten_fixed(np.asarray(heatmaps, dtype=np.int64), self.offset,
                                             self.gain, self.cfg)
             return out
-        return _flatten.flatten(heatmaps, self.offset, self.gain, self.cfg)
+        return _flatten.flatten_float(heatmaps, self.offset, self.gain, self.cfg)
 
     def run(self, heatmaps, first_frame: int = 0) -> list[list[TouchEvent]]:
         flat = self.flatten(heatmaps)          # vectorised over the frames

@@ -4,14 +4,14 @@ import math
 import numpy as np
 import pytest
 
-from fmt import chain, channel, params, receiver
+from fmt import chain, channel, params, rx_array
 from fmt import scene as S
 
 
 def _bound(cfg):
     # ADC rounding: |e| <= 1/2 LSB per sample, so |dX| <= N/2 and a cell moves by at most
     # N/2 * hm_scale = 2**(HM_W - ADC_BITS + 1) counts; statistically sqrt(N/24) * hm_scale RMS
-    return cfg.n_fft / 2 * receiver.hm_scale(cfg), math.sqrt(cfg.n_fft / 24) * receiver.hm_scale(cfg)
+    return cfg.n_fft / 2 * rx_array.hm_scale(cfg), math.sqrt(cfg.n_fft / 24) * rx_array.hm_scale(cfg)
 
 
 def test_render_matches_adc_path_default_scene():
@@ -61,7 +61,7 @@ def test_render_noise_statistics():
     # the rendered noise gives the default physics' 30 dB at M = 1 and 33 dB at M = 2
     cfg = params.DEFAULT
     r, c = cfg.rows // 2, cfg.cols // 2
-    clean = receiver.unit_cell_counts(cfg) * channel.finger_peak_coupling(cfg)
+    clean = rx_array.unit_cell_counts(cfg) * channel.finger_peak_coupling(cfg)
     cells = [(r, c), (r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)]
     for m, want, frames in ((1, 30.0, 1200), (2, 33.0, 800)):
         sc = S.Scene(sensor="default", frames=frames, m=m, seed=3, effects={"noise": {"snr_db": 30.0}},

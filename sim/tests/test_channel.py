@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from fmt import channel as ch
-from fmt import params, pn, receiver
+from fmt import params, pn_gen, rx_array
 from fmt import scene as S
 from fmt.sensor import TONE_LSB
 
@@ -42,16 +42,16 @@ def test_onset_on_exact_sample():
 def test_scale_and_unit_cell():
     cfg = params.MEDIUM
     sc = _finger(cfg)
-    hm = receiver.receive(ch.adc_streams(sc).adc, cfg)
+    hm = rx_array.receive(ch.adc_streams(sc).adc, cfg)
     r, c = cfg.rows // 2, cfg.cols // 2
-    expect = receiver.unit_cell_counts(cfg) * (1 + 1 / 32)
-    assert receiver.unit_cell_counts(cfg) == TONE_LSB * 32
+    expect = rx_array.unit_cell_counts(cfg) * (1 + 1 / 32)
+    assert rx_array.unit_cell_counts(cfg) == TONE_LSB * 32
     assert np.abs(hm[:, r, c] - expect).max() < 32      # ADC rounding bound, see test_chain
 
 
 def test_pn_stream_matches_pn_model():
     for chip, d in ((1, 0), (3, 5), (7, 40)):
-        tx, rx = pn.pn_signs(5000, chip_len=chip, rx_delay=d)
+        tx, rx = pn_gen.pn_signs(5000, chip_len=chip, rx_delay=d)
         assert np.array_equal(ch.pn_stream(0, 5000, chip, True, 0), tx)
         assert np.array_equal(ch.pn_stream(0, 5000, chip, True, d), rx)
         assert np.array_equal(ch.pn_stream(1000, 5000, chip, True, d), rx[1000:])
@@ -68,14 +68,14 @@ def test_pn_on_equals_off_when_matched():
     for on in (False, True):
         sc = S.Scene(effects={"delay_samples": 9, "pn": {"enable": on, "chip_len": 2}}, **base)
         r = ch.adc_streams(sc)
-        hm[on] = receiver.receive(r.adc, cfg, r.rx_sign)
+        hm[on] = rx_array.receive(r.adc, cfg, r.rx_sign)
         assert r.clipped == 0
     assert np.array_equal(hm[True], hm[False])
     # misaligned receive delay (hard case): chip_len 2 and one sample off halves the
     # correlation on average; with chip_len 1 the signal is destroyed
     sc = S.Scene(effects={"delay_samples": 9, "pn": {"enable": True, "chip_len": 1, "rx_delay": 10}}, **base)
     r = ch.adc_streams(sc)
-    bad = receiver.receive(r.adc, cfg, r.rx_sign)
+    bad = rx_array.receive(r.adc, cfg, r.rx_sign)
     assert bad[-1].max() < 0.25 * hm[True][-1].max()
 
 
@@ -88,7 +88,7 @@ def pn_rejection_db(cfg, chip_len, frames=64, bin_offset=0.0):
                      effects={"baseline": 0.0, "interferer": {"bin": k, "amp_lsb": 300.0},
                               "pn": {"enable": on, "chip_len": chip_len}})
         r = ch.adc_streams(sc)
-        out[on] = receiver.receive(r.adc, cfg, r.rx_sign)[:, cfg.rows // 2, :].mean()
+        out[on] = rx_array.receive(r.adc, cfg, r.rx_sign)[:, cfg.rows // 2, :].mean()
     return 20 * np.log10(out[True] / out[False])
 
 
@@ -125,7 +125,7 @@ def test_enob_and_dc():
     d = ch.adc_streams(_finger(cfg, dc_lsb=100.0)).adc
     assert np.array_equal(d.astype(int) - a, np.full(a.shape, 100))
     # DC never reaches a comb bin
-    assert np.allclose(receiver.receive(d, cfg), receiver.receive(a, cfg), atol=1e-9)
+    assert np.allclose(rx_array.receive(d, cfg), rx_array.receive(a, cfg), atol=1e-9)
 
 
 def test_chunking_does_not_change_the_stream():
@@ -139,8 +139,8 @@ def _snr_db(cfg, m, frames):
     r, c = cfg.rows // 2, cfg.cols // 2
     sc = S.Scene(sensor=cfg.name, frames=frames, m=m, seed=5, effects={"noise": {"snr_db": 30.0}},
                  contacts=[{"path": [[0, c * cfg.pitch_mm, r * cfg.pitch_mm]]}])
-    hm = receiver.receive(ch.adc_streams(sc).adc, cfg, m=m)
-    clean = receiver.unit_cell_counts(cfg) * ch.finger_peak_coupling(cfg)
+    hm = rx_array.receive(ch.adc_streams(sc).adc, cfg, m=m)
+    clean = rx_array.unit_cell_counts(cfg) * ch.finger_peak_coupling(cfg)
     # the peak cell and its 4 neighbours (all >> noise): the same in-phase noise RMS
     cells = [(r, c), (r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)]
     noise = np.concatenate([hm[:, i, j] - hm[:, i, j].mean() for i, j in cells])
@@ -183,3 +183,17 @@ def test_other_sensor_build():
     assert ch.adc_streams(strip).adc.max() == 2047
     assert ch.adc_streams(strip, cfg14).adc.max() > 2047
     assert strip.with_cfg(cfg14).replace(frames=2).cfg is cfg14
+
+
+
+def test_channel_sim_fixed_hand_values():
+    # 2 rows, 1 column; G = 0.5 and 0.25 (16 fractional bits); noise 0.5 LSB (4 frac bits)
+    dac = np.array([[3, 2], [3, 2], [2047, 2047], [-5, 1]])
+    g0 = np.array([[1 << 15], [1 << 14]])
+    g1 = np.array([[(1 << 16) - 1], [(1 << 16) - 1]])
+    noise = np.array([[8], [-8]])
+    adc, clip = ch.channel_sim_fixed(dac, g0, [(2, g1)], noise, adc_bits=12)
+    # s0: 1.5 + 0.5 + 0.5 = 2.5 -> 3 (half up); s1: 2.0 - 0.5 = 1.5 -> 2
+    # s2: ~4094 -> clipped to 2047; s3: (-5 + 1)*(1 - 2^-16) - 0.5 = -4.49994 -> -4
+    assert adc[:, 0].tolist() == [3, 2, 2047, -4]
+    assert clip.tolist() == [False, False, True, False]

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from fmt import params
-from fmt.flatten import GAIN_ONE, GAIN_MAX, calibrate, flatten, flatten_fixed, identity
+from fmt.flatten import GAIN_ONE, GAIN_MAX, calibrate, flatten_float, flatten_fixed, identity
 
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.DEFAULT], ids=lambda c: c.name)
@@ -14,7 +14,7 @@ def test_fixed_vs_float_bound(cfg):
     off = rng.integers(0, 4000, size=(cfg.rows, cfg.cols))
     gain = rng.integers(0, GAIN_MAX + 1, size=(cfg.rows, cfg.cols))
     q, sat = flatten_fixed(hm, off, gain, cfg)
-    f = flatten(hm, off, gain, cfg)
+    f = flatten_float(hm, off, gain, cfg)
     assert q.min() >= 0 and q.max() <= top
     ok = ~sat
     assert np.abs(q[ok] - f[ok]).max() <= 0.5          # round half up: at most 1/2 LSB

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from fmt import params
-from fmt.localmax import maxima_mask, local_maxima, offsets
+from fmt.localmax import maxima_mask, local_maxima_fixed, offsets
 
 
 def brute_force(z, thr, nb):
@@ -93,7 +93,7 @@ def test_edges_corners_spike_saturation_threshold():
         z[p] = 1000 + i
     z[3, 0] = 65535                 # saturated edge cell
     z[4, 5] = 999                   # exactly at the threshold below
-    cands, n, ov = local_maxima(z, 999, "moore", 16)
+    cands, n, ov = local_maxima_fixed(z, 999, "moore", 16)
     got = [(c.row, c.col) for c in cands]
     assert got == [(3, 0), (7, 9), (7, 0), (0, 9), (0, 0), (4, 5)]
     assert n == 6 and not ov
@@ -101,12 +101,12 @@ def test_edges_corners_spike_saturation_threshold():
     assert c.missing == 0b001001001 and c.z3[1, 1] == 65535 and c.z3[:, 0].tolist() == [0, 0, 0]
     c00 = [c for c in cands if (c.row, c.col) == (0, 0)][0]
     assert c00.missing == 0b001001111
-    assert local_maxima(z, 1000, "moore", 16)[1] == 5        # 999 is below threshold 1000
+    assert local_maxima_fixed(z, 1000, "moore", 16)[1] == 5        # 999 is below threshold 1000
     # a spike next to a 2-cell plateau on the other neighbourhood
     z2 = np.zeros((5, 5), dtype=np.int64)
     z2[1, 1] = z2[1, 2] = 300
     z2[3, 3] = 301
-    cands, n, _ = local_maxima(z2, 1, "vn", 16)
+    cands, n, _ = local_maxima_fixed(z2, 1, "vn", 16)
     assert [(c.row, c.col) for c in cands] == [(3, 3), (1, 1)]
 
 
@@ -118,7 +118,7 @@ def test_contact_limit_17_of_16():
     vals[5] = vals[6] = 700            # a tie in strength: raster order decides
     for p, v in zip(pos, vals):
         z[p] = v
-    cands, n, ov = local_maxima(z, 100, "moore", 16)
+    cands, n, ov = local_maxima_fixed(z, 100, "moore", 16)
     assert n == 17 and ov and len(cands) == 16
     weakest = pos[int(np.argmin(vals))]
     assert weakest not in [(c.row, c.col) for c in cands]
@@ -126,14 +126,14 @@ def test_contact_limit_17_of_16():
     assert zs == sorted(zs, reverse=True)
     i5 = [(c.row, c.col) for c in cands].index(pos[5])
     assert [(c.row, c.col) for c in cands][i5 + 1] == pos[6]
-    cands, n, ov = local_maxima(z, 100, "moore", 17)
+    cands, n, ov = local_maxima_fixed(z, 100, "moore", 17)
     assert n == 17 and not ov and len(cands) == 17
-    assert local_maxima(z, 100, "moore", 0)[0] == []
+    assert local_maxima_fixed(z, 100, "moore", 0)[0] == []
 
 
 def test_packed_z():
     z = np.arange(1, 10).reshape(3, 3)
-    cands, _, _ = local_maxima(z, 0, "moore", 4)
+    cands, _, _ = local_maxima_fixed(z, 0, "moore", 4)
     c = cands[0]
     assert (c.row, c.col) == (2, 2)
     w = c.packed_z(16)

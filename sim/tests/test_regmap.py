@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from fmt import params, regmap
 from fmt.settings import TouchSettings
-from fmt.tracking import TrackParams
+from fmt.tracker import TrackParams
 
 
 def test_generated_files_fresh():

@@ -1,13 +1,13 @@
 """make report (fmt.report): the smoke sweep writes its files with plausible numbers, and the
 cheap path it measures on (render_heatmaps + the receive chain's quantisation) has the
-noise statistics of the full path (ADC -> rx_fixed.rx_heatmaps_fixed)."""
+noise statistics of the full path (ADC -> rx_array.rx_heatmaps_fixed)."""
 import json
 import math
 
 import numpy as np
 import pytest
 
-from fmt import channel, params, report, rx_fixed, sensor
+from fmt import channel, params, report, rx_array, sensor
 from fmt import scene as S
 
 
@@ -40,7 +40,7 @@ def test_render_path_noise_matches_adc_path():
                  effects={"noise": {"snr_db": 30.0}, "pn": {"enable": True, "chip_len": 1}})
     a = channel.adc_streams(sc)
     assert a.clipped == 0
-    hm_a, _, flags = rx_fixed.rx_heatmaps_fixed(a.adc, a.rx_sign, cfg, 1)
+    hm_a, _, flags = rx_array.rx_heatmaps_fixed(a.adc, a.rx_sign, cfg, 1)
     assert not flags.any
     hm_r, sat = report.quantise(report.window_cells(sc), m, cfg.hm_width)
     assert not sat

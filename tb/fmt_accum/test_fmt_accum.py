@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/ref/fmt_accum.v against accum_fixed (sim/fmt/rx_fixed.py).
+"""cocotb testbench of rtl/ref/fmt_accum.v against accum_fixed (sim/fmt/rx_array.py).
 
 Windows of per-row magnitudes (rows in a shuffled order, as the pair split emits them)
 for M = 1, 2, 4, 8: the emitted cells are bit-exact (round half up, HM_SHIFT), only on
@@ -74,7 +74,7 @@ class TB(ClockedTB):
 
 
 def model(mags, m_log2, hm_w, hm_shift):
-    from fmt.rx_fixed import accum_fixed
+    from fmt.rx_array import accum_fixed
     return accum_fixed(mags, m_log2, hm_w, hm_shift)
 
 

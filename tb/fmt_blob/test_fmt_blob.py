@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_blob.v against sim/fmt/blobs.py (blob_stream_fixed).
+"""cocotb testbench of rtl/fmt_blob.v against sim/fmt/blob.py (blob_stream_fixed).
 
 Every frame's blob stream (area, Q8.8 centroid, bounding box, peak and peak cell, in
 the model's order: area descending, ties by the raster index of the first cell) and its
@@ -32,7 +32,7 @@ from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt.blobs import blob_mask_fixed, blob_stream_fixed, label_regions
+from fmt.blob import blob_mask_fixed, blob_stream_fixed, label_regions
 
 MAX_BLOBS = 8
 QMAX = 40                     # mask queries per frame when frames come back to back

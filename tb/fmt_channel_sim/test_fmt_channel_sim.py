@@ -1,5 +1,5 @@
 """cocotb testbench of the simulation-only channel bench/core/fmt_channel_sim.v
-against its twin sim/fmt/dds.py channel_sim_fixed.
+against its twin sim/fmt/channel.py channel_sim_fixed.
 
 Random row words and a random ce pattern; the coupling matrix is loaded through the
 update port and replaced twice during the run by updates stamped with the sample at
@@ -20,7 +20,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.runner import BUILD, run_cocotb
 from common.tb_util import ClockedTB, env_int, env_str
-from fmt import dds, params
+from fmt import channel, params
 from fmt_dds_bank.dds_driver import skip_extra_verilator_build
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -113,7 +113,7 @@ async def bit_exact_with_stamped_updates(dut):
     for _ in range(30):
         await step()
 
-    adc, clip = dds.channel_sim_fixed(np.array(dacs), g0, updates, tb.noise, adc_bits=cfg.adc_bits,
+    adc, clip = channel.channel_sim_fixed(np.array(dacs), g0, updates, tb.noise, adc_bits=cfg.adc_bits,
                                       coup_frac=COUP_FRAC, noise_frac=NOISE_FRAC)
     obs = np.array(obs)
     assert idx == list(range(len(idx))), "sample index"
@@ -133,7 +133,7 @@ def test_fmt_channel_sim(sim, cfg):
     noise = np.clip(np.rint(rng.normal(0, 3 * (1 << NOISE_FRAC), size=(NOISE_LEN, cfg.cols))),
                     -(1 << (NOISE_BITS - 1)), (1 << (NOISE_BITS - 1)) - 1).astype(np.int64)
     hexf, npyf = out / f"{cfg.name}.hex", out / f"{cfg.name}.npy"
-    dds.write_noise_hex(hexf, noise, NOISE_BITS)
+    channel.write_noise_hex(hexf, noise, NOISE_BITS)
     np.save(npyf, noise)
     p = cfg.verilog_params()
     run_cocotb(

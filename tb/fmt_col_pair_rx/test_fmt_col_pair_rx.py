@@ -23,7 +23,7 @@ from common.runner import run_cocotb, sources            # noqa: E402
 from common.sources import rom_define                     # noqa: E402
 from common.tb_util import ClockedTB, env_str             # noqa: E402
 from fmt import params                                    # noqa: E402
-from fmt import rx_fixed as R                             # noqa: E402
+from fmt import rx_array as R                             # noqa: E402
 import rx_stim                                            # noqa: E402
 
 

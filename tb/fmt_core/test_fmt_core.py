@@ -1,6 +1,6 @@
 """Tests of rtl/fmt_core.v through the simulation top of the ``make sim`` bench
 (bench/core/fmt_core_sim_top.v: fmt_core + fmt_channel_sim + coupling-update player +
-loggers) against the fixed-point models (bench/core/run_sim_rtl.py: fmt_tx_fixed ->
+loggers) against the fixed-point models (bench/core/run_sim_rtl.py: tx_fixed ->
 channel twin -> rx_heatmaps_fixed -> touch.process_frames(fixed=True)).
 
 The cocotb side is the bench's engine ``run_scene`` (bench/core/core_cocotb.py: the

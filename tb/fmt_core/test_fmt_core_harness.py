@@ -4,7 +4,7 @@ run_harness) on the small sensor (4 x 6, N = 64): a finger, a drag that starts
 mid-window and a tap that lands and lifts inside windows, CLK_PER_SAMPLE 3.
 
 Checks: the harness's channel in C++ feeds the core so that heat maps and events are
-bit-exact with the fixed-point model (fmt_tx_fixed -> channel twin -> rx_heatmaps_fixed
+bit-exact with the fixed-point model (tx_fixed -> channel twin -> rx_heatmaps_fixed
 -> touch.process_frames), every coupling update lands on its stamp (none late, all
 applied), no frame dropped, the latency counters read over the bus equal the cycles
 measured from the logs, and the scene gives new, move and lift events.  The same scene

@@ -1,6 +1,6 @@
 """Tests of bench/core/run_sim_rtl.py (``make sim`` through the RTL).
 
-Model side: the int64 channel twin equals ``dds.channel_sim_fixed`` (the bit-exact twin
+Model side: the int64 channel twin equals ``channel.channel_sim_fixed`` (the bit-exact twin
 of fmt_channel_sim) on a stream with stamped updates and noise; the coupling plan
 leaves every update enough clk cycles to load; the player records encode the plan.
 RTL smoke (short version for ``make test``): a few frames of the small scene through
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from bench.core import run_sim_rtl as rsr
-from fmt import dds, params
+from fmt import channel, params
 from fmt import scene as _scene
 
 
@@ -28,7 +28,7 @@ def test_channel_fixed_equals_channel_sim_fixed():
     ups = [(37, rng.integers(0, 1 << 16, size=(cfg.rows, cfg.cols))),
            (200, rng.integers(0, 1 << 16, size=(cfg.rows, cfg.cols)))]
     noise = rng.integers(-3000, 3000, size=(64, cfg.cols))
-    a, clip_a = dds.channel_sim_fixed(dac, g0, ups, noise, adc_bits=12)
+    a, clip_a = channel.channel_sim_fixed(dac, g0, ups, noise, adc_bits=12)
     b, clip_b = rsr.channel_fixed(dac, g0, ups, noise, 12)
     assert np.array_equal(a, b)
     assert int(clip_a.sum()) == clip_b and clip_b > 0

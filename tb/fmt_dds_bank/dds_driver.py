@@ -14,7 +14,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.runner import rom_define, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
-from fmt import dds, params
+from fmt import dds_bank, params
 
 LATENCY = 2     # the word of sample k is on dac_o after ce edge k + LATENCY
 
@@ -25,7 +25,7 @@ class TB(ClockedTB):
         self.cfg = params.get(env_str("CFG", "small"))
         self.sine_bits = env_int("SINE_BITS", self.cfg.sine_bits)
         self.dac_bits = env_int("DAC_BITS", self.cfg.dac_bits)
-        self.table_addr = env_int("TABLE_ADDR", dds.TABLE_ADDR)
+        self.table_addr = env_int("TABLE_ADDR", dds_bank.TABLE_ADDR)
         self.rows = self.cfg.rows
         self.rpe = env_int("RPE", 1)       # ROWS_PER_ENGINE
         self.row_w = max(1, (self.rows - 1).bit_length())
@@ -39,7 +39,7 @@ class TB(ClockedTB):
         self.defaults()
 
     def defaults(self):
-        tw, amp, en = dds.default_settings(self.cfg)
+        tw, amp, en = dds_bank.default_settings(self.cfg)
         self.tw, self.amp, self.en = tw.copy(), amp.copy(), en.copy()
 
     def words(self) -> np.ndarray:
@@ -49,7 +49,7 @@ class TB(ClockedTB):
         return np.where(w >= 1 << (d - 1), w - (1 << d), w)
 
     def model(self, n, tw, amp, en, sign):
-        return dds.dds_bank_fixed(n, tuning=tw, amp=amp, enable=en, tx_sign=sign, cfg=self.cfg,
+        return dds_bank.dds_bank_fixed(n, tuning=tw, amp=amp, enable=en, tx_sign=sign, cfg=self.cfg,
                                   table_addr=self.table_addr, sine_bits=self.sine_bits,
                                   dac_bits=self.dac_bits)
 
@@ -196,7 +196,7 @@ def run(sim, cfg, sine_bits=None, dac_bits=None, testcase=None, rpe=1):
     dac_bits = cfg.dac_bits if dac_bits is None else dac_bits
     p = cfg.verilog_params()
     parameters = {k: p[k] for k in ("ROWS", "LOG2_N", "BIN_LO", "BIN_STEP", "PHASE_BITS", "AMP_BITS")}
-    parameters.update(SINE_BITS=sine_bits, DAC_BITS=dac_bits, TABLE_ADDR=dds.TABLE_ADDR,
+    parameters.update(SINE_BITS=sine_bits, DAC_BITS=dac_bits, TABLE_ADDR=dds_bank.TABLE_ADDR,
                       ROWS_PER_ENGINE=rpe)
     run_cocotb(
         sim=sim,
@@ -206,7 +206,7 @@ def run(sim, cfg, sine_bits=None, dac_bits=None, testcase=None, rpe=1):
         test_dir=Path(__file__).parent,
         parameters=parameters,
         extra_env={"CFG": cfg.name, "SINE_BITS": sine_bits, "DAC_BITS": dac_bits,
-                   "TABLE_ADDR": dds.TABLE_ADDR, "RPE": rpe},
+                   "TABLE_ADDR": dds_bank.TABLE_ADDR, "RPE": rpe},
         build_args=build_args(sim),
         testcase=testcase,
     )

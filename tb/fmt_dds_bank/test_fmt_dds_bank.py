@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_dds_bank.v against its twin sim/fmt/dds.py.
+"""cocotb testbench of rtl/fmt_dds_bank.v against its twin sim/fmt/dds_bank.py.
 
 Checks, under both simulators, for ROWS_PER_ENGINE R = 1 (one engine per row, a random
 ce pattern) and R = 3 (time-multiplexed engines, ce every third clk at a random phase):
@@ -36,7 +36,7 @@ import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.tb_util import env_int
-from fmt import dds, params
+from fmt import dds_bank, params
 from fmt_dds_bank.dds_driver import LATENCY, TB, run, skip_extra_verilator_build
 
 @cocotb.test()
@@ -129,14 +129,14 @@ async def exact_comb_and_purity(dut):
     words = res[4][LATENCY:LATENCY + n_win * N]
     for w in range(1, n_win):
         assert np.array_equal(words[w * N:(w + 1) * N], words[:N]), f"window {w} differs from window 0"
-    flt = dds.dds_bank_float(n_win * N, cfg=tb.cfg, sine_bits=tb.sine_bits, dac_bits=tb.dac_bits)
+    flt = dds_bank.dds_bank_float(n_win * N, cfg=tb.cfg, sine_bits=tb.sine_bits, dac_bits=tb.dac_bits)
     err = np.abs(words - flt).max()
-    bound = dds.error_bound(tb.cfg, tb.table_addr, True, tb.sine_bits, tb.dac_bits)
+    bound = dds_bank.error_bound(tb.cfg, tb.table_addr, True, tb.sine_bits, tb.dac_bits)
     assert err <= bound, f"|rtl - float| = {err} > {bound}"
     # purity of the RTL words
     B = min(tb.sine_bits, tb.dac_bits)
-    row_spur = max(dds.worst_spur_dbc(words[:N, r], [tb.cfg.bins[r]])[0] for r in range(tb.rows))
-    comb_spur, k = dds.worst_spur_dbc(words[:N].sum(axis=1), tb.cfg.bins)
+    row_spur = max(dds_bank.worst_spur_dbc(words[:N, r], [tb.cfg.bins[r]])[0] for r in range(tb.rows))
+    comb_spur, k = dds_bank.worst_spur_dbc(words[:N].sum(axis=1), tb.cfg.bins)
     row_bound = -6.0 * B
     comb_bound = row_bound + 10 * math.log10(tb.rows)
     dut._log.info("rows %d SINE_BITS %d DAC_BITS %d: worst row spur %.1f dBc (bound %.1f), "

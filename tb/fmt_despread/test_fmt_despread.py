@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_despread.v against sim/fmt/dds.py despread_fixed.
+"""cocotb testbench of rtl/fmt_despread.v against sim/fmt/dds_bank.py despread_fixed.
 
 Checks, under both simulators (ADC_BITS 12; ADC_BITS 7 under Icarus, Verilator too
 with FMT_DDS_FULL=1): the extreme -2^(B-1) x -1 =
@@ -18,7 +18,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.dds import despread_fixed
+from fmt.dds_bank import despread_fixed
 from fmt_dds_bank.dds_driver import skip_extra_verilator_build
 
 

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_event_port.v against its cycle twin sim/fmt/events.py.
+"""cocotb testbench of rtl/fmt_event_port.v against its cycle twin sim/fmt/event_port.py.
 
 Every handshake (cycle, all fields, ev_time, ev_last) and the final drop / skip
 counters must equal the model's, for: dial delays 0, 1, 37, large and the loss-free
@@ -18,8 +18,8 @@ from cocotb.triggers import FallingEdge, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.events import FIXED_LATENCY, PortParams, frames_to_beats, run_port
-from fmt.tracking import EV_TYPES, TouchEvent
+from fmt.event_port import FIXED_LATENCY, PortParams, frames_to_beats, run_port
+from fmt.tracker import EV_TYPES, TouchEvent
 
 FIELDS = ("ev_frame_o", "ev_time_o", "ev_id_o", "ev_type_o", "ev_x_o", "ev_y_o",
           "ev_strength_o", "ev_axis_major_o", "ev_axis_minor_o", "ev_angle_o",

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_fft_r22sdf.v against its twin sim/fmt/fft_fixed.py.
+"""cocotb testbench of rtl/fmt_fft_r22sdf.v against its twin sim/fmt/fft_r22sdf.py.
 
 Every test streams whole windows back to back, collects the outputs (out_valid_o) and
 checks them bit for bit against ``fft_fixed_slots`` (slot order), together with
@@ -24,7 +24,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int, env_str
-from fmt import fft_fixed as F
+from fmt import fft_r22sdf as F
 from fmt import params
 
 

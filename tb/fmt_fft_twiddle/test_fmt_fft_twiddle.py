@@ -20,7 +20,7 @@ from cocotb.triggers import ReadOnly
 from common.runner import run_cocotb, sources
 from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int
-from fmt import fft_fixed as F
+from fmt import fft_r22sdf as F
 
 
 class TB(ClockedTB):

@@ -2,7 +2,7 @@
 
 Every frame's candidate stream (row, col, 3x3 neighbourhood, missing mask, order), its
 end-of-frame record (count, found, overflow) and frame number must equal the model's
-``local_maxima(hm, threshold, neighbourhood, limit)``.  Covered: random heat maps with
+``local_maxima_fixed(hm, threshold, neighbourhood, limit)``.  Covered: random heat maps with
 many ties, random row orders, beats on consecutive cycles and with gaps, back-to-back
 frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges and
 corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
@@ -17,13 +17,14 @@ from pathlib import Path
 import cocotb
 import numpy as np
 import pytest
-from cocotb.triggers import ReadOnly, RisingEdge
+from cocotb.triggers import RisingEdge
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import run_cocotb, sources
+from common.streams import StreamMonitor
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt.localmax import local_maxima, maxima_mask
+from fmt.localmax import local_maxima_fixed, maxima_mask
 
 
 class TB(ClockedTB):
@@ -33,18 +34,27 @@ class TB(ClockedTB):
         self.w = self.cfg.hm_width
         self.rows, self.cols = self.cfg.rows, self.cfg.cols
         self.k = env_int("MAX_TOUCHES", self.cfg.max_touches)
-        self.cycle = 0
         self.frames = []           # records from the candidate stream
-        self.cur = []
         self.set(threshold=1, moore=True, limit=self.k)
         for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i"):
             getattr(dut, s).value = 0
         self.mon = None
 
+    CAND_FIELDS = ("row", "col", "z", "missing", "frame")
+    EOF_FIELDS = ("frame", "count", "found", "overflow", "incomplete")
+
     async def reset(self, cycles: int = 4):
         await super().reset(cycles)
         if self.mon is None:                 # outputs are defined from the first reset on
-            self.mon = cocotb.start_soon(self.monitor())
+            # cocotb-bus BusMonitor of the candidate stream (tb/common/streams.py)
+            self.mon = StreamMonitor(self.dut, "cand", self.clk, self.CAND_FIELDS, eof="eof",
+                                     eof_fields=self.EOF_FIELDS, reset=self.rst,
+                                     callback=self._frame)
+
+    @property
+    def cycle(self) -> int:
+        """Monitor cycle number (edges since the monitor started)."""
+        return self.mon.cycle if self.mon is not None else 0
 
     def set(self, threshold, moore, limit):
         # limits above MAX_TOUCHES act as MAX_TOUCHES (the list length)
@@ -53,27 +63,9 @@ class TB(ClockedTB):
         self.dut.moore_i.value = int(moore)
         self.dut.limit_i.value = limit
 
-    async def monitor(self):
-        d = self.dut
-        while True:
-            await RisingEdge(self.clk)
-            await ReadOnly()
-            self.cycle += 1
-            if int(d.rst.value):
-                self.cur = []
-                continue
-            if int(d.cand_valid_o.value):
-                self.cur.append((int(d.cand_row_o.value), int(d.cand_col_o.value),
-                                 int(d.cand_z_o.value), int(d.cand_missing_o.value),
-                                 int(d.cand_frame_o.value), self.cycle))
-            if int(d.cand_eof_o.value):
-                self.frames.append(dict(cands=self.cur, frame=int(d.cand_frame_o.value),
-                                        count=int(d.cand_count_o.value),
-                                        found=int(d.cand_found_o.value),
-                                        overflow=int(d.cand_overflow_o.value),
-                                        incomplete=int(d.cand_incomplete_o.value),
-                                        cycle=self.cycle))
-                self.cur = []
+    def _frame(self, rec):
+        self.frames.append(dict(cands=[b.tuple(self.CAND_FIELDS) + (b.cycle,) for b in rec.beats],
+                                cycle=rec.cycle, **rec.eof))
 
     def pack(self, row) -> int:
         return pack_row(row, self.w)
@@ -103,7 +95,7 @@ class TB(ClockedTB):
         raise AssertionError(f"only {len(self.frames)} of {n_frames} frames came out")
 
     def expect(self, rec, hm, frame):
-        cands, n_found, overflow = local_maxima(hm, self.thr, self.nb, self.limit)
+        cands, n_found, overflow = local_maxima_fixed(hm, self.thr, self.nb, self.limit)
         want = [(c.row, c.col, c.packed_z(self.w), c.missing) for c in cands]
         got = [x[:4] for x in rec["cands"]]
         assert got == want, f"frame {frame}: got {got[:4]}.. want {want[:4]}.. (thr {self.thr} {self.nb})"

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_magnitude.v against magnitude_fixed (sim/fmt/rx_fixed.py).
+"""cocotb testbench of rtl/fmt_magnitude.v against magnitude_fixed (sim/fmt/rx_array.py).
 
 Bit-exact magnitudes for random full-scale inputs, the extremes (-2^(W-1) on both axes,
 axes, zero), the tag and valid path, ce gating (random ce pattern: the pipeline only
@@ -17,7 +17,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
-from fmt import rx_fixed as R
+from fmt import rx_array as R
 
 
 class TB(ClockedTB):

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_pair_split.v against pair_split_fixed (sim/fmt/rx_fixed.py).
+"""cocotb testbench of rtl/fmt_pair_split.v against pair_split_fixed (sim/fmt/rx_array.py).
 
 Random FFT outputs (full W-bit range, extremes included) stream in bit-reversed bin order
 as fmt_fft_r22sdf emits them, one bin per ce: every row's (2A, 2B) is bit-exact, comes
@@ -19,7 +19,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt import rx_fixed as R
+from fmt import rx_array as R
 
 
 class TB(ClockedTB):

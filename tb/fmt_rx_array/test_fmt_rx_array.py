@@ -1,5 +1,5 @@
 """cocotb testbench of rtl/fmt_rx_array.v (the whole receive back end: COLS/2 column-pair
-receivers) against rx_heatmaps_fixed (sim/fmt/rx_fixed.py).
+receivers) against rx_heatmaps_fixed (sim/fmt/rx_array.py).
 
 Checks: heat maps bit-exact for touch-like stirred tones with random PN settings (on/off,
 chip length, delay) and M = 1, 2, 3, 5 windows per frame (any M: the exact reciprocal
@@ -29,8 +29,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from common.runner import ROOT, run_cocotb, sources      # noqa: E402
 from common.tb_util import env_int, env_str               # noqa: E402
-from fmt import fft_fixed, params                         # noqa: E402
-from fmt import rx_fixed as R                             # noqa: E402
+from fmt import fft_r22sdf, params                         # noqa: E402
+from fmt import rx_array as R                             # noqa: E402
 from fmt_rx_array.rx_driver import TB, build_args         # noqa: E402
 import rx_stim                                            # noqa: E402
 
@@ -125,7 +125,7 @@ def row_beats_formula(cfg, every=1, post_clk=1, cps=None, fft_ch=None):
     engine (rx_fixed.rx_row_beats: queued 1 step later, loaded >= 1 step after that, P
     unit input steps, MAG_ITER + 3 magnitude stages, accumulator read, sum, round, row
     register; a step is a clk with POST_CLK = 1, a ce period with POST_CLK = 0)."""
-    lat0 = fft_fixed.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
+    lat0 = fft_r22sdf.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
     return R.rx_row_beats(cfg, lat0, every, post_clk, cps, fft_ch=fft_ch)
 
 

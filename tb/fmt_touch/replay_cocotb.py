@@ -4,7 +4,7 @@ rtl/fmt_touch.v, events to JSON lines.
 Environment: CFG (sensor config), REPLAY_IN (.npy, frames x rows x cols), REPLAY_OUT
 (.jsonl), REPLAY_SETTINGS (optional JSON of fmt.settings.TouchSettings fields),
 REPLAY_FRAME_PERIOD_S (default: one window).  Rows go
-in the order the RTL receive chain emits them (rx_fixed.row_order), one frame per window
+in the order the RTL receive chain emits them (rx_array.row_order), one frame per window
 at 3 x fs (3 N clocks), identity calibration.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ import cocotb
 import numpy as np
 from cocotb.triggers import RisingEdge
 
-from fmt import flatten, rx_fixed
+from fmt import flatten, rx_array
 from fmt.settings import TouchSettings
 from fmt_touch.touch_driver import TB, group
 
@@ -30,7 +30,7 @@ class _FftOrder:
     """Stands in for the rng of TB.send: rows in the receive chain's order."""
 
     def __init__(self, cfg):
-        self.order = [int(r) for r in rx_fixed.row_order(cfg)]
+        self.order = [int(r) for r in rx_array.row_order(cfg)]
 
     def shuffle(self, rows):
         rows[:] = self.order

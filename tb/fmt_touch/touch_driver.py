@@ -14,7 +14,7 @@ from common.sources import rom_define
 from common.tb_util import ClockedTB, env_str
 from fmt import params, sensor
 from fmt.settings import TouchSettings
-from fmt.tracking import TrackParams
+from fmt.tracker import TrackParams
 
 FRAME_PERIOD_S = 1e-3          # scaled timeline for the tracking settings
 

@@ -1,4 +1,4 @@
-"""cocotb testbench of rtl/fmt_tracker.v against its twin sim/fmt/tracking.py.
+"""cocotb testbench of rtl/fmt_tracker.v against its twin sim/fmt/tracker.py.
 
 Every frame's events (id, type, x, y, strength, axes, angle, flags, ev_last, in order)
 must equal Tracker.step's, for: random touch streams (wandering fingers that appear,
@@ -6,9 +6,9 @@ vanish and flicker, random order, more than MAX_TOUCHES touches, random settings
 scripted scenarios on a scaled timeline (drumroll, merge/split, fast crossing,
 flicker, hold-off expiry, 17 touches with 16 slots), plus a reset in the middle of a
 frame.  Also measures and checks the tail latency: the frame's last event is on the
-output exactly fmt.tracking.tail_cycles cycles after the tp_eof cycle,
+output exactly fmt.tracker.tail_cycles cycles after the tp_eof cycle,
 n_events + 2 n_stale + n_noslot + 4 (n_stale = stale picks of the lazy match, counted
-by fmt.tracking.lazy_greedy on the model's candidate matrix; n_noslot = new touches
+by fmt.tracker.lazy_greedy on the model's candidate matrix; n_noslot = new touches
 dropped for want of a slot, one cycle each), and that busy_o falls h + 1 cycles after
 that (h = contacts in hold-off, updated one per cycle).  The worst case of the match (all touches ranking the
 slots alike, 120 stale picks at 16) is a test of its own.
@@ -26,7 +26,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.tracking import Touch, Tracker, TrackParams, lazy_greedy, tail_cycles
+from fmt.tracker import Touch, Tracker, TrackParams, lazy_greedy, tail_cycles
 
 
 class TB(ClockedTB):

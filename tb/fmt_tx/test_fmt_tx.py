@@ -1,5 +1,5 @@
 """cocotb testbench of rtl/fmt_tx.v (fmt_pn_gen + fmt_dds_bank) against
-sim/fmt/pn.py + sim/fmt/dds.py.
+sim/fmt/pn_gen.py + sim/fmt/dds_bank.py.
 
 Checks, under Icarus (Verilator: MEDIUM with R = 3; all variants with FMT_DDS_FULL=1),
 for ROWS_PER_ENGINE R = 1 (ce = 1) and R = 3 (ce on clk cycles 0, 3,
@@ -22,8 +22,8 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.runner import run_cocotb, sources
 from common.tb_util import env_int
-from fmt import dds, params
-from fmt.pn import MAXIMAL_TAPS, lfsr_chips
+from fmt import dds_bank, params
+from fmt.pn_gen import MAXIMAL_TAPS, lfsr_chips
 from fmt_dds_bank.dds_driver import LATENCY, TB as BankTB, build_args, skip_extra_verilator_build
 
 ALIGN_DELAY = 3   # rx_delay_i that lines rx_sign_o up with the words on dac_o
@@ -100,10 +100,10 @@ async def bit_exact_pn_and_settings(dut):
         tw, amp, en, pen, obs, rxs = await tb.run_tx(n, rng, p_toggle=0.02 if seg else 0,
                                                      p_write=0.05 if seg else 0)
         if seg == 0:
-            # reset comb, PN on: the transmit twin fmt_tx_fixed
-            ref = dds.fmt_tx_fixed(n, cfg=tb.cfg, pn_enable=True, chip_len=chip_len)
+            # reset comb, PN on: the transmit twin tx_fixed
+            ref = dds_bank.tx_fixed(n, cfg=tb.cfg, pn_enable=True, chip_len=chip_len)
             assert not obs[:LATENCY].any()
-            assert np.array_equal(obs[LATENCY:], ref[:n - LATENCY]), "fmt_tx_fixed mismatch"
+            assert np.array_equal(obs[LATENCY:], ref[:n - LATENCY]), "tx_fixed mismatch"
         n_clk = len(pen)
         # the PN generator steps on ce: tx_sign_o after ce edge k (clk edge kR) = PN enable
         # at that edge AND chip (k // chip_len); it holds between ce edges
@@ -131,7 +131,7 @@ def test_fmt_tx(sim, cfg, rpe):
     p = cfg.verilog_params()
     parameters = {k: p[k] for k in ("ROWS", "LOG2_N", "BIN_LO", "BIN_STEP", "PHASE_BITS",
                                     "AMP_BITS", "SINE_BITS", "DAC_BITS", "PN_BITS")}
-    parameters.update(TAPS=MAXIMAL_TAPS[cfg.pn_bits], TABLE_ADDR=dds.TABLE_ADDR,
+    parameters.update(TAPS=MAXIMAL_TAPS[cfg.pn_bits], TABLE_ADDR=dds_bank.TABLE_ADDR,
                       ROWS_PER_ENGINE=rpe)
     run_cocotb(
         sim=sim,

@@ -2,6 +2,10 @@
 decodes an RTL transmit pin, DIV clock cycles per bit (the RTL's own clock).
 
 Shared by the testbenches of fmt_uart, fmt_ctrl_port and fmt_fmtctl.
+
+Own code, not cocotb-bus: cocotb-bus 0.3.0 has no UART (its drivers and monitors are
+AMBA, Avalon, OPB and XGMII), and a BusMonitor over one serial pin would still need
+this bit timing (start-bit search, mid-bit sampling every DIV cycles, stop-bit check).
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fmt.pn import MAXIMAL_TAPS, lfsr_chips, pn_signs
+from fmt.pn_gen import MAXIMAL_TAPS, lfsr_chips, pn_signs
 
 
 @pytest.mark.parametrize("bits", sorted(b for b in MAXIMAL_TAPS if b <= 15))

@@ -1,4 +1,4 @@
-"""Model tests of sim/fmt/rx_fixed.py: the fixed-point receive back end against exact
+"""Model tests of sim/fmt/rx_array.py: the fixed-point receive back end against exact
 references (pair split, magnitude error bound, accumulation, row order)."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from fmt import params
-from fmt import rx_fixed as R
+from fmt import rx_array as R
 
 RTL = Path(__file__).resolve().parents[2] / "rtl"
 
@@ -332,7 +332,7 @@ def test_split_clk_step_map(fft_ch, every):
 def test_row_beats_shared_engine_default():
     """30 x 40 at 3 x fs: the shared FFT engines (FFT_CH = 3, the default) move the last
     heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (854 clk)."""
-    from fmt import fft_fixed as F
+    from fmt import fft_r22sdf as F
     cfg = params.DEFAULT
     lat0 = F.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
     one = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1, fft_ch=1).values())

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fmt import params, receiver
+from fmt import params, rx_array
 
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM, params.DEFAULT], ids=lambda c: c.name)
@@ -12,7 +12,7 @@ def test_tone_amplitude_scale(cfg):
     r = cfg.rows - 1
     A = np.array([100.0, 333.0])
     x = A[None, :] * np.cos(2 * np.pi * cfg.bins[r] * n / cfg.n_fft + 0.3)[:, None]
-    hm = receiver.receive(x, cfg)
+    hm = rx_array.receive(x, cfg)
     assert hm.shape == (3, cfg.rows, 2)
     assert np.allclose(hm[:, r, :], A * 32, rtol=1e-12)
     hm[:, r, :] = 0
@@ -24,28 +24,28 @@ def test_despread_and_accumulate():
     rng = np.random.default_rng(0)
     x = rng.normal(size=(8 * cfg.n_fft + 5, 6))
     sign = rng.integers(0, 2, size=x.shape[0]).astype(np.uint8)
-    y = receiver.despread(x, sign)
+    y = rx_array.despread_float(x, sign)
     assert np.array_equal(y, x * (1 - 2 * sign[:, None].astype(float)))
-    cells = receiver.window_cells(x, cfg, sign)
+    cells = rx_array.window_cells(x, cfg, sign)
     assert cells.shape == (8, cfg.rows, 6)               # trailing partial window dropped
-    hm = receiver.receive(x, cfg, sign, m=3)
+    hm = rx_array.receive(x, cfg, sign, m=3)
     assert hm.shape == (2, cfg.rows, 6)                  # trailing partial frame dropped
     assert np.allclose(hm[1], cells[3:6].mean(axis=0))
     # cells are scale * |DFT| of the despread window
     X = np.fft.fft(y[cfg.n_fft:2 * cfg.n_fft], axis=0)[np.asarray(cfg.bins)]
-    assert np.allclose(cells[1], receiver.hm_scale(cfg) * np.abs(X))
+    assert np.allclose(cells[1], rx_array.hm_scale(cfg) * np.abs(X))
 
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
 def test_scale_matches_fixed_receive_chain(cfg):
     # the float heat map has the fixed-point chain's scale (other block's twin, rx_fixed)
-    R = pytest.importorskip("fmt.rx_fixed")
-    pytest.importorskip("fmt.fft_fixed")
+    R = pytest.importorskip("fmt.rx_array")
+    pytest.importorskip("fmt.fft_r22sdf")
     from fmt import channel, scene
     sc = scene.Scene(sensor=cfg.name, frames=2, effects={"pn": {"enable": True}}, contacts=[
         {"path": [[0, 7.0, 6.0]]}, {"path": [[0, 21.0, 12.0]], "strength": 0.5}])
     a = channel.adc_streams(sc)
-    hf = receiver.receive(a.adc, cfg, a.rx_sign)
+    hf = rx_array.receive(a.adc, cfg, a.rx_sign)
     hx = R.rx_heatmaps_fixed(a.adc, a.rx_sign, cfg)[0]
     big = hf > 1000
     assert big.sum() >= 4

@@ -1,4 +1,4 @@
-"""Model tests of sim/fmt/fft_fixed.py (twin of rtl/fmt_fft_r22sdf.v).
+"""Model tests of sim/fmt/fft_r22sdf.py (twin of rtl/fmt_fft_r22sdf.v).
 
 The fixed-point FFT against numpy's FFT of the same integer samples (error bounds),
 the twiddle ROM files (stale = fail), the structure helpers, the no-overflow claim at
@@ -7,7 +7,7 @@ the extreme inputs, and the output rounding option.
 import numpy as np
 import pytest
 
-from fmt import fft_fixed as F
+from fmt import fft_r22sdf as F
 from fmt import params
 
 IN_W = 13

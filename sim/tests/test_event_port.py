@@ -5,8 +5,8 @@ import random
 
 import pytest
 
-from fmt.events import FIXED_LATENCY, EventPort, PortOut, PortParams, frames_to_beats, run_port
-from fmt.tracking import TouchEvent
+from fmt.event_port import FIXED_LATENCY, EventPort, PortOut, PortParams, frames_to_beats, run_port
+from fmt.tracker import TouchEvent
 
 
 def mk_frames(n_frames, rng, max_ev=6):

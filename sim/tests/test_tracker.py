@@ -10,7 +10,7 @@ import pytest
 
 from fmt import params
 from fmt.settings import TouchSettings
-from fmt.tracking import Touch, TrackParams, Tracker, track, track_fixed
+from fmt.tracker import Touch, TrackParams, Tracker, track_fixed
 
 CFG = params.DEFAULT
 FR = 1.0 / CFG.window_s          # 162.76 kHz frames
@@ -26,11 +26,7 @@ def ids_of(evs, typ=None):
 
 
 def run(frames, p):
-    return track(frames, p)
-
-
-def test_float_is_fixed():
-    assert track is track_fixed
+    return track_fixed(frames, p)
 
 
 def test_conversion_defaults():
@@ -189,24 +185,24 @@ def test_17_touches_limit_16():
     p = TrackParams(max_touches=16)
     frame = [tq(10 + 8 * (i % 6), 10 + 8 * (i // 6)) for i in range(17)]
     tr = Tracker(p)
-    out = track([frame, frame], p, tracker=tr)
+    out = track_fixed([frame, frame], p, tracker=tr)
     assert len(out[0]) == 16 and all(e.type == "new" for e in out[0])
     assert len(set(ids_of(out[0]))) == 16
     assert len(out[1]) == 16 and all(e.type == "move" for e in out[1])
     assert tr.stats.dropped_touches == 2
     # 16 live contacts + one more touch in a later frame: no slot, counted
     tr2 = Tracker(p)
-    out = track([frame[:16], frame[:17][::-1][:1] + frame[:16]], p, tracker=tr2)
+    out = track_fixed([frame[:16], frame[:17][::-1][:1] + frame[:16]], p, tracker=tr2)
     assert tr2.stats.no_slot == 0                  # 17 given -> 16 kept (first 16)
     tr3 = Tracker(p)
     f16 = frame[:16]
     extra = tq(120, 100)
-    track([f16, f16 + [extra]], p, tracker=tr3)
+    track_fixed([f16, f16 + [extra]], p, tracker=tr3)
     assert tr3.stats.dropped_touches == 1
     tr4 = Tracker(TrackParams(max_touches=4))
-    track([[tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)],
+    track_fixed([[tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)],
            [tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)]], tr4.p, tracker=tr4)
-    out = track([[tq(10, 10), tq(30, 10), tq(100, 50), tq(50, 10)]], tr4.p, tracker=tr4)
+    out = track_fixed([[tq(10, 10), tq(30, 10), tq(100, 50), tq(50, 10)]], tr4.p, tracker=tr4)
     assert tr4.stats.no_slot == 1                  # (70,10) is in hold-off, no slot for (100,50)
 
 
@@ -251,12 +247,12 @@ def test_velocity_clamp_and_prediction():
     p = TrackParams(vel_shift=4, hold_off_frames=50, max_speed_v=1 << 20)
     tr = Tracker(p)
     frames = [[Touch(1000 + 3 * k, 2000 - 2 * k)] for k in range(200)]
-    track(frames, p, tracker=tr)
+    track_fixed(frames, p, tracker=tr)
     s = next(s for s in tr.slots if s.active)
     assert abs(s.vx - (3 << p.vel_frac)) < 64 and abs(s.vy + (2 << p.vel_frac)) < 64
     p2 = TrackParams(vel_shift=4, max_speed_v=1 << p.vel_frac, hold_off_frames=50)
     tr2 = Tracker(p2)
-    track(frames, p2, tracker=tr2)
+    track_fixed(frames, p2, tracker=tr2)
     s2 = next(s for s in tr2.slots if s.active)
     assert s2.vx == 1 << p.vel_frac and s2.vy == -(1 << p.vel_frac)
 
@@ -266,24 +262,24 @@ def test_greedy_global_order_and_tiebreak():
     the first touch's nearest contact is that pair's contact."""
     p = TrackParams(max_jump_q=1000)
     tr = Tracker(p)
-    track([[Touch(1000, 1000), Touch(1400, 1000)]], p, tracker=tr)
+    track_fixed([[Touch(1000, 1000), Touch(1400, 1000)]], p, tracker=tr)
     ida, idb = tr.slot_id(0), tr.slot_id(1)
     # touch 0 at 1250 is nearer contact B (150) than A (250); touch 1 at 1390 is nearer
     # B (10): greedy global gives B <- touch 1, A <- touch 0
-    out = track([[Touch(1250, 1000), Touch(1390, 1000)]], p, tracker=tr)[0]
+    out = track_fixed([[Touch(1250, 1000), Touch(1390, 1000)]], p, tracker=tr)[0]
     got = {e.id: e.x_q for e in out}
     assert got == {ida: 1250, idb: 1390}
     assert [e.x_q for e in out] == [1390, 1250]       # match order = increasing distance
     # exact tie: equal distances -> lower touch index first, then lower slot
     tr = Tracker(p)
-    track([[Touch(1000, 1000), Touch(1200, 1000)]], p, tracker=tr)
-    out = track([[Touch(1100, 1000), Touch(1300, 1000)]], p, tracker=tr)[0]
+    track_fixed([[Touch(1000, 1000), Touch(1200, 1000)]], p, tracker=tr)
+    out = track_fixed([[Touch(1100, 1000), Touch(1300, 1000)]], p, tracker=tr)[0]
     assert [(e.id, e.x_q) for e in out] == [(tr.slot_id(0), 1100), (tr.slot_id(1), 1300)]
 
 
 def flat_greedy(dm):
     """Greedy nearest pairs by the flat argmin over the whole matrix (Tracker.step)."""
-    from fmt.tracking import NO_CAND
+    from fmt.tracker import NO_CAND
     dm = dm.copy()
     n = dm.shape[1]
     pairs = []
@@ -299,7 +295,7 @@ def flat_greedy(dm):
 def test_lazy_greedy_is_greedy(seed):
     """The RTL's lazily refreshed per-touch minima pick exactly the flat greedy pairs,
     in the same order, including ties (small distance ranges force many)."""
-    from fmt.tracking import NO_CAND, lazy_greedy
+    from fmt.tracker import NO_CAND, lazy_greedy
     rng = np.random.default_rng(seed)
     stale_seen = 0
     for _ in range(400):
@@ -316,7 +312,7 @@ def test_lazy_greedy_is_greedy(seed):
 def test_lazy_greedy_worst_case():
     """All touches ranking the slots alike: every remaining touch goes stale after each
     assignment, 15 + 14 + ... + 1 = 120 stale picks at 16 x 16."""
-    from fmt.tracking import lazy_greedy
+    from fmt.tracker import lazy_greedy
     n = 16
     dm = np.array([[100 * s + t for s in range(n)] for t in range(n)], dtype=np.int64)
     pairs, stale = lazy_greedy(dm)

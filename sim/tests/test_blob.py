@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from fmt import params
-from fmt.blobs import find_blobs, label_regions, split_touches
-from fmt.localmax import local_maxima
+from fmt.blob import find_blobs, label_regions, split_touches
+from fmt.localmax import local_maxima_fixed
 
 
 def ellipse_map(cfg, cx, cy, a, b, peak, rng=None):
@@ -39,7 +39,7 @@ def test_palm_is_one_blob_and_fingers_survive():
     z = palm.copy()
     for r, c in fingers:
         z = np.maximum(z, finger(cfg, r, c, 6000))
-    cands, n, _ = local_maxima(z, 2000, "moore", 64)
+    cands, n, _ = local_maxima_fixed(z, 2000, "moore", 64)
     assert n > len(fingers) + 1                      # the noisy palm gives a swarm of maxima
     kept, blobs = split_touches(z, cands, blob_threshold=1000, blob_min_cells=12)
     assert len(blobs) == 1
@@ -59,7 +59,7 @@ def test_sensor_rendered_palm():
     cmap = (sensor.contact_map(cfg, [(60.0, 70.0, 70.0, 1.0, 50.0, 0.3)])
             + sensor.contact_map(cfg, [(120.0, 70.0, 8.0, 1.0)]))
     z = np.rint(cmap * 10000).astype(np.int64)
-    cands, n, _ = local_maxima(z, 2000, "moore", 64)
+    cands, n, _ = local_maxima_fixed(z, 2000, "moore", 64)
     kept, blobs = split_touches(z, cands, 1000, 12)
     assert len(blobs) == 1 and blobs[0].area >= 100
     assert abs(blobs[0].cx * 5 - 60.0) < 2.5 and abs(blobs[0].cy * 5 - 70.0) < 2.5
@@ -77,7 +77,7 @@ def test_small_region_is_not_a_blob():
 def test_blob_stream_fixed_order_limit_and_bounds():
     """The RTL twin: largest first, ties by the first cell's raster index, the first
     max_blobs kept, overflow when more; centroid within 0.5 LSB of the float value."""
-    from fmt.blobs import blob_stream_fixed
+    from fmt.blob import blob_stream_fixed
     rng = np.random.default_rng(9)
     z = np.zeros((8, 10), dtype=np.int64)
     z[0, 0] = 7                                  # 1 cell, first in raster order
@@ -104,7 +104,7 @@ def test_blob_stream_fixed_order_limit_and_bounds():
 
 
 def test_blob_mask_fixed_is_union_of_blob_masks():
-    from fmt.blobs import blob_mask_fixed
+    from fmt.blob import blob_mask_fixed
     z = np.zeros((6, 8), dtype=np.int64)
     z[0, 0:3] = 10                 # 3 cells
     z[2:5, 5] = 10                 # 3 cells

@@ -198,12 +198,12 @@ def error_bound(cfg: SensorConfig = DEFAULT, table_addr: int = TABLE_ADDR, exact
     return b
 
 
-def fmt_tx_fixed(n_samples: int, cfg: SensorConfig = DEFAULT, pn_enable: bool = True,
+def tx_fixed(n_samples: int, cfg: SensorConfig = DEFAULT, pn_enable: bool = True,
                  chip_len: int = 1, **kw) -> np.ndarray:
     """Words of ``fmt_tx`` (fmt_pn_gen + fmt_dds_bank), samples 0..n-1 after reset:
     DDS sample k carries the PN sign of PN sample k-1 (the generator's registered
     output; +1 for k = 0)."""
-    from .pn import pn_signs
+    from .pn_gen import pn_signs
     tx, _ = pn_signs(max(n_samples - 1, 0), chip_len=chip_len, enable=pn_enable, bits=cfg.pn_bits)
     sign = np.concatenate([[0], tx]).astype(np.int64)[:n_samples]
     return dds_bank_fixed(n_samples, tx_sign=sign, cfg=cfg, **kw)
@@ -217,54 +217,10 @@ def despread_fixed(x, sign) -> np.ndarray:
     return np.where(np.asarray(sign) != 0, -x, x)
 
 
-def despread(x, sign) -> np.ndarray:
+def despread_float(x, sign) -> np.ndarray:
     """Float twin (the operation is exact: identical to the fixed one)."""
     x = np.asarray(x, dtype=np.float64)
     return np.where(np.asarray(sign) != 0, -x, x)
-
-
-# ---- simulation-only channel (bench/core/fmt_channel_sim.v) ------------------------
-def write_noise_hex(path, noise: np.ndarray, noise_bits: int = 16) -> None:
-    """Noise words (shape (NOISE_LEN, cols), signed noise_bits) for $readmemh,
-    row-major (sample, column)."""
-    a = np.asarray(noise, dtype=np.int64)
-    lim = 1 << (noise_bits - 1)
-    if a.min() < -lim or a.max() >= lim:
-        raise ValueError("noise word out of range")
-    digits = (noise_bits + 3) // 4
-    mask = (1 << noise_bits) - 1
-    Path(path).write_text("".join(f"{int(v) & mask:0{digits}x}\n" for v in a.ravel()))
-
-
-def channel_sim_fixed(dac: np.ndarray, g0: np.ndarray, updates=(), noise=None,
-                      adc_bits: int = 12, coup_frac: int = 16, noise_frac: int = 4):
-    """Bit-exact twin of ``fmt_channel_sim``.  ``dac``: (n, rows) row words of samples
-    0..n-1; ``g0``: (rows, cols) coupling in effect from sample 0 (unsigned integers,
-    coup_frac fractional bits); ``updates``: (stamp, G) pairs in commit order, each in
-    effect from sample ``stamp`` on (a later commit must have a later stamp);
-    ``noise``: (L, cols) signed words with noise_frac fractional bits, sample k uses
-    row k mod L.  Returns (adc (n, cols) int64, clip (n,) bool): round half up of
-    sum_r dac*G + noise, then clip to the ADC range."""
-    dac = np.asarray(dac, dtype=np.int64)
-    n = dac.shape[0]
-    g_of = np.empty(n, dtype=np.int64)
-    mats = [np.asarray(g0, dtype=np.int64)] + [np.asarray(g, dtype=np.int64) for _, g in updates]
-    g_of[:] = 0
-    for i, (stamp, _) in enumerate(updates):
-        g_of[int(stamp):] = i + 1
-    acc = np.zeros((n, mats[0].shape[1]), dtype=object)
-    for i, g in enumerate(mats):
-        sel = g_of == i
-        if sel.any():
-            acc[sel] = (dac[sel].astype(object)) @ g.astype(object)
-    if noise is not None:
-        nz = np.asarray(noise, dtype=np.int64)
-        acc = acc + (nz[np.arange(n) % nz.shape[0]].astype(object) << (coup_frac - noise_frac))
-    half = (1 << (coup_frac - 1)) if coup_frac > 0 else 0
-    y = np.array((acc + half) >> coup_frac, dtype=np.int64)
-    lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
-    clip = ((y < lo) | (y > hi)).any(axis=1)
-    return np.clip(y, lo, hi), clip
 
 
 # ---- spectral purity -------------------------------------------------------------

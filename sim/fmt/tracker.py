@@ -2,7 +2,7 @@
 
 Coordinates are integers (Q8.8 cells) and every step below is integer arithmetic, so
 the floating-point reference and the fixed-point twin are the same function
-(:func:`track` = :func:`track_fixed`).
+(:func:`track_fixed` is both).
 
 Per contact slot (``max_touches`` slots) the tracker keeps: ``active``, ``id``,
 the predicted position ``p`` (Q8.(8+VF), VF = ``vel_frac`` extra fractional bits),
@@ -337,7 +337,7 @@ def tail_cycles(events, stale: int, no_slot: int) -> int:
     return len(events) + 2 * stale + no_slot + 4
 
 
-def track(touch_frames, params: TrackParams, first_frame: int = 0, tracker: Tracker | None = None):
+def track_fixed(touch_frames, params: TrackParams, first_frame: int = 0, tracker: Tracker | None = None):
     """Track a sequence of frames.  ``touch_frames``: list (per frame) of touches, or of
     ``(frame_number, touches)`` pairs.  Returns a list (per frame) of event lists."""
     tr = tracker or Tracker(params)
@@ -350,6 +350,3 @@ def track(touch_frames, params: TrackParams, first_frame: int = 0, tracker: Trac
         out.append(tr.step(fr, ts))
     return out
 
-
-# Coordinates are integers: the reference and the RTL twin are one function.
-track_fixed = track
