@@ -118,6 +118,10 @@ module fmt_flatten #(
             wire [GAIN_W-1:0] gain_rd_q = cal_rd2_q[HM_W +: GAIN_W];
             wire we_off  = cal_we_i && (cal_col_i == c) && !cal_sel_i;
             wire we_gain = cal_we_i && (cal_col_i == c) &&  cal_sel_i;
+            // The two branches below are the same memory and differ only in the
+            // ram_style attribute: XST and Yosys read the attribute as a literal string,
+            // so it cannot come from a parameter, and one copy per style is the portable
+            // way to choose (CAL_BRAM).  Change both together.
             if (CAL_BRAM != 0) begin : g_bram
                 (* ram_style = "block" *)
                 reg [HM_W+GAIN_W-1:0] mem [0:ROWS-1];

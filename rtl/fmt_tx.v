@@ -17,6 +17,8 @@
 `default_nettype none
 `include "fmt_defaults.vh"
 
+// The parameters below repeat fmt_dds_bank's (plus PN_BITS): Verilog-2001 has no way
+// to inherit a parameter list, and each one is passed straight through to the bank.
 module fmt_tx #(
     parameter ROWS       = `FMT_ROWS,        // number of rows (tones)
     parameter LOG2_N     = `FMT_LOG2_N,      // log2 of the FFT length N
