@@ -35,7 +35,8 @@
 // simulation prints an ERROR and counts it in ce_errors; ce that stops for good is not
 // an error: the outputs hold, a reset restarts the bank).  Schedule
 // (T_k = clk edge of ce edge k): slot c of sample k is processed at edge
-// T_k + D_c, D_c = R - 1 + c: the engine reads the ring head (phase of sample k),
+// T_k + D_c, D_c = R - 1 + c (its table word was read at the edge before, see
+// fmt_dds_chan): the engine takes the ring head (phase of sample k),
 // tw/amp/en of slot c, and the PN sign delayed by D_c clk cycles (= tx_sign_i at
 // T_k); its word is ready at T_k + D_c + 2 and goes into a staging register (the last
 // slot's word is ready exactly at T_k + 2R = T_{k+2} and goes straight to dac_o), and
@@ -189,6 +190,15 @@ module fmt_dds_bank #(
     endgenerate
 
     // ---------------------------------------------------------------- engines, tables
+    // The tables are read one pipeline edge ahead of the processing edge (see
+    // fmt_dds_chan); the word of sample 0 (phase 0, table word 0) comes from the cleared
+    // output register at the first pe edge after reset.
+    reg first_q;
+    always @(posedge clk) begin
+        if (rst)     first_q <= 1'b1;
+        else if (pe) first_q <= 1'b0;
+    end
+
     wire [TABLE_ADDR-1:0]       addr_w [0:2*NPAIR-1];
     wire signed [SINE_BITS-1:0] sine_w [0:2*NPAIR-1];
 
@@ -242,6 +252,7 @@ module fmt_dds_bank #(
             ) u_rom (
                 .clk      (clk),
                 .ce       (pe),
+                .clr_i    (first_q),
                 .addr_a_i (addr_w[2*e]),
                 .addr_b_i (addr_w[2*e+1]),
                 .data_a_o (sine_w[2*e]),

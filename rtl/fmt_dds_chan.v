@@ -16,27 +16,34 @@
 // others move down one place (SLOTS = 1: an ordinary accumulator).  Reset: all 0.
 //
 // Pipeline (advances when pe_i = 1; R = 1: pe_i = ce, R > 1: every clk):
-//   edge E   (processing of slot c = slot_i): the table reads rom[ph[0] >> (PHASE_BITS
-//            - TABLE_ADDR)]; amp[c], en[c] (0 unless proc_i) and sign_i registered.
-//   edge E+1 : partial-product sums (see below).
-//   edge E+2 : res = en ? (sign ? -r : r) : 0 (combinational from the E+1 registers),
-//              written into the staging register of slot c when stg_we_i[c] = 1
-//              (c < SLOTS-1).
+//   edge E-1 : the table latches rom[phase of slot c >> (PHASE_BITS - TABLE_ADDR)],
+//            read one edge early: addr_o = ph[1] (SLOTS > 1, the ring's next slot) or
+//            ph + tw (SLOTS = 1, the phase after this edge).
+//   edge E   (processing of slot c = slot_i): the table's output register takes that
+//            word (sine_i); the Booth digit controls of amp[c] with the sign sign_i
+//            folded in, and en[c] (0 unless proc_i), are registered.
+//   edge E+1 : partial-product sums (see below), zero when en = 0.
+//   edge E+2 : res = the sum of the two halves, bits [PW-1:SH] (combinational from the
+//              E+1 registers), written into the staging register of slot c when
+//              stg_we_i[c] = 1 (c < SLOTS-1).
 // Output: at an edge with ce_i = 1, dac_o[c] <= staging[c] (c < SLOTS-1) and
 // dac_o[SLOTS-1] <= res (the last slot's word computed at that very edge), so all rows
 // of the engine change together, at ce edges only.
 //
-// Amplitude product, LUT only (no DSP48E): p = s * amp with s the SINE_BITS-bit signed
-// table word and amp the AMP_BITS-bit unsigned amplitude, by radix-4 Booth recoding of
-// amp (ND = AMP_BITS/2 + 1 digits d_j = a[2j] + a[2j-1] - 2 a[2j+1] in -2..2, a[-1] =
-// 0, zero above the MSB): p = sum_j d_j s 4^j; a negative digit contributes ~m 4^j
-// plus a 1 at bit 2j, placed in a free low bit of digit j+1's shifted term (the last
-// digit is never negative).  The terms are summed in two halves registered at edge
-// E+1 and added after it (exact: two's complement modulo 2^PW, and |p| < 2^(PW-1)).
-// No `*` operator appears, so neither XST nor Yosys can map it to a DSP48E.
-// Rounding: r = (p + 2^(SH-1)) >> SH, SH = SINE_BITS + AMP_BITS - DAC_BITS
-// (round half up; the 2^(SH-1) is folded into the low half).  The sign is applied
-// after rounding, so the words of +1 and -1 are exact negatives.
+// Amplitude product, LUT only (no DSP48E): q = s * (sign ? -amp : amp) with s the
+// SINE_BITS-bit signed table word and amp the AMP_BITS-bit unsigned amplitude, by
+// radix-4 Booth recoding of amp (ND = AMP_BITS/2 + 1 digits d_j = a[2j] + a[2j-1] -
+// 2 a[2j+1] in -2..2, a[-1] = 0, zero above the MSB), each digit's sign flipped when
+// sign = 1: q = sum_j (+-d_j) s 4^j; a negative digit contributes ~m 4^j plus a 1 at
+// bit 2j, placed in a free low bit of digit j+1's shifted term (the last digit is
+// negative only when sign = 1: its 1 goes into the rounding constant).  The terms are
+// summed in two halves registered at edge E+1 and added after it (exact: two's
+// complement modulo 2^PW, and |q| < 2^(PW-1)).  No `*` operator appears, so neither
+// XST nor Yosys can map it to a DSP48E.
+// Rounding: r = (p + 2^(SH-1)) >> SH, p = s * amp, SH = SINE_BITS + AMP_BITS -
+// DAC_BITS (round half up), and the word is sign ? -r : r; -r is computed as
+// (-p + 2^(SH-1) - 1) >> SH (= floor((~p + 2^(SH-1)) / 2^SH)), so the rounding
+// constant is 2^(SH-1) or 2^(SH-1) - 1 and the words of +1 and -1 are exact negatives.
 // Range: |s| <= 2^(SINE_BITS-1) - 1 and amp <= 2^AMP_BITS - 1 give
 // |r| <= 2^(DAC_BITS-1) - 1 when 2^(SH-1) < 2^(SINE_BITS-1) + 2^AMP_BITS - 1 (always
 // so for DAC_BITS > AMP_BITS), so -r never overflows: no saturation is needed.
@@ -148,15 +155,19 @@ module fmt_dds_chan #(
     wire [PHASE_BITS-1:0] ph_head = ph_q[PHASE_BITS-1:0];
     wire [PHASE_BITS-1:0] ph_next = ph_head + tw_s;
 
-    assign addr_o = ph_head[PHASE_BITS-1 -: TABLE_ADDR];
 
+    // The table is read one edge ahead of the processing edge (its word is registered
+    // twice: block-RAM latch and output register).  SLOTS > 1: the slot processed at
+    // the next edge sits in ph[1]; SLOTS = 1: the phase after this edge is ph + tw.
     generate
         if (SLOTS > 1) begin : g_ring
+            assign addr_o = ph_q[2*PHASE_BITS-1 -: TABLE_ADDR];
             always @(posedge clk) begin
                 if (rst)         ph_q <= {(SLOTS*PHASE_BITS){1'b0}};
                 else if (proc_i) ph_q <= {ph_next, ph_q[SLOTS*PHASE_BITS-1:PHASE_BITS]};
             end
         end else begin : g_acc
+            assign addr_o = ph_next[PHASE_BITS-1 -: TABLE_ADDR];
             always @(posedge clk) begin
                 if (rst)         ph_q <= {PHASE_BITS{1'b0}};
                 else if (proc_i) ph_q <= ph_next;
@@ -165,39 +176,41 @@ module fmt_dds_chan #(
     endgenerate
 
     // ---------------------------------------------------------------- product pipeline
-    reg [AMP_BITS-1:0]   amp1_q;
-    reg                  en1_q, sg1_q, en2_q, sg2_q;
+    // Edge E registers the Booth digit controls of (sign ? -amp : amp) (per digit: |d|
+    // = 1, |d| = 2, negative) and en; edge E+1 the two partial sums (zero when the slot
+    // is disabled); after E+1 one adder gives the rounded, signed word.
+    reg [ND-1:0]         one1_q, two1_q, neg1_q;
+    reg                  en1_q, sg1_q;
     reg signed [PW-1:0]  pp_lo_q, pp_hi_q;
     reg signed [PW-1:0]  pp_lo_d, pp_hi_d;
+    reg [ND-1:0]         one_d, two_d, neg_d;
 
     wire signed [PW-1:0] s_ext = {{AMP_BITS{sine_i[SINE_BITS-1]}}, sine_i};
-    wire [2*ND:0]        ax    = {{(2*ND - AMP_BITS){1'b0}}, amp1_q, 1'b0};  // {0.., amp, 0}
-
-    // Booth partial product of digit bits b = {a[2j+1], a[2j], a[2j-1]} without its
-    // +1: neg ? ~m : m, m = s (b = 001, 010, 101, 110), 2s (011, 100) or 0
-    function [PW-1:0] booth_pp;
-        input [PW-1:0] s;
-        input [2:0]    b;
-        reg   [PW-1:0] m;
-        begin
-            case (b)
-                3'b001, 3'b010, 3'b101, 3'b110: m = s;
-                3'b011, 3'b100:                 m = {s[PW-2:0], 1'b0};
-                default:                        m = {PW{1'b0}};
-            endcase
-            booth_pp = b[2] ? ~m : m;
-        end
-    endfunction
+    wire [2*ND:0]        ax    = {{(2*ND - AMP_BITS){1'b0}}, amp_s, 1'b0};  // {0.., amp, 0}
+    // rounding constant: +2^(SH-1) for +r; for -r = (~p + 2^(SH-1)) >> SH with the
+    // products negated digit by digit, 2^(SH-1) - 1 plus the +1 of the top digit
+    // (always "negative" then, see below)
+    localparam [PW-1:0] TOP1  = {{(PW - 1){1'b0}}, 1'b1} << (2 * (ND - 1));
+    localparam [PW-1:0] RND_P = HALF;
+    localparam [PW-1:0] RND_N = HALF - {{(PW - 1){1'b0}}, 1'b1} + TOP1;
 
     integer j;
-    reg [PW-1:0] op;
+    reg [PW-1:0] m, op;
     always @* begin
-        pp_lo_d = HALF;
+        // digit j of amp: bits b = {a[2j+1], a[2j], a[2j-1]}, d = a[2j] + a[2j-1] - 2 a[2j+1];
+        // the sign flips every digit's sign bit (a zero digit with neg = 1 gives ~0 + 1 = 0)
+        for (j = 0; j < ND; j = j + 1) begin
+            one_d[j] = ax[2*j] ^ ax[2*j+1];
+            two_d[j] = (ax[2*j+2] & ~ax[2*j+1] & ~ax[2*j]) | (~ax[2*j+2] & ax[2*j+1] & ax[2*j]);
+            neg_d[j] = ax[2*j+2] ^ sign_i;
+        end
+        pp_lo_d = sg1_q ? RND_N : RND_P;
         pp_hi_d = {PW{1'b0}};
         for (j = 0; j < ND; j = j + 1) begin
-            op = booth_pp(s_ext, ax[2*j +: 3]) << (2 * j);
-            // the +1 of digit j-1 (a[2j-1] = ax[2j]) in a free low bit (bit 2j-2)
-            if (j > 0) op = op | ({{(PW - 1){1'b0}}, ax[2*j]} << (2 * j - 2));
+            m  = one1_q[j] ? s_ext : (two1_q[j] ? {s_ext[PW-2:0], 1'b0} : {PW{1'b0}});
+            op = (neg1_q[j] ? ~m : m) << (2 * j);
+            // the +1 of digit j-1 in a free low bit (bit 2j-2) of this term
+            if (j > 0) op = op | ({{(PW - 1){1'b0}}, neg1_q[j-1]} << (2 * j - 2));
             if (j < LO_D) pp_lo_d = pp_lo_d + op;
             else          pp_hi_d = pp_hi_d + op;
         end
@@ -207,26 +220,30 @@ module fmt_dds_chan #(
     /* verilator lint_off UNUSEDSIGNAL */
     wire signed [PW-1:0]       sum_w = pp_lo_q + pp_hi_q;
     /* verilator lint_on UNUSEDSIGNAL */
-    wire signed [DAC_BITS-1:0] r_w   = sum_w[PW-1:SH];
-    wire signed [DAC_BITS-1:0] res_w = !en2_q ? {DAC_BITS{1'b0}} : (sg2_q ? -r_w : r_w);
+    wire signed [DAC_BITS-1:0] res_w = sum_w[PW-1:SH];
 
     always @(posedge clk) begin
         if (rst) begin
-            amp1_q  <= {AMP_BITS{1'b0}};
+            one1_q  <= {ND{1'b0}};
+            two1_q  <= {ND{1'b0}};
+            neg1_q  <= {ND{1'b0}};
             en1_q   <= 1'b0;
             sg1_q   <= 1'b0;
-            en2_q   <= 1'b0;
-            sg2_q   <= 1'b0;
             pp_lo_q <= {PW{1'b0}};
             pp_hi_q <= {PW{1'b0}};
         end else if (pe_i) begin
-            amp1_q  <= amp_s;
+            one1_q  <= one_d;
+            two1_q  <= two_d;
+            neg1_q  <= neg_d;
             en1_q   <= proc_i & en_s;
             sg1_q   <= sign_i;
-            pp_lo_q <= pp_lo_d;
-            pp_hi_q <= pp_hi_d;
-            en2_q   <= en1_q;
-            sg2_q   <= sg1_q;
+            if (en1_q) begin
+                pp_lo_q <= pp_lo_d;
+                pp_hi_q <= pp_hi_d;
+            end else begin
+                pp_lo_q <= {PW{1'b0}};
+                pp_hi_q <= {PW{1'b0}};
+            end
         end
     end
 

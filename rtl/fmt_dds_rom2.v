@@ -8,9 +8,10 @@
 // paths from their working directory get the folder through the macro FMT_ROM_DIR
 // (e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\"); Yosys and XST find it beside the source.
 //
-// Timing: synchronous read, one register (the block RAM's output latch), advancing
-// only when ce = 1: data_x_o holds the word of the address present at the last ce
-// edge.  Why a full-wave table and no quarter-wave folding: 1024 x 16 bit fits in
+// Timing: synchronous read with two registers (the block RAM's output latch and its
+// output register, which XST packs as DOA_REG/DOB_REG), both advancing only when
+// ce = 1: data_x_o holds the word of the address present two ce edges ago.  clr_i
+// (synchronous, at a ce edge) zeroes the output register (the block RAM's SSR).  Why a full-wave table and no quarter-wave folding: 1024 x 16 bit fits in
 // one RAMB18 either way, and folding would cost an address and a sign adder per row.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -21,10 +22,11 @@ module fmt_dds_rom2 #(
 ) (
     input  wire                         clk,
     input  wire                         ce,        // sample strobe: read only when 1
+    input  wire                         clr_i,     // zero the output registers at this ce edge
     input  wire [TABLE_ADDR-1:0]        addr_a_i,  // port A address (row 2p)
     input  wire [TABLE_ADDR-1:0]        addr_b_i,  // port B address (row 2p + 1)
-    output reg  signed [SINE_BITS-1:0]  data_a_o,  // port A word, registered
-    output reg  signed [SINE_BITS-1:0]  data_b_o   // port B word, registered
+    output reg  signed [SINE_BITS-1:0]  data_a_o,  // port A word, two registers
+    output reg  signed [SINE_BITS-1:0]  data_b_o   // port B word, two registers
 );
 
     // "fmt_sine_rom_aAA_sSS.hex" (24 characters; two decimal digits per number)
@@ -45,10 +47,24 @@ module fmt_dds_rom2 #(
 `endif
     end
 
+    reg [SINE_BITS-1:0] rd_a_q, rd_b_q;   // block-RAM output latches
+
     always @(posedge clk) begin
         if (ce) begin
-            data_a_o <= rom[addr_a_i];
-            data_b_o <= rom[addr_b_i];
+            rd_a_q <= rom[addr_a_i];
+            rd_b_q <= rom[addr_b_i];
+        end
+    end
+
+    always @(posedge clk) begin
+        if (ce) begin
+            if (clr_i) begin
+                data_a_o <= {SINE_BITS{1'b0}};
+                data_b_o <= {SINE_BITS{1'b0}};
+            end else begin
+                data_a_o <= rd_a_q;
+                data_b_o <= rd_b_q;
+            end
         end
     end
 
