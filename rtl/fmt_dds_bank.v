@@ -43,7 +43,7 @@
 // all staging registers load dac_o at T_{k+2}.  The settings bus is delayed by D_c clk
 // cycles for slot c, so a slot read at T_k + D_c sees exactly the writes made before
 // T_k, as the non-multiplexed bank does.
-// Twin: sim/fmt/dds.py dds_bank_fixed.
+// Twin: sim/fmt/dds_bank.py dds_bank_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

@@ -49,7 +49,7 @@
 // so for DAC_BITS > AMP_BITS), so -r never overflows: no saturation is needed.
 // Full amplitude (2^AMP_BITS - 1) gives a peak of (2^AMP_BITS - 1) / 2^AMP_BITS of the
 // DAC range (2040 of 2047 for 16/8/12 bits).
-// Twin: sim/fmt/dds.py dds_bank_fixed.
+// Twin: sim/fmt/dds_bank.py dds_bank_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
 

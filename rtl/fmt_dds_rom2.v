@@ -3,7 +3,7 @@
 // Full-wave table of 2^TABLE_ADDR signed SINE_BITS words, entry i =
 // round((2^(SINE_BITS-1) - 1) * sin(2*pi*i / 2^TABLE_ADDR)) (odd-symmetric, never
 // -2^(SINE_BITS-1)).  Contents come from rtl/fmt_sine_rom_aAA_sSS.hex, written by
-// `python -m fmt.dds --write-hex` (sim/tests/test_dds.py fails when it is stale).
+// `python -m fmt.generate` (`make lint` fails when it is stale).
 // The file name is built from the two parameters; simulators that resolve $readmemh
 // paths from their working directory get the folder through the macro FMT_ROM_DIR
 // (e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\"); Yosys and XST find it beside the source.
