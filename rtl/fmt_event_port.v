@@ -99,7 +99,7 @@ module fmt_event_port #(
     localparam TLSB = RW - FRAME_W - TIME_W;        // time stamp field: [TLSB +: TIME_W]
 
     // read data on a read/write collision is never used (a read is issued only for an
-    // address written in an earlier cycle): no collision logic around the block RAM
+    // address written in an earlier cycle): no collision circuit around the block RAM
     (* no_rw_check *)
     reg [RW-1:0]     mem [0:DEPTH-1];
     reg [TIME_W-1:0] now_q, nxt_q;                  // nxt_q = now_q + 1

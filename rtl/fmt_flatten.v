@@ -174,7 +174,7 @@ module fmt_flatten #(
     endgenerate
 
     // population count of the saturated cells of the output beat: stage 1 counts each
-    // group of 16 cells (4-cell counts in logic, then two levels of small adders), stage
+    // group of 16 cells (4-cell counts in LUTs, then two levels of small adders), stage
     // 2 adds the group counts, then the counter adds the total
     function [2:0] pop4;
         input [3:0] b;

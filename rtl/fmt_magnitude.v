@@ -16,7 +16,7 @@
 // 2^(GAIN_BITS-1); one 18-bit slice per product, so that each is one 18 x 18
 // multiplier on ECP5 / one DSP48E with its product registered), beside them
 // (x << (GAIN_BITS-1)) + rounding constant; P = the sum of the three, of which the
-// output keeps bits [SH +: IN_W].  No multiplier output goes through logic before a
+// output keeps bits [SH +: IN_W].  No multiplier output goes through LUTs before a
 // register.
 // Formats: re, im signed IN_W (integers); mag unsigned OUT_W = IN_W (the largest
 // magnitude, sqrt(2) * 2^(IN_W-1), is below 2^IN_W: no overflow is possible).

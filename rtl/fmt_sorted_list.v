@@ -44,7 +44,7 @@ module fmt_sorted_list #(
     parameter PAY_W       = 4,   // payload width; 0 = no payload (pay_o, drop_pay_o are one
                                  // constant 0 bit per entry); >= $clog2(K + 1) with PAY_RST_IDX
     parameter PAY_RST_IDX = 0,   // 1: rst sets payload i = i and drop_pay_o = K; 0: no reset
-    parameter HAS_POP     = 1    // 1: pop_i works; 0: pop_i is ignored (no pop logic)
+    parameter HAS_POP     = 1    // 1: pop_i works; 0: pop_i is ignored (no pop circuit)
 ) (
     input  wire               clk,
     input  wire               rst,         // synchronous, active high
