@@ -1,16 +1,29 @@
 // fmt_channel_sim -- SIMULATION-ONLY channel model for full-chain simulations: the
-// DDS bank's row words, a ROWS x COLS coupling matrix and additive noise make COLS
-// ADC samples per sample strobe.  Not synthesizable by intent (64-bit arithmetic,
-// whole-matrix copies, a file of noise); it lives in bench/core/, not rtl/.
+// DDS bank's row words, a ROWS x COLS coupling matrix and additive effects (counter-
+// based Gaussian noise, DC offset, interferers), channel delay and ENOB make COLS ADC
+// samples per sample strobe.  Not synthesizable by intent (64-bit arithmetic,
+// whole-matrix copies, tables from files); it lives in bench/core/, not rtl/.
 //
 // Sample k = k-th ce edge after reset; the row words present at that edge are sample k.
-//   acc[c] = sum_r dac[r] * G[r][c]  +  noise[(k mod NOISE_LEN)][c] << (COUP_FRAC - NOISE_FRAC)
+//   acc[c] = sum_r dac[k - delay][r] * G[r][c] + fnoise[(k mod NOISE_LEN)][c] << (COUP_FRAC - NOISE_FRAC)
+//            + noise(k, c) + dc_q + sum_i interferer_i(k)
 //   y[c]   = (acc[c] + 2^(COUP_FRAC-1)) >>> COUP_FRAC          (round half up)
-//   adc[c] = clip(y[c], -2^(ADC_BITS-1), 2^(ADC_BITS-1) - 1), clip_o = any column clipped
+//   adc[c] = clip(y[c], -2^(ADC_BITS-1), 2^(ADC_BITS-1) - 1) & ~enob_mask,
+//   clip_o = any column clipped (before the ENOB mask)
 // G[r][c] is unsigned COUP_BITS with COUP_FRAC fractional bits (in ADC LSB per DAC
-// LSB); noise words are signed NOISE_BITS with NOISE_FRAC fractional bits (ADC LSB),
-// NOISE_LEN x COLS words, row-major (sample, column), from the $readmemh file
-// NOISE_FILE (written by sim/fmt/channel.py write_noise_hex; "" = no noise).
+// LSB).  File noise (tests of this module only): signed NOISE_BITS words with
+// NOISE_FRAC fractional bits, NOISE_LEN x COLS, row-major (sample, column), from the
+// $readmemh file NOISE_FILE ("" = none).
+// Effects (CHAN_FILE, "" = none; the bench's channel, twin sim/fmt/channel.py
+// FixedEffects, terms in 2^-16 LSB, so COUP_FRAC must be 16 when CHAN_FILE is used):
+// CHAN_FILE = 64-bit words key, sigma_q, dc_q, enob_mask, delay, n_if, then (inc, ph0,
+// amp) per interferer (<= IF_MAX); GAUSS_FILE = 2^16 signed 16-bit words, SINE_FILE =
+// 2^12 signed 16-bit words.
+//   noise(k, c)       = (GAUSS[z[63:48]] * sigma_q) >>> 4,
+//                       z = mix64(key + ({k, c[7:0]} + 1) * 64'h9E3779B97F4A7C15)  (splitmix64)
+//   interferer_i(k)   = (amp_i * SINE[(ph0_i + k * inc_i)[31:20]]) >>> 7   (32-bit phase)
+//   dac[k - delay]    = the row words of sample k - delay from a DELAY_MAX-sample line,
+//                       0 before sample ``delay`` (the line is cleared by reset).
 // Output registered: adc_o / clip_o after ce edge k belong to sample k (latency 1).
 // clip_sticky_o stays 1 from the first clipped sample until reset.
 //
@@ -36,6 +49,11 @@ module fmt_channel_sim #(
     parameter NOISE_FRAC = 4,              // noise fractional bits (<= COUP_FRAC)
     parameter NOISE_LEN  = 1024,           // noise samples per column in the file
     parameter NOISE_FILE = "",             // $readmemh file of noise words ("" = none)
+    parameter CHAN_FILE  = "",             // $readmemh file of effect parameters ("" = none)
+    parameter GAUSS_FILE = "",             // $readmemh Gaussian table (2^16 words), with CHAN_FILE
+    parameter SINE_FILE  = "",             // $readmemh interferer sine table (2^12 words), with CHAN_FILE
+    parameter IF_MAX     = 8,              // interferers at most
+    parameter DELAY_MAX  = 64,             // channel delay at most (samples, a power of 2)
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,  // width of upd_row_i
     parameter COL_W      = (COLS > 1) ? $clog2(COLS) : 1   // width of upd_col_i
 ) (
@@ -58,13 +76,67 @@ module fmt_channel_sim #(
     reg [COUP_BITS-1:0]  g_q    [0:ROWS*COLS-1];
     reg [COUP_BITS-1:0]  gp_q   [0:ROWS*COLS-1];
     reg [NOISE_BITS-1:0] noise  [0:NOISE_LEN*COLS-1];
+    reg [63:0]           par    [0:6+3*IF_MAX-1];
+    reg [15:0]           gauss  [0:65535];
+    reg [15:0]           sine   [0:4095];
+    reg [DAC_BITS-1:0]   dline  [0:DELAY_MAX*ROWS-1];
     reg [31:0]           k_q;
     reg                  armed_q;
     reg [31:0]           stamp_q;
 
     integer r, c, idx;
-    reg signed [63:0] acc, y, nz;
+    reg signed [63:0] acc, y, nz, common;
     reg               clip_any;
+    reg [ROWS*DAC_BITS-1:0] dac_d;
+
+    // effect parameters (0 = off until CHAN_FILE is read)
+    wire        [63:0] key      = par[0];
+    wire signed [63:0] sigma_q  = par[1];
+    wire signed [63:0] dc_q     = par[2];
+    wire        [63:0] enob_msk = par[3];
+    wire        [31:0] delay    = par[4][31:0];
+    wire        [31:0] n_if     = par[5][31:0];
+
+    function [63:0] mix64;                 // splitmix64's finaliser (wrapping 64-bit)
+        input [63:0] v;
+        reg   [63:0] t;
+        begin
+            t     = (v ^ (v >> 30)) * 64'hBF58476D1CE4E5B9;
+            t     = (t ^ (t >> 27)) * 64'h94D049BB133111EB;
+            mix64 = t ^ (t >> 31);
+        end
+    endfunction
+
+    // zz[47:0] / p[19:0] unused: the tables are indexed by the top bits
+    /* verilator lint_off UNUSEDSIGNAL */
+    function signed [63:0] fx_noise;       // noise word of sample kk, column cc (2^-16 LSB)
+        input [31:0] kk;
+        input [7:0]  cc;
+        reg   [63:0] zz;
+        reg signed [63:0] w;
+        begin
+            zz = mix64(key + ({24'd0, kk, cc} + 64'd1) * 64'h9E3779B97F4A7C15);
+            w  = {{48{gauss[zz[63:48]][15]}}, gauss[zz[63:48]]};
+            fx_noise = (sigma_q == 64'sd0) ? 64'sd0 : ((w * sigma_q) >>> 4);
+        end
+    endfunction
+
+    function signed [63:0] fx_common;      // DC + interferers at sample kk (2^-16 LSB)
+        input [31:0] kk;
+        integer      j;
+        reg   [31:0] p;
+        reg signed [63:0] v;
+        begin
+            v = dc_q;
+            for (j = 0; j < IF_MAX; j = j + 1)
+                if (j < n_if) begin
+                    p = par[7 + 3 * j][31:0] + kk * par[6 + 3 * j][31:0];
+                    v = v + (($signed(par[8 + 3 * j]) * $signed({{48{sine[p[31:20]][15]}}, sine[p[31:20]]})) >>> 7);
+                end
+            fx_common = v;
+        end
+    endfunction
+    /* verilator lint_on UNUSEDSIGNAL */
 
     localparam signed [63:0] HI = (64'sd1 <<< (ADC_BITS - 1)) - 1;
     localparam signed [63:0] LO = -(64'sd1 <<< (ADC_BITS - 1));
@@ -77,6 +149,15 @@ module fmt_channel_sim #(
         end
         for (idx = 0; idx < NOISE_LEN * COLS; idx = idx + 1) noise[idx] = {NOISE_BITS{1'b0}};
         if (NOISE_FILE != "") $readmemh(NOISE_FILE, noise);
+        for (idx = 0; idx < 6 + 3 * IF_MAX; idx = idx + 1) par[idx] = 64'd0;
+        for (idx = 0; idx < 65536; idx = idx + 1) gauss[idx] = 16'd0;
+        for (idx = 0; idx < 4096; idx = idx + 1) sine[idx] = 16'd0;
+        for (idx = 0; idx < DELAY_MAX * ROWS; idx = idx + 1) dline[idx] = {DAC_BITS{1'b0}};
+        if (CHAN_FILE != "") begin
+            $readmemh(CHAN_FILE, par);
+            $readmemh(GAUSS_FILE, gauss);
+            $readmemh(SINE_FILE, sine);
+        end
     end
 
     // Simulation model: blocking temporaries (acc, y, the matrix copy) inside the
@@ -92,6 +173,7 @@ module fmt_channel_sim #(
             clip_o        <= 1'b0;
             clip_sticky_o <= 1'b0;
             sample_o      <= 32'd0;
+            for (idx = 0; idx < DELAY_MAX * ROWS; idx = idx + 1) dline[idx] = {DAC_BITS{1'b0}};
         end else begin
             if (upd_commit_i) begin
                 armed_q <= 1'b1;
@@ -102,18 +184,28 @@ module fmt_channel_sim #(
                     for (idx = 0; idx < ROWS * COLS; idx = idx + 1) g_q[idx] = gp_q[idx];
                     if (!upd_commit_i) armed_q <= 1'b0;
                 end
+                // the row words of sample k - delay: read the line, then write sample k
+                for (r = 0; r < ROWS; r = r + 1) begin
+                    dac_d[r*DAC_BITS +: DAC_BITS] = (delay == 32'd0) ? dac_i[r*DAC_BITS +: DAC_BITS]
+                        : dline[((k_q - delay) % DELAY_MAX) * ROWS + r];
+                    dline[(k_q % DELAY_MAX) * ROWS + r] = dac_i[r*DAC_BITS +: DAC_BITS];
+                end
+                // DC and interferers (the same in every column)
+                common = fx_common(k_q);
                 clip_any = 1'b0;
                 for (c = 0; c < COLS; c = c + 1) begin
                     acc = 64'sd0;
                     for (r = 0; r < ROWS; r = r + 1)
-                        acc = acc + $signed(dac_i[r*DAC_BITS +: DAC_BITS])
+                        acc = acc + $signed(dac_d[r*DAC_BITS +: DAC_BITS])
                                   * $signed({1'b0, g_q[r * COLS + c]});
+                    acc = acc + fx_noise(k_q, c[7:0]) + common;
                     nz  = {{(64 - NOISE_BITS){noise[(k_q % NOISE_LEN) * COLS + c][NOISE_BITS-1]}},
                            noise[(k_q % NOISE_LEN) * COLS + c]};
                     acc = acc + (nz <<< (COUP_FRAC - NOISE_FRAC));
                     y   = (acc + HALF) >>> COUP_FRAC;
                     if (y > HI) begin y = HI; clip_any = 1'b1; end
                     if (y < LO) begin y = LO; clip_any = 1'b1; end
+                    y = y & ~enob_msk;
                     adc_o[c*ADC_BITS +: ADC_BITS] <= y[ADC_BITS-1:0];
                 end
                 clip_o   <= clip_any;

@@ -1,7 +1,9 @@
 // fmt_core_sim_top -- SIMULATION-ONLY full-chain top: fmt_core + fmt_channel_sim (the
-// DAC words through a coupling matrix with stamped updates and file noise back into the
-// ADC inputs) + a coupling-update player + loggers, so that a whole scene runs with no
-// testbench code on the per-sample path.
+// DAC words through the channel delay and a coupling matrix with stamped updates, plus
+// counter-based noise, DC offset and interferers, clipped, ENOB-masked, back into the
+// ADC inputs; effects from CHAN_FILE / GAUSS_FILE / SINE_FILE) + a coupling-update
+// player + loggers, so that a whole scene runs with no testbench code on the
+// per-sample path.
 //
 // Coupling-update player (runs while play_i = 1): UPD_FILE ($readmemh, 64-bit records, UPD_LEN entries) is
 // executed from the first cycle after reset, one record per cycle:
@@ -43,8 +45,9 @@ module fmt_core_sim_top #(
     parameter CLK_PER_SAMPLE = 3,                // clk cycles per sample
     parameter EV_DEPTH       = 2048,             // event FIFO depth
     parameter UART_DIV       = 8,                // clk cycles per UART bit
-    parameter NOISE_LEN      = 1024,             // noise samples per column in NOISE_FILE
-    parameter NOISE_FILE     = "",               // channel noise ($readmemh), "" = none
+    parameter CHAN_FILE      = "",               // channel effects ($readmemh, fmt_channel_sim), "" = none
+    parameter GAUSS_FILE     = "",               // the noise generator's Gaussian table
+    parameter SINE_FILE      = "",               // the interferers' sine table
     parameter UPD_LEN        = 1,                // coupling-update records
     parameter UPD_FILE       = "",               // coupling-update records ($readmemh), "" = none
     parameter HM_LOG         = "",               // heat-map log file
@@ -168,7 +171,8 @@ module fmt_core_sim_top #(
 
         fmt_channel_sim #(
             .ROWS(ROWS), .COLS(COLS), .DAC_BITS(`FMT_DAC_BITS), .ADC_BITS(`FMT_ADC_BITS), .COUP_BITS(16), .COUP_FRAC(16),
-            .NOISE_BITS(16), .NOISE_FRAC(4), .NOISE_LEN(NOISE_LEN), .NOISE_FILE(NOISE_FILE)
+            .NOISE_BITS(16), .NOISE_FRAC(4), .NOISE_LEN(1), .NOISE_FILE(""),
+            .CHAN_FILE(CHAN_FILE), .GAUSS_FILE(GAUSS_FILE), .SINE_FILE(SINE_FILE)
         ) u_ch (
             .clk(clk), .rst(rst), .ce(ce), .dac_i(dac),
             .upd_we_i(upd_we), .upd_row_i(upd_row), .upd_col_i(upd_col), .upd_data_i(upd_data),

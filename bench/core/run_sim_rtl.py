@@ -10,21 +10,31 @@ fixed-point model in lockstep as the reference.
 ``bench/core/`` (README.md there); the RTL comes from ``rtl/filelists/fmt_core.f``.
 
 The simulation top ``bench/core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
-channel (DAC words x coupling matrix + file noise -> ADC words) + a coupling-update
-player + loggers; nothing in Python is on the per-sample path:
+channel (DAC words through the channel delay x coupling matrix + counter-based noise,
+DC, interferers -> clip -> ENOB -> ADC words) + a coupling-update player + loggers;
+nothing in Python is on the per-sample path:
 
+0. :func:`check_scene`: every effect of the scene is applied by the RTL path
+   (``fmt.channel.fixed_effects``: noise, DC offset, ENOB, channel delay, interferers;
+   PN in the core's registers; coupling effects in the plan) or the run stops before
+   anything is built: ``main`` prints ONE line naming the effect and returns 2
+   (``tone_phases`` other than "zero": the DDS has no phase register; a delay over 63
+   samples, more than 8 interferers, a PN setting outside its register).
 1. The scene becomes a coupling plan (:func:`coupling_plan`): the channel matrix G (16
    fraction bits, ADC LSB per DAC LSB) at sample 0 and stamped updates -- at every window
    boundary where the coupling changed (moving contacts: the map at the window's first
    sample, held for the window) and at every sample where a contact's touch starts or
    ends inside a window (the exact onset sample).  Updates too close together to be
    loaded in time by the Verilog player (one pending-matrix write per clk) are merged
-   into the later one; the model uses the same list, so this costs no exactness.  Noise:
-   white Gaussian words with the scene's sigma, 4 fraction bits, NOISE_LEN samples per
-   column repeating.
-2. The model reference (:func:`model_reference`): ``tx_fixed`` (DDS + PN) ->
-   3-sample DAC delay -> :func:`channel_fixed` (int64 twin of ``channel_sim_fixed``) ->
-   1-sample ADC register -> ``rx_heatmaps_fixed`` (PN receive delay 4 samples) ->
+   into the later one; the model uses the same list, so this costs no exactness.  The
+   effects go to ``chan.hex`` with the shared tables ``gauss.hex`` / ``sine.hex``
+   (:func:`write_channel_files`); the noise is f(seed, sample, column) (a splitmix64
+   counter and an inverse-CDF table, ``fmt.channel.FixedEffects``): it never repeats.
+2. The model reference (:func:`model_reference`): the PN signs as the core makes them
+   (:func:`pn_rtl`: the chip length reaches the generator a few samples after the
+   reset) -> ``dds_bank_fixed`` -> 3-sample DAC delay -> :func:`channel_fixed` (int64
+   twin of ``channel_sim_fixed``, with the effects) -> 1-sample ADC register ->
+   ``rx_heatmaps_fixed`` (PN receive delay 4 samples + the scene's rx_delay) ->
    ``touch.process_frames(fixed=True)`` with the scene's calibration.
 3. The RTL run.  Engine ``cpp`` (default): the standalone Verilator harness
    ``bench/core/sim_main.cpp`` (:func:`run_harness`; built once per sensor size and
@@ -53,7 +63,7 @@ and serves one client at a time, any number of clients in turn, until Ctrl-C (SI
 SIGTERM: a clean end), ``--serve-seconds`` of wall time (default 600, 0 = none) or, with
 ``--serve-once``, the first client's disconnect.  The loggers stay on for the first
 ``--serve-log-frames`` frames of serving (default 2000, -1 = all).  The coupling of the
-scene's last frame holds while serving (the noise keeps looping); only the scene's
+scene's last frame holds while serving (the noise generator runs on); only the scene's
 frames are compared with the model (the logs are cut at the cycle where serving
 started); ``serve.log`` in the job folder lists every UART byte with its cycle.
 
@@ -93,11 +103,6 @@ ADC_DELAY = 1            # receiver sample j = channel sample j - 1 (channel out
 PN_RX_DELAY = DAC_DELAY + ADC_DELAY   # PN_RX_DELAY register value that aligns the despreaders
 LOAD_MARGIN = 6          # clk cycles of slack per update load
 TYPE_NAMES = {0: "new", 1: "move", 2: "lift", 3: "blob"}
-
-
-def noise_len(cfg) -> int:
-    """Noise samples per column in the channel's file (repeats after this many)."""
-    return 1 << 17 if cfg.rows * cfg.cols >= 400 else 1 << 12
 
 
 def upd_len(cfg) -> int:
@@ -188,20 +193,40 @@ def write_records(path, rec) -> None:
     Path(path).write_text("".join(f"{v:016x}\n" for v in rec))
 
 
-def make_noise(scene: _scene.Scene, length: int) -> np.ndarray:
-    sigma = _channel.scene_noise_sigma(scene)
-    rng = np.random.default_rng(scene.seed + 1000)
-    lim = (1 << (NOISE_BITS - 1)) - 1
-    v = np.rint(rng.standard_normal((length, scene.cfg.cols)) * sigma * (1 << NOISE_FRAC))
-    return np.clip(v, -lim, lim).astype(np.int64)
+def check_scene(scene: _scene.Scene) -> _channel.FixedEffects:
+    """The scene's channel effects in fixed point, or :class:`fmt.channel.UnsupportedEffect`
+    (one line naming the effect) when the RTL path cannot apply one: tone phases other
+    than "zero" (the DDS has no phase register), a PN setting outside its register, and
+    the ranges of ``channel.fixed_effects``."""
+    eff = _channel.fixed_effects(scene, adc_delay=ADC_DELAY)
+    enable, chip_len, _d, rx_delay = _channel.pn_settings(scene)
+    if not 1 <= chip_len <= 1023:
+        raise _channel.UnsupportedEffect(f"effect pn: chip_len {chip_len} outside the register (1..1023)")
+    if not 0 <= PN_RX_DELAY + rx_delay <= 63:
+        raise _channel.UnsupportedEffect(
+            f"effect pn: rx_delay {rx_delay} (register PN_RX_DELAY = {PN_RX_DELAY} + rx_delay) outside 0..63")
+    return eff
 
 
-def channel_fixed(dac, g0, updates, noise, adc_bits: int = 12):
+def write_channel_files(d: Path, eff: _channel.FixedEffects) -> None:
+    """chan.hex (parameter words), gauss.hex and sine.hex (the shared tables) in the job folder."""
+    write_records(d / "chan.hex", eff.param_words())
+    _channel.write_table_hex(d / "gauss.hex", _channel.gauss_table(), 16)
+    _channel.write_table_hex(d / "sine.hex", _channel.if_sine_table(), 16)
+
+
+def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, adc_bits: int = 12,
+                  noise=None):
     """int64 twin of ``fmt_channel_sim`` / ``channel.channel_sim_fixed`` (same formula:
-    round half up of sum_r dac*G + noise << 12, >> 16, clip); int64 is exact here
-    (|dac| < 2^11, G < 2^16, ROWS <= 64).  Returns (adc, clipped samples)."""
+    round half up of sum_r dac[k - delay]*G + additive effects, >> 16, clip, ENOB mask);
+    int64 is exact here (|dac| < 2^11, G < 2^16, ROWS <= 64, additive < 2^40).
+    ``noise``: file words as channel_sim_fixed's (tests).  Returns (adc, clipped samples)."""
     dac = np.asarray(dac, dtype=np.int64)
     n = dac.shape[0]
+    if eff is not None and eff.delay:
+        dd = np.zeros_like(dac)
+        dd[eff.delay:] = dac[:max(n - eff.delay, 0)]
+        dac = dd
     out = np.empty((n, g0.shape[1]), dtype=np.int64)
     stamps = [0] + [int(s) for s, _ in updates] + [n]
     mats = [g0] + [g for _, g in updates]
@@ -211,10 +236,15 @@ def channel_fixed(dac, g0, updates, noise, adc_bits: int = 12):
             out[a:b] = dac[a:b] @ g
     if noise is not None:
         out += noise[np.arange(n) % noise.shape[0]] << (COUP_FRAC - NOISE_FRAC)
+    if eff is not None:
+        out += eff.additive(0, n, out.shape[1])
     y = (out + (1 << (COUP_FRAC - 1))) >> COUP_FRAC
     lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
     clip = int(np.count_nonzero(((y < lo) | (y > hi)).any(axis=1)))
-    return np.clip(y, lo, hi), clip
+    y = np.clip(y, lo, hi)
+    if eff is not None and eff.enob_clear:
+        y &= ~np.int64((1 << eff.enob_clear) - 1)
+    return y, clip
 
 
 @dataclass
@@ -225,23 +255,59 @@ class Reference:
 
 
 def pn_of(scene):
-    enable, chip_len, _d, _rx = _channel.pn_settings(scene)
-    return enable, chip_len
+    """(enable, chip_len, PN_RX_DELAY register): the bench's 4 samples of DAC and ADC
+    registers plus the scene's receive delay (default: its channel delay, matched)."""
+    enable, chip_len, _d, rx = _channel.pn_settings(scene)
+    return enable, chip_len, PN_RX_DELAY + rx
 
 
-def model_reference(scene: _scene.Scene, g0, updates, noise, frames: int, settings, cal) -> Reference:
+REG_LAT = 2             # a register written at clk cycle w reaches fmt_pn_gen from cycle w + 2
+
+
+def pn_rtl(n: int, enable: bool, chip_len: int, rx_delay: int, bits: int, first: int = 0):
+    """(tx, rx) PN signs of samples 0..n-1 as fmt_core's generator makes them in this
+    bench.  The registers are written after the reset, so the first ``first`` samples
+    (ce edges before PN_CHIP_LEN reaches the generator, :func:`pn_chip_first`) step the
+    chip counter with the reset chip length 1: tx[t] = chips[t] for t < first, then
+    chips[first + (t - first) // chip_len] -- the model's ``pn_signs`` sequence advanced
+    by first * (chip_len - 1) samples from sample ``first`` on (all the same for
+    chip_len 1).  rx[t] = tx[t - rx_delay], 0 before.  The late PN_ENABLE and
+    PN_RX_DELAY writes change nothing: the LFSR (seed 1) gives chip 0 for its first 14
+    chips, so every sign before they arrive is 0 either way."""
+    chip_len = max(1, int(chip_len))
+    t = np.arange(n, dtype=np.int64)
+    idx = np.where(t < first, t, first + (t - first) // chip_len)
+    tx = np.zeros(n, dtype=np.uint8)
+    if enable and n:
+        per = _channel._pn_period(bits, _pn.DEFAULT_SEED)        # one LFSR period, cached
+        tx = per[idx % per.size].astype(np.uint8)
+    rx = np.zeros_like(tx)
+    if rx_delay < n:
+        rx[rx_delay:] = tx[:n - rx_delay]
+    return tx, rx
+
+
+def pn_chip_first(scene: _scene.Scene, cps: int) -> int:
+    """Samples (ce edges at clk 0, cps, 2 cps, ...) taken before the PN_CHIP_LEN write
+    (the i-th register write, at clk i) reaches the generator at clk i + REG_LAT."""
+    names = [nm for nm, _v in register_writes(scene, TouchSettings())]
+    return -(-(names.index("PN_CHIP_LEN") + REG_LAT) // cps)
+
+
+def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings, cal,
+                    cps: int = 3) -> Reference:
     from fmt import touch as _touch
     cfg = scene.cfg
     spf = scene.samples_per_frame
     n = frames * spf
-    enable, chip_len = pn_of(scene)
-    dds = _dds.tx_fixed(n, cfg, pn_enable=enable, chip_len=chip_len)
+    enable, chip_len, rx_delay = pn_of(scene)
+    tx, rx = pn_rtl(n, enable, chip_len, rx_delay, cfg.pn_bits, pn_chip_first(scene, cps))
+    dds = _dds.dds_bank_fixed(n, tx_sign=np.concatenate([[0], tx[:-1]]).astype(np.int64), cfg=cfg)
     dac = np.zeros_like(dds)
     dac[DAC_DELAY:] = dds[:n - DAC_DELAY]
-    adc_ch, clipped = channel_fixed(dac, g0, updates, noise, cfg.adc_bits)
+    adc_ch, clipped = channel_fixed(dac, g0, updates, eff, cfg.adc_bits)
     adc = np.zeros_like(adc_ch)
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
-    _tx, rx = _pn.pn_signs(n, chip_len=chip_len, enable=enable, rx_delay=PN_RX_DELAY, bits=cfg.pn_bits)
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
     hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m=scene.m)
     evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
@@ -253,10 +319,10 @@ def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
     """(name, value) register writes of a run: PN, M, touch settings, every frame
     reported, no extra delay."""
     cfg = scene.cfg
-    enable, chip_len = pn_of(scene)
+    enable, chip_len, rx_delay = pn_of(scene)
     tp = TrackParams.from_settings(cfg, settings, scene.frame_period_s)
     return [
-        ("PN_RX_DELAY", PN_RX_DELAY), ("PN_ENABLE", int(enable)), ("PN_CHIP_LEN", chip_len),
+        ("PN_RX_DELAY", rx_delay), ("PN_ENABLE", int(enable)), ("PN_CHIP_LEN", chip_len),
         ("WINDOWS_M", scene.m),
         ("TOUCH_THRESHOLD", settings.threshold),
         ("TOUCH_MODE", int(settings.neighbourhood == "moore") | (2 if settings.bias_correction else 0)
@@ -459,7 +525,8 @@ def sim_parameters(cfg, cps: int, d: Path) -> dict:
     return {"ROWS": cfg.rows, "COLS": cfg.cols, "LOG2_N": cfg.log2_n, "BIN_LO": cfg.bin_lo,
             "HM_W": cfg.hm_width, "MAX_TOUCHES": cfg.max_touches, "CLK_PER_SAMPLE": cps,
             "EV_DEPTH": 2048, "UART_DIV": 4,
-            "NOISE_LEN": noise_len(cfg), "NOISE_FILE": f'"{d / "noise.hex"}"',
+            "CHAN_FILE": f'"{d / "chan.hex"}"', "GAUSS_FILE": f'"{d / "gauss.hex"}"',
+            "SINE_FILE": f'"{d / "sine.hex"}"',
             "UPD_LEN": upd_len(cfg), "UPD_FILE": f'"{d / "upd.hex"}"',
             "HM_LOG": f'"{d / "hm.log"}"', "EV_LOG": f'"{d / "ev.log"}"', "FE_LOG": f'"{d / "fe.log"}"'}
 
@@ -498,9 +565,8 @@ def harness_args(cfg, cps: int, d: Path, bdir: Path, cflags: str = HARNESS_CFLAG
     harness then leaves the channel to the model: a cross-check and a speed comparison)."""
     p = sim_parameters(cfg, cps, d)
     if not verilog_channel:
-        for k in ("NOISE_FILE", "UPD_FILE"):
+        for k in ("CHAN_FILE", "GAUSS_FILE", "SINE_FILE", "UPD_FILE"):
             p.pop(k)                               # the C++ channel reads them (job file)
-        p["NOISE_LEN"] = 1
         p["UPD_LEN"] = 1
     p["EXT_CHANNEL"] = 0 if verilog_channel else 1
     args = ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
@@ -530,7 +596,7 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
         raise RuntimeError("verilator not on PATH (source scripts/env.sh)")
     h = hashlib.sha1(json.dumps(args).encode())
     h.update(subprocess.run([verilator, "--version"], capture_output=True, text=True).stdout.encode())
-    for s in sim_sources() + [HARNESS_SRC, ROOT / "rtl" / "fmt_defaults.vh"]:
+    for s in sim_sources() + [HARNESS_SRC, BENCH / "channel_fx.h", ROOT / "rtl" / "fmt_defaults.vh"]:
         h.update(Path(s).read_bytes())
     for s in sorted((ROOT / "rtl").glob("*.vh")) + sorted((ROOT / "rtl").glob("*.hex")):
         h.update(s.name.encode() + Path(s).read_bytes())
@@ -563,9 +629,10 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
     from fmt import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
-             f"progress {int(progress)}", f"noise_len {noise_len(cfg)}",
+             f"progress {int(progress)}",
              f"ext_channel {0 if verilog_channel else 1}",
-             f"noise_file {d / 'noise.hex'}", f"upd_file {d / 'upd.hex'}",
+             f"chan_file {d / 'chan.hex'}", f"gauss_file {d / 'gauss.hex'}",
+             f"sine_file {d / 'sine.hex'}", f"upd_file {d / 'upd.hex'}",
              f"reset_cycles {job['reset_cycles']}", f"run_cycles {job['run_cycles']}",
              f"out {d / 'result.json'}"]
     for key in ("cal", "regs"):
@@ -625,6 +692,7 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
     """Write the job folder (records, noise, job.json) and compute the reference."""
     from fmt import run_sim as _run_sim
     cfg = scene.cfg
+    eff = check_scene(scene)
     settings = settings or TouchSettings()
     d = job_dir(cfg, cps, tag)
     d.mkdir(parents=True, exist_ok=True)
@@ -634,12 +702,11 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
     if len(rec) > upd_len(cfg):
         raise ValueError(f"{len(rec)} update records > capacity {upd_len(cfg)}: fewer frames")
     write_records(d / "upd.hex", rec)
-    noise = make_noise(scene, noise_len(cfg))
-    _channel.write_noise_hex(d / "noise.hex", noise, NOISE_BITS)
+    write_channel_files(d, eff)
     if cal == "scene":
         cal = _run_sim.calibration(scene)
         cal = (np.asarray(cal[0], dtype=np.int64), np.asarray(cal[1], dtype=np.int64))
-    ref = model_reference(scene, g0, updates, noise, frames, settings, cal)
+    ref = model_reference(scene, g0, updates, eff, frames, settings, cal, cps)
     # cycles: all frames end, plus the post-processing tail
     run_cycles = (n + 4) * cps + 2 * scene.samples_per_frame * cps + 1000
     job = {"frames": frames, "cps": cps, "run_cycles": run_cycles,
@@ -664,6 +731,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
         raise ValueError("--serve needs the C++ harness (engine cpp, Verilator)")
     frames = frames or scene.frames
     scene = scene.replace(frames=frames)
+    check_scene(scene)                 # refuse an effect the RTL cannot apply, before any build
     if engine == "cpp" and sim == "verilator":
         t0 = time.perf_counter()
         d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet,
@@ -745,6 +813,11 @@ def main(argv=None) -> int:
                     help=f"C++ flags of the harness build (default '{HARNESS_CFLAGS}'; tests: -O0)")
     a = ap.parse_args(argv)
     sc = _scene.load(a.scene)
+    try:
+        check_scene(sc)
+    except _channel.UnsupportedEffect as exc:
+        print(f"run_sim_rtl: scene '{sc.name}' refused: {exc}", file=sys.stderr)
+        return 2
     serve = None
     if a.serve is not None:
         spf_clk = sc.samples_per_frame * a.cps

@@ -14,9 +14,16 @@
 //
 // The channel (bench/core/fmt_channel_sim.v, bit-exact, in C++): at every clk edge
 // with rst low and ce_o high (sample k = k-th such edge since reset)
-//   acc[c] = sum_r dac[r] * G[r][c] + noise[(k mod NOISE_LEN)][c] << (16 - 4)
-//   adc[c] = clip((acc[c] + 2^15) >> 16, -2048, 2047)     (arithmetic shift: floor)
-// registered (the core sees it from the next edge on), rst clears it.  G is 0 until
+//   acc[c] = sum_r dac[k - delay][r] * G[r][c] + noise(k, c) + dc + sum_i interferer_i(k)
+//   adc[c] = clip((acc[c] + 2^15) >> 16, -2048, 2047) & ~enob_mask  (>>: floor)
+// registered (the core sees it from the next edge on), rst clears it (and the delay
+// line: dac[j] = 0 for j < 0).  The additive terms (2^-16 LSB) are those of
+// sim/fmt/channel.py FixedEffects: noise(k, c) = (GAUSS[z >> 48] * sigma_q) >> 4 with
+// z = splitmix64 mix of key + (((k << 8) | c) + 1) * 0x9E3779B97F4A7C15 (a counter-based
+// generator: nothing repeats); interferer i = (amp_i * SINE[(ph0_i + k * inc_i) >> 20]) >> 7
+// (32-bit phase).  Parameters from chan_file (64-bit hex words: key, sigma_q, dc_q,
+// enob_mask, delay, n_if, then inc, ph0, amp per interferer), the tables from
+// gauss_file (2^16 words) and sine_file (2^12 words), all written by run_sim_rtl.py.  G is 0 until
 // phase 2; the coupling updates come from the same record file as the Verilog player's
 // (upd.hex: kind 1 = pending write, kind 2 = commit stamped with a sample, 0 = end):
 // a commit arms a copy G := pending at the first ce edge whose sample index is >= the
@@ -31,7 +38,7 @@
 // harness listens on 127.0.0.1:P (non-blocking), prints the line
 //   serving the RTL UART on socket://127.0.0.1:<port>
 // on stdout (flushed) and keeps clocking the core (ev_ready_i = 1 again, the last
-// coupling matrix held, the noise looping as always, the loggers running) while it
+// coupling matrix held, the noise generator running on, the loggers running) while it
 // bridges one TCP client at a time to the core's UART: received bytes are sent
 // bit-serial (8N1, back to back, serve_div clk per bit = the top's UART_DIV) into
 // uart_rx_i; uart_tx_o is sampled every clk (mid-bit) and the decoded bytes are sent to
@@ -70,6 +77,7 @@
 #include <vector>
 
 #include "Vfmt_core_sim_top.h"
+#include "channel_fx.h"
 #include "verilated.h"
 
 namespace {
@@ -98,8 +106,8 @@ struct Update {
 };
 
 struct Job {
-    int rows = 0, cols = 0, cps = 3, noise_len = 1, frames = 0, progress = 0, ext_channel = 1;
-    std::string noise_file, upd_file, out;
+    int rows = 0, cols = 0, cps = 3, frames = 0, progress = 0, ext_channel = 1;
+    std::string chan_file, gauss_file, sine_file, upd_file, out;
     std::vector<std::pair<uint32_t, uint32_t>> cal, regs;
     std::vector<std::pair<std::string, uint32_t>> status;
     long long reset_cycles = 16, run_cycles = 0;
@@ -144,7 +152,6 @@ Job read_job(const char* path) {
         else if (k == "frames") { if (std::fscanf(f, "%d", &j.frames) != 1) die(k); }
         else if (k == "progress") { if (std::fscanf(f, "%d", &j.progress) != 1) die(k); }
         else if (k == "ext_channel") { if (std::fscanf(f, "%d", &j.ext_channel) != 1) die(k); }
-        else if (k == "noise_len") { if (std::fscanf(f, "%d", &j.noise_len) != 1) die(k); }
         else if (k == "reset_cycles") { if (std::fscanf(f, "%lld", &j.reset_cycles) != 1) die(k); }
         else if (k == "run_cycles") { if (std::fscanf(f, "%lld", &j.run_cycles) != 1) die(k); }
         else if (k == "serve_port") { if (std::fscanf(f, "%d", &j.serve_port) != 1) die(k); }
@@ -154,7 +161,9 @@ Job read_job(const char* path) {
         else if (k == "serve_cycles") { if (std::fscanf(f, "%lld", &j.serve_cycles) != 1) die(k); }
         else if (k == "serve_log_clk") { if (std::fscanf(f, "%lld", &j.serve_log_clk) != 1) die(k); }
         else if (k == "serve_log") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.serve_log = sval; }
-        else if (k == "noise_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.noise_file = sval; }
+        else if (k == "chan_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.chan_file = sval; }
+        else if (k == "gauss_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.gauss_file = sval; }
+        else if (k == "sine_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.sine_file = sval; }
         else if (k == "upd_file") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.upd_file = sval; }
         else if (k == "out") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.out = sval; }
         else if (k == "cal") pairs(j.cal);
@@ -176,9 +185,10 @@ Job read_job(const char* path) {
 
 // The channel of fmt_channel_sim.v plus the coupling-update sequencing.
 struct Channel {
-    int rows, cols, noise_len;
+    int rows, cols;
     std::vector<int32_t> g, pending;          // column-major
-    std::vector<int64_t> noise;               // [k * cols + c], already << 12
+    Effects fx;
+    std::vector<int32_t> dline;               // [(k mod DELAY_MAX) * rows + r]
     std::vector<Update> updates;              // commits in record order
     std::vector<int32_t> dac;
     std::vector<uint32_t> adc_words;          // registered output, packed
@@ -189,10 +199,10 @@ struct Channel {
     bool clip_sticky = false;
 
     Channel(const Job& j, size_t adc_nwords)
-        : rows(j.rows), cols(j.cols), noise_len(j.noise_len),
+        : rows(j.rows), cols(j.cols),
           g(static_cast<size_t>(rows) * cols, 0), pending(g.size(), 0),
-          noise(static_cast<size_t>(noise_len) * cols, 0), dac(rows, 0), adc_words(adc_nwords, 0) {
-        if (!j.noise_file.empty()) load_noise(j.noise_file);
+          dline(static_cast<size_t>(Effects::DELAY_MAX) * rows, 0), dac(rows, 0), adc_words(adc_nwords, 0) {
+        if (!j.chan_file.empty()) load_effects(j);
         if (!j.upd_file.empty()) load_updates(j.upd_file);
     }
 
@@ -221,12 +231,9 @@ struct Channel {
         return out;
     }
 
-    void load_noise(const std::string& path) {
-        const std::vector<uint64_t> w = read_hex(path);
-        for (size_t i = 0; i < noise.size() && i < w.size(); ++i) {
-            const int32_t s = static_cast<int32_t>(static_cast<int16_t>(w[i] & 0xFFFF));
-            noise[i] = static_cast<int64_t>(s) * (1 << (16 - 4));
-        }
+    void load_effects(const Job& j) {
+        const std::string err = fx.load(j.chan_file, j.gauss_file, j.sine_file);
+        if (!err.empty()) die(err);
     }
 
     void load_updates(const std::string& path) {
@@ -250,6 +257,7 @@ struct Channel {
         if (rst) {
             k = 0;
             armed = false;
+            std::fill(dline.begin(), dline.end(), 0);
             clip_sticky = false;
             std::fill(adc_words.begin(), adc_words.end(), 0u);
             if (playing && next_upd == 0) arm_next = true;   // the initial matrix: first edge after reset
@@ -265,18 +273,26 @@ struct Channel {
                 if (next_upd < updates.size()) arm_now = true;   // next commit, armed from the next edge
             }
             const uint32_t* dw = words_of(dac_port);
-            for (int r = 0; r < rows; ++r) dac[r] = get_field(dw, r * 12, 12);
-            const int64_t* nz = &noise[static_cast<size_t>(k % static_cast<uint32_t>(noise_len)) * cols];
+            if (fx.delay == 0) {
+                for (int r = 0; r < rows; ++r) dac[r] = get_field(dw, r * 12, 12);
+            } else {                        // ring of DELAY_MAX samples, 0 after reset
+                int32_t* slot = &dline[static_cast<size_t>(k % Effects::DELAY_MAX) * rows];
+                const int32_t* old = &dline[static_cast<size_t>((k - fx.delay) % Effects::DELAY_MAX) * rows];
+                for (int r = 0; r < rows; ++r) dac[r] = old[r];   // sample k - delay (0 before)
+                for (int r = 0; r < rows; ++r) slot[r] = get_field(dw, r * 12, 12);
+            }
+            const int64_t common = fx.common(k);
             std::fill(adc_words.begin(), adc_words.end(), 0u);
             bool clip = false;
             for (int c = 0; c < cols; ++c) {
                 const int32_t* gc = &g[static_cast<size_t>(c) * rows];
                 int64_t acc = 0;
                 for (int r = 0; r < rows; ++r) acc += static_cast<int64_t>(dac[r]) * gc[r];
-                acc += nz[c];
+                acc += fx.noise(k, c) + common;
                 int64_t y = (acc + (1 << 15)) >> 16;
                 if (y > 2047) { y = 2047; clip = true; }
                 if (y < -2048) { y = -2048; clip = true; }
+                y &= ~fx.enob_mask;
                 const uint64_t u = static_cast<uint64_t>(y) & 0xFFF;
                 const int lsb = c * 12, i = lsb >> 5, s = lsb & 31;
                 adc_words[i] |= static_cast<uint32_t>(u << s);
@@ -373,7 +389,7 @@ int main(int argc, char** argv) {
         static_cast<size_t>(job.rows) * 12 > sizeof(top->dac_o) * 8)
         die("job size does not match the build");
     Job chjob = job;
-    if (!job.ext_channel) { chjob.noise_file.clear(); chjob.upd_file.clear(); }
+    if (!job.ext_channel) { chjob.chan_file.clear(); chjob.upd_file.clear(); }
     Channel ch(chjob, ADC_NWORDS);
     const bool cpp_channel = job.ext_channel != 0;   // 0: the Verilog channel of the top runs
 

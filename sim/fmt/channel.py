@@ -21,6 +21,12 @@ Column c at ADC sample n (before quantisation, in LSB):
 * ADC: round half to even (numpy rint), clip to the B-bit range (counted: ``clipped``),
   ENOB = clear the low B - enob bits (floor), DC offset and noise before quantisation.
   Noise: white Gaussian, sigma from ``noise_sigma_for_snr`` (the default physics).
+
+The RTL bench (``make sim``) applies the same effects in integers (``FixedEffects``,
+``channel_sim_fixed`` below; bit-exact with bench/core's C++ and Verilog channels): a
+counter-based noise generator instead of numpy's, interferers from a 32-bit phase
+accumulator and a 4096-word sine table, round half up, row words before the channel
+delay are 0 (docs/simulation.md lists the differences).
 """
 from __future__ import annotations
 
@@ -307,16 +313,25 @@ def write_noise_hex(path, noise: np.ndarray, noise_bits: int = 16) -> None:
 
 
 def channel_sim_fixed(dac: np.ndarray, g0: np.ndarray, updates=(), noise=None,
-                      adc_bits: int = 12, coup_frac: int = 16, noise_frac: int = 4):
+                      adc_bits: int = 12, coup_frac: int = 16, noise_frac: int = 4,
+                      effects: "FixedEffects | None" = None):
     """Bit-exact twin of ``fmt_channel_sim``.  ``dac``: (n, rows) row words of samples
     0..n-1; ``g0``: (rows, cols) coupling in effect from sample 0 (unsigned integers,
     coup_frac fractional bits); ``updates``: (stamp, G) pairs in commit order, each in
     effect from sample ``stamp`` on (a later commit must have a later stamp);
-    ``noise``: (L, cols) signed words with noise_frac fractional bits, sample k uses
-    row k mod L.  Returns (adc (n, cols) int64, clip (n,) bool): round half up of
-    sum_r dac*G + noise, then clip to the ADC range."""
+    ``noise``: (L, cols) signed file words with noise_frac fractional bits, sample k uses
+    row k mod L (the NOISE_FILE of the Verilog; the bench uses ``effects`` instead);
+    ``effects``: :class:`FixedEffects` (coup_frac must be ADD_FRAC): the row words
+    delayed by ``delay`` samples, the counter noise, DC and interferers added, the ENOB
+    mask after the clip.  Returns (adc (n, cols) int64, clip (n,) bool): round half up of
+    sum_r dac*G + additive terms, then clip to the ADC range (clip: before the ENOB mask)."""
     dac = np.asarray(dac, dtype=np.int64)
     n = dac.shape[0]
+    if effects is not None and effects.delay:
+        d = effects.delay
+        dd = np.zeros_like(dac)
+        dd[d:] = dac[:max(n - d, 0)]
+        dac = dd
     g_of = np.empty(n, dtype=np.int64)
     mats = [np.asarray(g0, dtype=np.int64)] + [np.asarray(g, dtype=np.int64) for _, g in updates]
     g_of[:] = 0
@@ -330,8 +345,192 @@ def channel_sim_fixed(dac: np.ndarray, g0: np.ndarray, updates=(), noise=None,
     if noise is not None:
         nz = np.asarray(noise, dtype=np.int64)
         acc = acc + (nz[np.arange(n) % nz.shape[0]].astype(object) << (coup_frac - noise_frac))
+    if effects is not None:
+        if coup_frac != ADD_FRAC:
+            raise ValueError("effects need coup_frac == ADD_FRAC")
+        acc = acc + effects.additive(0, n, acc.shape[1]).astype(object)
     half = (1 << (coup_frac - 1)) if coup_frac > 0 else 0
     y = np.array((acc + half) >> coup_frac, dtype=np.int64)
     lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
     clip = ((y < lo) | (y > hi)).any(axis=1)
-    return np.clip(y, lo, hi), clip
+    y = np.clip(y, lo, hi)
+    if effects is not None and effects.enob_clear:
+        y &= ~np.int64((1 << effects.enob_clear) - 1)
+    return y, clip
+
+
+# ---- the RTL bench's additive effects, fixed point (bench/core: numpy, C++, Verilog) ------
+# Every word below is computed with integer arithmetic only, identically by
+# ``channel_sim_fixed`` / ``bench.core.run_sim_rtl.channel_fixed`` (numpy),
+# bench/core/sim_main.cpp (C++) and bench/core/fmt_channel_sim.v (Verilog).  Units of the
+# additive term: 2^-ADD_FRAC ADC LSB (= the coupling product's fraction bits).
+#
+# Noise (counter based, no state, no repetition): for channel sample k (32 bits) and
+# column c (< 256), z = mix64(key + (((k << 8) | c) + 1) * GAMMA) mod 2^64 -- splitmix64's
+# output number ((k << 8) | c) + 1 of a generator seeded with ``key`` -- and the word is
+#   noise = (GAUSS[z >> (64 - GAUSS_BITS)] * sigma_q) >>> (GAUSS_FRAC + SIGMA_FRAC - ADD_FRAC)
+# GAUSS: the 2^16 midpoint quantiles of the standard normal, scaled so that the table's
+# variance is 1, GAUSS_FRAC fraction bits (|word| <= 4.2 sigma); sigma_q = sigma in
+# 2^-SIGMA_FRAC LSB.  Sample variance = (sigma_q / 2^8)^2 within 1e-5 + the floor's
+# 1/12 * 2^-32 LSB^2.  The float model (adc_streams) draws numpy Gaussians instead.
+# Interferer i: a 32-bit phase accumulator ph_i(k) = ph0_i + k * inc_i (mod 2^32), a sine
+# table of 2^IF_TABLE_BITS words round(32767 sin(2 pi j / 2^IF_TABLE_BITS)) read at
+# ph >> (32 - IF_TABLE_BITS) (truncated phase: spurs near -72 dBc), amplitude amp_q in
+# 2^-IF_AMP_FRAC LSB: term = (amp_q * SINE[...]) >>> (IF_AMP_FRAC + 15 - ADD_FRAC), the
+# same in every column.  inc = round(f / fs * 2^32) (a bin b: round(b * 2^32 / N), exact
+# for half bins), ph0 = round(phase / 2 pi * 2^32) + adc_delay * inc (channel sample k
+# reaches the receiver as ADC sample k + adc_delay, the float model's time base).
+# DC: dc_q = round(dc_lsb * 2^ADD_FRAC).  ENOB: the low ADC_BITS - enob bits of the
+# clipped word cleared.  Delay: the row words of channel sample k are those of sample
+# k - delay (0 before sample ``delay``: a delay line reset to 0; the float model continues
+# the periodic tones there instead).
+ADD_FRAC = 16
+GAUSS_BITS, GAUSS_FRAC, SIGMA_FRAC = 16, 12, 8
+IF_TABLE_BITS, IF_AMP_FRAC, IF_MAX = 12, 8, 8
+GAMMA = 0x9E3779B97F4A7C15
+MIX1, MIX2 = 0xBF58476D1CE4E5B9, 0x94D049BB133111EB
+_M64 = (1 << 64) - 1
+
+
+class UnsupportedEffect(ValueError):
+    """A scene effect the fixed-point / RTL channel cannot apply (one line naming it)."""
+
+
+def mix64(z):
+    """splitmix64's finaliser on uint64 numpy arrays (wrapping arithmetic)."""
+    z = np.asarray(z, dtype=np.uint64)
+    with np.errstate(over="ignore"):
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(MIX1)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(MIX2)
+    return z ^ (z >> np.uint64(31))
+
+
+@functools.lru_cache(maxsize=1)
+def gauss_table() -> np.ndarray:
+    """2^GAUSS_BITS int64 words, GAUSS_FRAC fraction bits: the midpoint quantiles
+    Phi^-1((i + 1/2) / 2^GAUSS_BITS) scaled to unit variance (statistics.NormalDist:
+    plain double arithmetic), rounded; antisymmetric (T[L-1-i] = -T[i])."""
+    from statistics import NormalDist
+    size = 1 << GAUSS_BITS
+    inv = NormalDist().inv_cdf
+    q = np.array([inv((i + 0.5) / size) for i in range(size // 2)], dtype=np.float64)
+    q = np.concatenate([q, -q[::-1]])
+    q /= math.sqrt(float(np.mean(q * q)))
+    return np.rint(q * (1 << GAUSS_FRAC)).astype(np.int64)
+
+
+@functools.lru_cache(maxsize=1)
+def if_sine_table() -> np.ndarray:
+    """2^IF_TABLE_BITS int64 words round(32767 sin(2 pi j / 2^IF_TABLE_BITS))."""
+    j = np.arange(1 << IF_TABLE_BITS)
+    return np.rint(32767.0 * np.sin(2.0 * np.pi * j / (1 << IF_TABLE_BITS))).astype(np.int64)
+
+
+def write_table_hex(path, words, bits: int = 16) -> None:
+    """Signed words for $readmemh / the C++ harness, one per line, two's complement."""
+    a = np.asarray(words, dtype=np.int64)
+    digits, mask = (bits + 3) // 4, (1 << bits) - 1
+    Path(path).write_text("".join(f"{int(v) & mask:0{digits}x}\n" for v in a))
+
+
+@dataclass(frozen=True)
+class FixedEffects:
+    """The additive effects of a scene as the fixed-point channel applies them."""
+
+    key: int = 0                 # noise generator seed (64 bits)
+    sigma_q: int = 0             # noise sigma, 2^-SIGMA_FRAC LSB (0 = no noise)
+    dc_q: int = 0                # DC offset, 2^-ADD_FRAC LSB
+    enob_clear: int = 0          # low ADC bits cleared after the clip (ADC_BITS - enob)
+    delay: int = 0               # channel delay of the row words, samples
+    interferers: tuple = ()      # (inc, ph0, amp_q) per interferer
+
+    def noise(self, k0: int, n: int, cols: int) -> np.ndarray:
+        """(n, cols) int64 noise words of channel samples k0 .. k0+n-1, 2^-ADD_FRAC LSB."""
+        if self.sigma_q == 0 or n <= 0:
+            return np.zeros((max(n, 0), cols), dtype=np.int64)
+        k = (np.arange(k0, k0 + n, dtype=np.uint64) & np.uint64(0xFFFFFFFF))
+        ctr = (k[:, None] << np.uint64(8)) | np.arange(cols, dtype=np.uint64)[None, :]
+        with np.errstate(over="ignore"):
+            z = mix64(np.uint64(self.key) + (ctr + np.uint64(1)) * np.uint64(GAMMA))
+        idx = (z >> np.uint64(64 - GAUSS_BITS)).astype(np.int64)
+        return (gauss_table()[idx] * self.sigma_q) >> (GAUSS_FRAC + SIGMA_FRAC - ADD_FRAC)
+
+    def interference(self, k0: int, n: int) -> np.ndarray:
+        """(n,) int64 sum of the interferers at channel samples k0 .. k0+n-1."""
+        out = np.zeros(max(n, 0), dtype=np.int64)
+        tab = if_sine_table()
+        k = np.arange(k0, k0 + n, dtype=np.uint64) & np.uint64(0xFFFFFFFF)
+        for inc, ph0, amp in self.interferers:
+            with np.errstate(over="ignore"):            # mod 2^64, then mod 2^32
+                ph = (np.uint64(ph0) + k * np.uint64(inc)) & np.uint64(0xFFFFFFFF)
+            idx = (ph >> np.uint64(32 - IF_TABLE_BITS)).astype(np.int64)
+            out += (amp * tab[idx]) >> (IF_AMP_FRAC + 15 - ADD_FRAC)
+        return out
+
+    def additive(self, k0: int, n: int, cols: int) -> np.ndarray:
+        """(n, cols) int64: noise + DC + interferers, 2^-ADD_FRAC LSB."""
+        a = self.noise(k0, n, cols)
+        if self.dc_q:
+            a += self.dc_q
+        if self.interferers:
+            a += self.interference(k0, n)[:, None]
+        return a
+
+    def param_words(self) -> list[int]:
+        """The channel parameter file (CHAN_FILE of fmt_channel_sim.v, chan_file of the
+        C++ harness), 64-bit words: key, sigma_q, dc_q, mask of the ENOB-cleared bits,
+        delay, number of interferers, then (inc, ph0, amp_q) per interferer."""
+        mask = (1 << self.enob_clear) - 1
+        w = [self.key, self.sigma_q, self.dc_q, mask, self.delay, len(self.interferers)]
+        for it in self.interferers:
+            w += list(it)
+        return [int(v) & _M64 for v in w]
+
+
+def fixed_effects(scene: Scene, adc_delay: int = 1, key: int | None = None) -> FixedEffects:
+    """The scene's additive channel effects in fixed point (see above); raises
+    :class:`UnsupportedEffect` (a one-line message naming the effect) for an effect the
+    fixed-point channel cannot apply.  ``key``: the noise seed (default scene.seed + 1000)."""
+    cfg = scene.cfg
+    eff = scene.effects
+    ph = eff.get("tone_phases", "zero")
+    if ph != "zero":
+        raise UnsupportedEffect(f"effect tone_phases '{ph}': the RTL DDS starts every row at phase 0 "
+                                "(no phase register); only 'zero' runs through the RTL")
+    sigma = scene_noise_sigma(scene)
+    sigma_q = int(round(sigma * (1 << SIGMA_FRAC)))
+    if not 0 <= sigma_q < (1 << 32):
+        raise UnsupportedEffect(f"effect noise: sigma {sigma} LSB outside 0 .. 2^{32 - SIGMA_FRAC}")
+    dc = float(eff.get("dc_lsb", 0.0))
+    if abs(dc) >= (1 << 20):
+        raise UnsupportedEffect(f"effect dc_lsb: {dc} LSB too large (|dc| < 2^20)")
+    dc_q = int(round(dc * (1 << ADD_FRAC)))
+    enob = eff.get("enob")
+    if enob is not None:
+        if int(enob) != enob or not 1 <= int(enob):
+            raise UnsupportedEffect(f"effect enob: {enob} is not a whole number of bits >= 1")
+    clear = 0 if enob is None else max(0, cfg.adc_bits - int(enob))
+    d = eff.get("delay_samples", 0)
+    if int(d) != d or not 0 <= int(d) <= 63:
+        raise UnsupportedEffect(f"effect delay_samples: {d} is not a whole number of samples 0..63")
+    interf = eff.get("interferer") or []
+    if isinstance(interf, dict):
+        interf = [interf]
+    if len(interf) > IF_MAX:
+        raise UnsupportedEffect(f"effect interferer: {len(interf)} interferers > {IF_MAX}")
+    its = []
+    for it in interf:
+        if "freq_hz" in it:
+            inc = int(round(float(it["freq_hz"]) / cfg.fs_hz * (1 << 32)))
+        else:
+            inc = int(round(float(it["bin"]) * (1 << 32) / cfg.n_fft))
+        inc &= 0xFFFFFFFF
+        amp = float(it.get("amp_lsb", 0.0))
+        if not 0 <= amp < (1 << 16):
+            raise UnsupportedEffect(f"effect interferer: amp_lsb {amp} outside 0 .. 65535")
+        ph0 = int(round(float(it.get("phase_rad", 0.0)) / (2 * math.pi) * (1 << 32)))
+        ph0 = (ph0 + adc_delay * inc) & 0xFFFFFFFF
+        its.append((inc, ph0, int(round(amp * (1 << IF_AMP_FRAC)))))
+    k = (scene.seed + 1000) if key is None else key
+    return FixedEffects(key=int(k) & _M64, sigma_q=sigma_q, dc_q=dc_q, enob_clear=clear, delay=int(d),
+                        interferers=tuple(its))

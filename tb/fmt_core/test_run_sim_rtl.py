@@ -29,7 +29,7 @@ def test_channel_fixed_equals_channel_sim_fixed():
            (200, rng.integers(0, 1 << 16, size=(cfg.rows, cfg.cols)))]
     noise = rng.integers(-3000, 3000, size=(64, cfg.cols))
     a, clip_a = channel.channel_sim_fixed(dac, g0, ups, noise, adc_bits=12)
-    b, clip_b = rsr.channel_fixed(dac, g0, ups, noise, 12)
+    b, clip_b = rsr.channel_fixed(dac, g0, ups, None, 12, noise=noise)
     assert np.array_equal(a, b)
     assert int(clip_a.sum()) == clip_b and clip_b > 0
 
