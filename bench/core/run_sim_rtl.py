@@ -237,7 +237,9 @@ def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, ad
     if noise is not None:
         out += noise[np.arange(n) % noise.shape[0]] << (COUP_FRAC - NOISE_FRAC)
     if eff is not None:
-        out += eff.additive(0, n, out.shape[1])
+        for k0 in range(0, n, 1 << 16):           # in blocks: the generator's temporaries stay small
+            k1 = min(n, k0 + (1 << 16))
+            out[k0:k1] += eff.additive(k0, k1 - k0, out.shape[1])
     y = (out + (1 << (COUP_FRAC - 1))) >> COUP_FRAC
     lo, hi = -(1 << (adc_bits - 1)), (1 << (adc_bits - 1)) - 1
     clip = int(np.count_nonzero(((y < lo) | (y > hi)).any(axis=1)))
