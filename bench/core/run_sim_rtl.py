@@ -97,7 +97,7 @@ from fmt.tracker import TrackParams
 ROOT = Path(__file__).resolve().parents[2]
 BENCH = Path(__file__).resolve().parent
 COUP_BITS, COUP_FRAC = 16, 16
-NOISE_BITS, NOISE_FRAC = 16, 4
+NOISE_FRAC = 4           # fraction bits of test noise-file words (channel_fixed noise=)
 DAC_DELAY = 3            # channel sample k multiplies DDS sample k - 3 (fmt_tx + channel input)
 ADC_DELAY = 1            # receiver sample j = channel sample j - 1 (channel output register)
 PN_RX_DELAY = DAC_DELAY + ADC_DELAY   # PN_RX_DELAY register value that aligns the despreaders

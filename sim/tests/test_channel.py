@@ -1,4 +1,6 @@
 """Channel and ADC: orthogonal comb, exact onset sample, clipping, ENOB, DC, PN."""
+import math
+
 import numpy as np
 import pytest
 
@@ -197,3 +199,36 @@ def test_channel_sim_fixed_hand_values():
     # s2: ~4094 -> clipped to 2047; s3: (-5 + 1)*(1 - 2^-16) - 0.5 = -4.49994 -> -4
     assert adc[:, 0].tolist() == [3, 2, 2047, -4]
     assert clip.tolist() == [False, False, True, False]
+
+
+def test_fixed_effects_words():
+    """The scene's effects in fixed point (bench/core's channel): exact bin increments,
+    the ADC-delay phase offset, DC, ENOB, delay; tone_phases "schroeder" refused."""
+    cfg = params.DEFAULT
+    sc = S.Scene(name="x", sensor="default", frames=1, seed=5, contacts=[],
+                 effects={"dc_lsb": 2.5, "enob": 9, "delay_samples": 4, "noise": {"rms_lsb": 10.0},
+                          "interferer": [{"bin": 43, "amp_lsb": 200.0},
+                                         {"bin": 53.5, "amp_lsb": 1.5, "phase_rad": math.pi / 2}]})
+    e = ch.fixed_effects(sc, adc_delay=1)
+    assert (e.key, e.sigma_q, e.dc_q, e.enob_clear, e.delay) == (1005, 2560, 5 << 15, 3, 4)
+    inc0, inc1 = 43 << 24, int(53.5 * (1 << 24))
+    assert e.interferers == ((inc0, inc0, 51200), (inc1, (inc1 + (1 << 30)) & 0xFFFFFFFF, 384))
+    assert e.param_words()[:6] == [1005, 2560, 5 << 15, 7, 4, 2]
+    # the interferer sum follows the float sine within the table's phase truncation
+    k = np.arange(2000)
+    v = e.interference(0, 2000) / 65536.0
+    f = 200 * np.sin(2 * np.pi * 43 * (k + 1) / 256) + 1.5 * np.sin(2 * np.pi * 53.5 * (k + 1) / 256 + np.pi / 2)
+    assert np.abs(v - f).max() < 0.35
+    with pytest.raises(ch.UnsupportedEffect, match="tone_phases"):
+        ch.fixed_effects(sc.replace(effects={"tone_phases": "schroeder"}))
+
+
+def test_channel_sim_fixed_effects_hand_values():
+    # 1 row, 1 column, G = 1.0 - 2^-16; delay 2, DC 0.5 LSB, ENOB 10 (2 low bits cleared)
+    dac = np.array([[100], [-7], [13], [2047], [-2048]])
+    g0 = np.array([[(1 << 16) - 1]])
+    e = ch.FixedEffects(dc_q=1 << 15, delay=2, enob_clear=2)
+    adc, clip = ch.channel_sim_fixed(dac, g0, (), None, adc_bits=12, effects=e)
+    # samples 0, 1: no row words yet, 0.5 -> 1 (half up) -> 0 after ENOB;
+    # 2: 100 (1 - 2^-16) + 0.5 = 100.4985 -> 100; 3: -6.4999 -> -6 -> -8; 4: 13.4998 -> 13 -> 12
+    assert adc[:, 0].tolist() == [0, 0, 100, -8, 12] and not clip.any()

@@ -108,14 +108,12 @@ def test_generator_numpy_cpp_verilog_word_for_word(tmp_path, k0):
     eff = fx_all()
     rsr.write_channel_files(tmp_path, eff)
     n, cols = 1500, 6                                      # 9000 noise words, 1500 common terms
-    k = np.arange(k0, k0 + n)
     py = np.column_stack([eff.noise(k0, n, cols), eff.additive(k0, n, 1)[:, 0] - eff.noise(k0, n, 1)[:, 0]])
     assert np.count_nonzero(py[:, :cols]) > 0.99 * n * cols and np.unique(py[:, cols]).size > 100
     cpp = _dump_cpp(tmp_path, k0, n, cols)
     assert np.array_equal(cpp, py), f"C++ differs at {np.argwhere(cpp != py)[:3].tolist()}"
     ver = _dump_verilog(tmp_path, k0, n, cols)
     assert np.array_equal(ver, py), f"Verilog differs at {np.argwhere(ver != py)[:3].tolist()}"
-    del k
 
 
 def test_noise_variance_and_no_repeat():
@@ -277,6 +275,18 @@ def test_effect_through_core_icarus(tmp_path, name):
     rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True)
     assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+
+
+@pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
+@pytest.mark.parametrize("cps,chip_len", [(1, 3), (2, 4)])
+def test_pn_chip_len_through_core_icarus(tmp_path, cps, chip_len):
+    """chip_len > 1 at other clk per sample: the model's PN signs follow the core's
+    (pn_rtl: the first pn_chip_first samples step with the reset chip length 1)."""
+    sc = _scene.small_scene()
+    sc = sc.replace(frames=4, effects={**sc.effects, "pn": {"enable": True, "chip_len": chip_len}})
+    assert rsr.pn_chip_first(sc, cps) == -(-(2 + rsr.REG_LAT) // cps)
+    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=cps, sim="icarus", engine="cocotb", plot=False, quiet=True)
+    assert rep["frames_dropped"] == 0 and rep["golden_mismatches"] == 0, rep["golden_detail"]
 
 
 @pytest.mark.verilator_only
