@@ -1,0 +1,424 @@
+"""fmtctl -- host tool for the FMT control/monitor port (UART, pyserial).
+
+    fmtctl --port /dev/ttyUSB0 [--baud 115200] info
+    fmtctl --port socket://127.0.0.1:PORT get NAME
+    fmtctl --port ... set NAME VALUE
+    fmtctl --port ... heatmap --out hm.npy [--png hm.png] [--frames K]
+    fmtctl --port ... touches [--count N]          (JSON lines on stdout)
+    fmtctl --port ... latency                       (the latency counters as a report)
+    fmtctl --port ... calibrate --out cal.json [--frames K] [--yes]
+    fmtctl --port ... load-cal cal.json
+    fmtctl regs                                     (the register map; no port needed)
+
+NAME is a register name of docs/REGISTERS.md (case-insensitive) or an address (0x...).
+The simulation serves the core's UART on a socket (python -m bench.core.run_sim_rtl --serve
+PORT): socket:// ports get a longer default reply timeout (10 s; the simulated UART runs
+at a few kB/s or less, and the wire time computed from --baud does not apply there).
+Protocol: docs/PROTOCOL.md.  Any failure (port unreachable, timeout, CRC error, device
+error reply) prints ONE line on stderr and exits with status 2 (1 for usage errors).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import struct
+import sys
+import time
+from pathlib import Path
+
+from fmt import protocol as P
+from fmt import regmap
+
+
+class FmtError(Exception):
+    """A failure reported as one line."""
+
+
+class Device:
+    """One control port.  Requests are serialised; every reply is matched by SEQ."""
+
+    def __init__(self, port: str, baud: int, timeout: float):
+        try:
+            import serial  # pyserial
+        except ImportError as e:
+            raise FmtError("pyserial is not installed (pip install pyserial)") from e
+        self.serial_mod = serial
+        try:
+            self.ser = serial.serial_for_url(port, baudrate=baud, timeout=0.02)
+        except (serial.SerialException, OSError, ValueError) as e:
+            raise FmtError(str(e) if port in str(e) else f"cannot open {port}: {e}") from None
+        self.port = port
+        self.baud = baud
+        self.timeout = timeout
+        self.seq = int(time.time() * 1000) & 0xFF
+        self.parser = P.Parser()
+        self.pending: list[P.Frame] = []
+        self._info = None
+        self.snap_frame = None      # frame number of the last heat-map snapshot (SNAP_STATUS)
+
+    def close(self):
+        try:
+            self.ser.close()
+        except Exception:
+            pass
+
+    # ---- transport ---------------------------------------------------------------
+    def _read_frames(self, max_len: int, deadline: float) -> list[P.Frame]:
+        self.parser.max_len = max_len
+        while time.monotonic() < deadline:
+            try:
+                data = self.ser.read(4096)
+            except (self.serial_mod.SerialException, OSError) as e:
+                raise FmtError(f"{self.port}: read failed: {e}") from None
+            if data:
+                frames = self.parser.feed(data)
+                if frames:
+                    return frames
+        return []
+
+    def transact(self, cmd: int, payload: bytes = b"", reply_len: int = 0) -> bytes:
+        self.seq = (self.seq + 1) & 0xFF
+        seq = self.seq
+        try:
+            self.ser.write(P.encode(seq, cmd, payload))
+            self.ser.flush()
+        except (self.serial_mod.SerialException, OSError) as e:
+            raise FmtError(f"{self.port}: write failed: {e}") from None
+        # time on the wire at the baud rate plus the allowed latency
+        wire = 10.0 * (len(payload) + reply_len + 16) / self.baud
+        deadline = time.monotonic() + self.timeout + wire
+        dropped0 = self.parser.dropped
+        while True:
+            # LEN bound: this reply, an error reply or an event frame (events may be on)
+            frames = self._read_frames(max(reply_len, P.EVENT_BYTES), deadline)
+            if not frames:
+                bad = self.parser.dropped - dropped0
+                why = f" ({bad} bytes with a bad CRC or framing discarded)" if bad else ""
+                raise FmtError(f"no valid reply to {P.COMMANDS.get(cmd, hex(cmd))} from "
+                               f"{self.port} within {self.timeout + wire:.1f} s{why}")
+            answer = None
+            for fr in frames:
+                if fr.cmd == P.CMD_EVENT:
+                    self.pending.append(fr)   # kept for events(), in order
+                elif fr.seq == seq and answer is None:
+                    answer = fr
+                # anything else is a stale reply (e.g. a junk-burst error): ignored
+            if answer is not None:
+                try:
+                    return P.check_reply(answer, seq, cmd)
+                except P.ProtocolError as e:
+                    raise FmtError(str(e)) from None
+
+    # ---- commands ----------------------------------------------------------------
+    def info(self) -> dict:
+        if self._info is None:
+            try:
+                self._info = P.decode_info(self.transact(P.CMD_INFO, b"", P.INFO_LEN))
+            except P.ProtocolError as e:
+                raise FmtError(str(e)) from None
+        return self._info
+
+    def read(self, addr: int, n: int = 1) -> list[int]:
+        out = []
+        while n > 0:
+            k = min(n, P.MAX_READ)
+            p = self.transact(P.CMD_READ, struct.pack(">HB", addr, k), 4 * k)
+            out += P.payload_words(p)
+            addr += k
+            n -= k
+        return out
+
+    def write(self, addr: int, values) -> None:
+        values = [int(v) & 0xFFFFFFFF for v in values]
+        per = max(1, (self.info()["payload_max"] - 2) // 4)
+        for i in range(0, len(values), per):
+            chunk = values[i:i + per]
+            self.transact(P.CMD_WRITE, struct.pack(">H", addr + i)
+                          + b"".join(struct.pack(">I", v) for v in chunk), 0)
+
+    def blkread(self, addr: int, n: int) -> list[int]:
+        out = []
+        while n > 0:
+            k = min(n, 1024)
+            out += P.payload_words(self.transact(P.CMD_BLKREAD, struct.pack(">HH", addr, k), 4 * k))
+            addr += k
+            n -= k
+        return out
+
+    def stream(self, on: bool) -> None:
+        self.transact(P.CMD_STREAM, bytes([1 if on else 0]), 0)
+
+    def events(self, count: int | None, timeout: float):
+        """Yield decoded events until ``count`` (None = forever)."""
+        got = 0
+        last = time.monotonic()
+        while count is None or got < count:
+            while self.pending:
+                fr = self.pending.pop(0)
+                yield P.unpack_event(fr.payload)
+                got += 1
+                last = time.monotonic()
+                if count is not None and got >= count:
+                    return
+            frames = self._read_frames(P.EVENT_BYTES, time.monotonic() + 0.2)
+            self.pending += [f for f in frames if f.cmd == P.CMD_EVENT]
+            if not self.pending and time.monotonic() - last > timeout:
+                raise FmtError(f"no event for {timeout:.1f} s (is anything touching the sensor?)")
+
+    def heatmap(self) -> "np.ndarray":
+        import numpy as np
+        inf = self.info()
+        rows, cols = inf["rows"], inf["cols"]
+        if "SNAP_REQ" in regmap.BY_NAME:            # request a coherent whole-frame snapshot
+            self.write(regmap.BY_NAME["SNAP_REQ"].addr, [1])
+            st_addr = regmap.BY_NAME["SNAP_STATUS"].addr
+            deadline = time.monotonic() + self.timeout
+            while True:
+                st = self.read(st_addr)[0]
+                if (st >> 31) & 1 and not (st >> 30) & 1:     # complete, nothing pending
+                    self.snap_frame = st & 0xFFFF
+                    break
+                if time.monotonic() > deadline:
+                    raise FmtError(f"heat-map snapshot not complete within {self.timeout:.1f} s "
+                                   f"(SNAP_STATUS 0x{st:08X})")
+        w = self.blkread(regmap.WINDOW_BY_NAME["HEATMAP"].base, rows * cols)
+        mask = (1 << inf["hm_width"]) - 1
+        return (np.array(w, dtype=np.int64) & mask).reshape(rows, cols)
+
+
+def parse_int(s: str) -> int:
+    try:
+        return int(s, 0)
+    except ValueError:
+        raise FmtError(f"'{s}' is not a number") from None
+
+
+def resolve(name: str):
+    """(address, Reg or None) of a register name or a numeric address."""
+    if name[:1].isdigit():
+        a = parse_int(name)
+        for r in regmap.REGISTERS:
+            if r.addr == a:
+                return a, r
+        return a, None
+    try:
+        r = regmap.lookup(name)
+    except KeyError as e:
+        raise FmtError(str(e.args[0])) from None
+    return r.addr, r
+
+
+# ---- sub-commands ------------------------------------------------------------------------
+def cmd_info(dev: Device, a) -> None:
+    inf = dev.info()
+    for k, v in inf.items():
+        print(f"{k}: {v}")
+    local = regmap.regmap_id() & 0xFFFF
+    print(f"host_regmap_id: {local}")
+    if inf["regmap_id"] != local:
+        print("warning: the device's register map differs from this fmtctl's", file=sys.stderr)
+
+
+def cmd_get(dev: Device, a) -> None:
+    addr, r = resolve(a.name)
+    v = dev.read(addr)[0]
+    label = r.name if r else f"0x{addr:03X}"
+    print(f"{label} = {v} (0x{v:X})")
+
+
+def cmd_set(dev: Device, a) -> None:
+    addr, r = resolve(a.name)
+    v = parse_int(a.value)
+    if r is not None:
+        if r.access in ("const", "ro"):
+            raise FmtError(f"{r.name} is read-only ({r.access})")
+        if v < 0 or v >= 1 << r.width:
+            raise FmtError(f"{v} does not fit {r.name} ({r.width} bits)")
+    dev.write(addr, [v])
+    if r is not None and r.access == "rw":
+        back = dev.read(addr)[0]
+        if back != v:
+            raise FmtError(f"{r.name}: wrote {v}, read back {back}")
+    print(f"{r.name if r else hex(addr)} = {v} (0x{v:X})")
+
+
+def cmd_heatmap(dev: Device, a) -> None:
+    import numpy as np
+    frames, nums = [], []
+    for _ in range(max(1, a.frames)):
+        frames.append(dev.heatmap())
+        nums.append(dev.snap_frame)
+    hm = frames[0] if len(frames) == 1 else np.stack(frames)
+    np.save(a.out, hm)
+    of = "" if nums[0] is None else " of frame " + ",".join(str(n) for n in nums)
+    print(f"heat map {hm.shape}{of} saved to {a.out} (min {hm.min()}, max {hm.max()})")
+    if a.png:
+        try:
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+        except ImportError:
+            raise FmtError("--png needs matplotlib (pip install matplotlib); the .npy was saved") from None
+        fig, ax = plt.subplots(figsize=(6, 5))
+        im = ax.imshow(frames[-1], origin="upper", interpolation="nearest")
+        ax.set_xlabel("column (x)")
+        ax.set_ylabel("row (y)")
+        fig.colorbar(im, ax=ax, label="counts")
+        fig.savefig(a.png, dpi=100)
+        print(f"image saved to {a.png}")
+
+
+def cmd_touches(dev: Device, a) -> None:
+    dev.stream(True)
+    try:
+        for ev in dev.events(a.count, a.event_timeout):
+            print(json.dumps(ev), flush=True)
+    finally:
+        try:
+            dev.stream(False)
+        except FmtError:
+            pass
+
+
+def cmd_latency(dev: Device, a) -> None:
+    base = regmap.BY_NAME["LAT_FIRST_LAST"].addr
+    n = regmap.BY_NAME["LAT_TRIG_ARMED"].addr - base + 1
+    v = dict(zip(range(base, base + n), dev.read(base, n)))
+    val = lambda name: v[regmap.BY_NAME[name].addr]
+    st = {k: dev.read(regmap.BY_NAME[k].addr)[0]
+          for k in ("FRAME_COUNT", "EV_DROP_COUNT", "EV_SKIP_COUNT", "STATUS")}
+    win = regmap.WINDOW_BY_NAME["LAT_HIST"]
+    hist = dev.blkread(win.base, win.size)
+    us = lambda c: c / regmap.PROC_CLK_HZ * 1e6
+    print(f"latency in processing-clock cycles ({regmap.PROC_CLK_HZ / 1e6:.0f} MHz) and us")
+    for key, what in (("FIRST", "window end -> first event"), ("LAST", "window end -> last event"),
+                      ("TRIG", "trigger -> new contact")):
+        l, lo, hi, cnt = (val(f"LAT_{key}_{f}") for f in ("LAST", "MIN", "MAX", "COUNT"))
+        rng = f"min {lo} max {hi}" if cnt else "min - max -"
+        print(f"  {what:26s} last {l} {rng} count {cnt}  "
+              f"(last {us(l):.3f} us, max {us(hi):.3f} us)")
+    if val("LAT_TRIG_ARMED"):
+        print("  trigger armed: waiting for a new contact")
+    half = win.size // 2
+    print(f"  histogram first event ({half} bins): " + " ".join(map(str, hist[:half])))
+    print(f"  histogram last event  ({half} bins): " + " ".join(map(str, hist[half:])))
+    print(f"  frames {st['FRAME_COUNT']}, event frames dropped {st['EV_DROP_COUNT']}, "
+          f"skipped {st['EV_SKIP_COUNT']}, status flags 0x{st['STATUS']:02X}")
+
+
+def cmd_calibrate(dev: Device, a) -> None:
+    import numpy as np
+    from fmt import flatten
+    inf = dev.info()
+    print(f"capturing {a.frames} untouched frames: keep the sensor clear", file=sys.stderr)
+    base = np.stack([dev.heatmap() for _ in range(a.frames)])
+    if not a.yes:
+        print("place the calibration object (flat sheet covering the sensor), then press Enter",
+              file=sys.stderr)
+        sys.stdin.readline()
+    cal = np.stack([dev.heatmap() for _ in range(a.frames)])
+    from fmt.params import SensorConfig
+    cfg = SensorConfig(name="device", rows=inf["rows"], cols=inf["cols"], n_fft=inf["n_fft"],
+                       bin_lo=inf["bin_lo"], bin_step=inf["bin_step"], hm_width=inf["hm_width"])
+    offset, gain = flatten.calibrate(base, cal, None, cfg)
+    out = {"rows": inf["rows"], "cols": inf["cols"], "hm_width": inf["hm_width"],
+           "gain_frac_bits": flatten.GAIN_FRAC, "offset": offset.tolist(), "gain": gain.tolist()}
+    Path(a.out).write_text(json.dumps(out))
+    print(f"calibration saved to {a.out} (offset mean {offset.mean():.1f}, "
+          f"gain {gain.min() / flatten.GAIN_ONE:.3f}..{gain.max() / flatten.GAIN_ONE:.3f})")
+
+
+def cmd_load_cal(dev: Device, a) -> None:
+    try:
+        cal = json.loads(Path(a.file).read_text())
+        offset, gain = cal["offset"], cal["gain"]
+    except (OSError, ValueError, KeyError) as e:
+        raise FmtError(f"cannot read calibration {a.file}: {e}") from None
+    inf = dev.info()
+    if len(offset) != inf["rows"] or len(offset[0]) != inf["cols"]:
+        raise FmtError(f"calibration is {len(offset)} x {len(offset[0])}, device is "
+                       f"{inf['rows']} x {inf['cols']}")
+    base = regmap.BY_NAME["CAL_ROW"].addr        # CAL_ROW, CAL_COL, CAL_OFFSET, CAL_GAIN
+    n = 0
+    for r in range(inf["rows"]):
+        for c in range(inf["cols"]):
+            dev.write(base, [r, c, int(offset[r][c]), int(gain[r][c])])
+            n += 1
+    print(f"loaded {n} cells")
+
+
+def cmd_regs(_dev, a) -> None:
+    for r in regmap.REGISTERS:
+        print(f"0x{r.addr:03X} {r.name:18s} {r.access:6s} {r.width:2d}  {r.desc}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="fmtctl", description="FMT control-port host tool")
+    ap.add_argument("--port", help="serial port or pyserial URL (socket://host:port)")
+    ap.add_argument("--baud", type=int, default=115200)
+    ap.add_argument("--timeout", type=float, default=None,
+                    help="reply timeout in s (plus wire time); default 1 s, 10 s on socket:// ports "
+                         "(the simulation's UART is slow)")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    sub.add_parser("info", help="version and sizes").set_defaults(fn=cmd_info)
+    p = sub.add_parser("get", help="read a register")
+    p.add_argument("name")
+    p.set_defaults(fn=cmd_get)
+    p = sub.add_parser("set", help="write a register")
+    p.add_argument("name")
+    p.add_argument("value")
+    p.set_defaults(fn=cmd_set)
+    p = sub.add_parser("heatmap", help="heat-map snapshot to .npy (rows x cols)")
+    p.add_argument("--out", required=True)
+    p.add_argument("--png")
+    p.add_argument("--frames", type=int, default=1, help="snapshots (stacked when > 1)")
+    p.set_defaults(fn=cmd_heatmap)
+    p = sub.add_parser("touches", help="stream touch events as JSON lines")
+    p.add_argument("--count", type=int, default=None)
+    p.add_argument("--event-timeout", type=float, default=10.0)
+    p.set_defaults(fn=cmd_touches)
+    sub.add_parser("latency", help="latency counters report").set_defaults(fn=cmd_latency)
+    p = sub.add_parser("calibrate", help="field-flattening calibration (fmt.flatten.calibrate)")
+    p.add_argument("--out", required=True)
+    p.add_argument("--frames", type=int, default=16)
+    p.add_argument("--yes", action="store_true", help="do not wait for Enter before the object frames")
+    p.set_defaults(fn=cmd_calibrate)
+    p = sub.add_parser("load-cal", help="write a calibration file into the core")
+    p.add_argument("file")
+    p.set_defaults(fn=cmd_load_cal)
+    sub.add_parser("regs", help="list the register map").set_defaults(fn=cmd_regs)
+    return ap
+
+
+def main(argv=None) -> int:
+    a = build_parser().parse_args(argv)
+    if a.cmd == "regs":
+        a.fn(None, a)
+        return 0
+    if not a.port:
+        print("fmtctl: error: --port is required", file=sys.stderr)
+        return 1
+    dev = None
+    try:
+        timeout = a.timeout
+        if timeout is None:
+            timeout = 10.0 if a.port.startswith("socket://") else 1.0
+        dev = Device(a.port, a.baud, timeout)
+        a.fn(dev, a)
+        return 0
+    except FmtError as e:
+        print(f"fmtctl: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("fmtctl: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:                       # never a traceback for the user
+        print(f"fmtctl: error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 2
+    finally:
+        if dev is not None:
+            dev.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
