@@ -148,22 +148,41 @@ class Device:
     def stream(self, on: bool) -> None:
         self.transact(P.CMD_STREAM, bytes([1 if on else 0]), 0)
 
-    def events(self, count: int | None, timeout: float):
-        """Yield decoded events until ``count`` (None = forever)."""
+    def payloads(self, count: int | None, timeout: float, wait: float = 0.2):
+        """Yield event payloads until ``count`` (None = forever); after ``wait`` s
+        without an event, yield None (callers may then do other work)."""
         got = 0
         last = time.monotonic()
         while count is None or got < count:
             while self.pending:
                 fr = self.pending.pop(0)
-                yield P.unpack_event(fr.payload)
+                yield fr.payload
                 got += 1
                 last = time.monotonic()
                 if count is not None and got >= count:
                     return
-            frames = self._read_frames(P.EVENT_BYTES, time.monotonic() + 0.2)
+            frames = self._read_frames(P.EVENT_BYTES, time.monotonic() + wait)
             self.pending += [f for f in frames if f.cmd == P.CMD_EVENT]
-            if not self.pending and time.monotonic() - last > timeout:
-                raise FmtError(f"no event for {timeout:.1f} s (is anything touching the sensor?)")
+            if not self.pending:
+                if time.monotonic() - last > timeout:
+                    raise FmtError(f"no event for {timeout:.1f} s (is anything touching the sensor?)")
+                yield None
+
+    def events(self, count: int | None, timeout: float):
+        """Yield decoded events (protocol.unpack_event) until ``count`` (None = forever)."""
+        for p in self.payloads(count, timeout):
+            if p is not None:
+                yield P.unpack_event(p)
+
+    def records(self, count: int | None, timeout: float, wait: float = 0.2):
+        """Yield event records (fmt.host.events) until ``count``; None after ``wait`` s
+        without an event."""
+        from fmt.host import events as E
+        for p in self.payloads(count, timeout, wait):
+            try:
+                yield None if p is None else E.from_payload(p)
+            except P.ProtocolError as e:
+                raise FmtError(str(e)) from None
 
     def heatmap(self) -> "np.ndarray":
         import numpy as np
@@ -347,6 +366,59 @@ def cmd_load_cal(dev: Device, a) -> None:
     print(f"loaded {n} cells")
 
 
+# ---- the event stream as reports (tuio, uinput, view, record) -----------------------------
+class streaming:
+    """STREAM on inside the with-block, off after it (best effort)."""
+
+    def __init__(self, dev: Device):
+        self.dev = dev
+
+    def __enter__(self):
+        self.dev.stream(True)
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            self.dev.stream(False)
+        except FmtError:
+            pass
+        return False
+
+
+def updates(dev: Device, a):
+    """(events.Update, report) for every report of the stream, forever (until the
+    caller stops or no event arrives for --event-timeout s)."""
+    from fmt.host import events as E
+    grouper, contacts = E.Reports(), E.Contacts(a.hold_frames)
+    for rec in dev.records(None, a.event_timeout):
+        if rec is None:
+            continue
+        for rep in grouper.feed(rec):
+            yield contacts.update(rep), rep
+
+
+def cmd_tuio(dev: Device, a) -> None:
+    import socket
+    from fmt.host import events as E
+    from fmt.host import tuio
+    sensor = E.Sensor.from_info(dev.info())
+    try:
+        snd = tuio.Sender(a.host, a.osc_port, sensor, a.version, source=f"fmt@{socket.gethostname()}")
+    except OSError as e:
+        raise FmtError(f"cannot send OSC to {a.host}:{a.osc_port}: {e}") from None
+    t0 = time.monotonic()
+    with streaming(dev):
+        for upd, _rep in updates(dev, a):
+            try:
+                snd.send(upd, time.time())
+            except OSError as e:
+                raise FmtError(f"cannot send OSC to {a.host}:{a.osc_port}: {e}") from None
+            if a.count and snd.bundles >= a.count:
+                break
+    print(f"tuio {a.version}: {snd.bundles} bundles to {a.host}:{a.osc_port} "
+          f"in {time.monotonic() - t0:.1f} s")
+
+
 def cmd_regs(_dev, a) -> None:
     for r in regmap.REGISTERS:
         print(f"0x{r.addr:03X} {r.name:18s} {r.access:6s} {r.width:2d}  {r.desc}")
@@ -387,7 +459,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file")
     p.set_defaults(fn=cmd_load_cal)
     sub.add_parser("regs", help="list the register map").set_defaults(fn=cmd_regs)
+
+    def stream_opts(p):
+        p.add_argument("--count", type=int, default=0, help="stop after this many reports (0: never)")
+        p.add_argument("--event-timeout", type=float, default=3600.0,
+                       help="give up after this many s without an event (default 1 h)")
+        p.add_argument("--hold-frames", type=int, default=40,
+                       help="a contact absent from a report stays alive this many frames "
+                            "(the tracker's hold-off; a decimated stream ends it at the next report)")
+
+    p = sub.add_parser("tuio", help="the event stream as TUIO over OSC/UDP (python-osc)")
+    p.add_argument("--host", default="127.0.0.1", help="OSC receiver (default 127.0.0.1)")
+    p.add_argument("--port", dest="osc_port", type=int, default=3333, help="OSC UDP port (default 3333)")
+    p.add_argument("--version", default="1.1", choices=("1.1", "2.0"),
+                   help="TUIO 1.1 (/tuio/2Dcur) or 2.0 (/tuio2/ptr)")
+    stream_opts(p)
+    p.set_defaults(fn=cmd_tuio, needs=(("pythonosc", "python-osc"),))
     return ap
+
+
+def check_needs(a) -> None:
+    """One line for a missing optional package, before the port is opened."""
+    import importlib
+    for mod, pkg in getattr(a, "needs", ()):
+        try:
+            importlib.import_module(mod)
+        except ImportError:
+            raise FmtError(f"fmtctl {a.cmd} needs the Python package {pkg} (pip install {pkg}; "
+                           f"pinned in requirements.txt)") from None
 
 
 def main(argv=None) -> int:
@@ -395,6 +494,11 @@ def main(argv=None) -> int:
     if a.cmd == "regs":
         a.fn(None, a)
         return 0
+    try:
+        check_needs(a)
+    except FmtError as e:
+        print(f"fmtctl: error: {e}", file=sys.stderr)
+        return 2
     if not a.port:
         print("fmtctl: error: --port is required", file=sys.stderr)
         return 1
