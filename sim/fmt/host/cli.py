@@ -419,6 +419,36 @@ def cmd_tuio(dev: Device, a) -> None:
           f"in {time.monotonic() - t0:.1f} s")
 
 
+def pre_uinput(a) -> None:
+    import os
+    if not os.path.exists(a.devnode):
+        raise FmtError(f"{a.devnode} does not exist (load the uinput module: modprobe uinput)")
+    if not os.access(a.devnode, os.W_OK):
+        raise FmtError(f"{a.devnode} is not writable by this user (udev rule or group 'input')")
+
+
+def cmd_uinput(dev: Device, a) -> None:
+    from fmt.host import events as E
+    from fmt.host import uinput as U
+    sensor = E.Sensor.from_info(dev.info(), a.pitch_mm)
+    try:
+        ud = U.Device(U.MTMapper(sensor, a.slots), devnode=a.devnode)
+    except OSError as e:
+        raise FmtError(str(e)) from None
+    print(f"uinput device {ud.path}: {sensor.cols} x {sensor.rows} cells, {a.slots} slots", flush=True)
+    n = 0
+    try:
+        with streaming(dev):
+            for upd, _rep in updates(dev, a):
+                ud.send(upd)
+                n += 1
+                if a.count and n >= a.count:
+                    break
+    finally:
+        ud.close()
+    print(f"uinput: {n} reports")
+
+
 def cmd_regs(_dev, a) -> None:
     for r in regmap.REGISTERS:
         print(f"0x{r.addr:03X} {r.name:18s} {r.access:6s} {r.width:2d}  {r.desc}")
@@ -475,6 +505,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="TUIO 1.1 (/tuio/2Dcur) or 2.0 (/tuio2/ptr)")
     stream_opts(p)
     p.set_defaults(fn=cmd_tuio, needs=(("pythonosc", "python-osc"),))
+    p = sub.add_parser("uinput", help="the event stream as a Linux multitouch (protocol B) device")
+    p.add_argument("--devnode", default="/dev/uinput")
+    p.add_argument("--slots", type=int, default=16, help="multitouch slots (default 16)")
+    p.add_argument("--pitch-mm", type=float, default=5.0, help="electrode pitch (axis resolution)")
+    stream_opts(p)
+    p.set_defaults(fn=cmd_uinput, needs=(("evdev", "evdev"),), pre=pre_uinput)
     return ap
 
 
@@ -496,6 +532,8 @@ def main(argv=None) -> int:
         return 0
     try:
         check_needs(a)
+        if getattr(a, "pre", None):
+            a.pre(a)
     except FmtError as e:
         print(f"fmtctl: error: {e}", file=sys.stderr)
         return 2

@@ -19,7 +19,8 @@ TUIO 2.0::
 Session IDs are the tracker's contact IDs (0..254; blobs 256 + k), positions are
 normalised to the sensor (0..1 from the left / top edge, events.Sensor.norm), the
 angle is the major axis against the x axis in radians, widths/heights the ellipse's
-axes normalised to the sensor, pressure the strength / 2^16 (clipped to 1).
+axes (twice the event's semi-axes) normalised to the sensor width / height, the radius
+half the width, pressure the strength / 2^16 (clipped to 1).
 :func:`messages` is the pure mapping; :class:`Sender` builds and sends the bundles.
 """
 from __future__ import annotations
@@ -35,8 +36,8 @@ PRESS_FULL = 1 << 16          # strength of pressure 1.0
 def _geom(c, sensor: Sensor):
     x, y = sensor.norm(c.x_q, c.y_q)
     a = c.angle * math.pi / 256.0
-    w = c.axis_major_q / 256.0 / sensor.cols
-    h = c.axis_minor_q / 256.0 / sensor.rows
+    w = 2 * c.axis_major_q / 256.0 / sensor.cols        # the axes are semi-axes
+    h = 2 * c.axis_minor_q / 256.0 / sensor.rows
     return x, y, a, w, h
 
 
