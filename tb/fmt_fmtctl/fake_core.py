@@ -24,7 +24,7 @@ from fmt.host import events as E
 
 class FakeCore:
     def __init__(self, cfg, heatmaps=None, records=(), pace_s: float = 0.002,
-                 snapshot_frames=None):
+                 snapshot_frames=None, snap_delay_s: float = 0.0):
         self.cfg = cfg
         self.heatmaps = None if heatmaps is None else np.asarray(heatmaps)
         self.snap_frames = (list(snapshot_frames) if snapshot_frames is not None
@@ -34,6 +34,8 @@ class FakeCore:
         self.regs = {r.addr: r.reset for r in regmap.REGISTERS}
         self.snap_i = -1
         self.snap = None
+        self.snap_delay = snap_delay_s      # SNAP_STATUS says 'pending' this long after SNAP_REQ
+        self.snap_ready = 0.0
         self.stream_on = threading.Event()
         self.sent_events = 0
         self.lock = threading.Lock()
@@ -111,6 +113,11 @@ class FakeCore:
             return P.reply(fr.seq, c, P.info_payload(self.cfg, regmap.regmap_id()))
         if c == P.CMD_READ:
             addr, n = struct.unpack(">HB", p)
+            st = regmap.BY_NAME["SNAP_STATUS"].addr
+            if addr <= st < addr + n and time.monotonic() < self.snap_ready:
+                regs = dict(self.regs)
+                regs[st] = (regs[st] & ~(1 << 31)) | (1 << 30)      # a capture is pending
+                return P.reply(fr.seq, c, P.words_payload(regs.get(a, 0) for a in range(addr, addr + n)))
             return P.reply(fr.seq, c, P.words_payload(self.regs.get(a, 0) for a in range(addr, addr + n)))
         if c == P.CMD_WRITE:
             addr = struct.unpack(">H", p[:2])[0]
@@ -134,5 +141,6 @@ class FakeCore:
             self.snap_i = min(self.snap_i + 1, len(self.heatmaps) - 1)
             self.snap = self.heatmaps[self.snap_i]
             self.regs[regmap.BY_NAME["SNAP_STATUS"].addr] = (1 << 31) | (self.snap_frames[self.snap_i] & 0xFFFF)
+            self.snap_ready = time.monotonic() + self.snap_delay
             return
         self.regs[addr] = v

@@ -449,6 +449,44 @@ def cmd_uinput(dev: Device, a) -> None:
     print(f"uinput: {n} reports")
 
 
+def cmd_view(dev: Device | None, a) -> None:
+    from fmt.host import events as E
+    from fmt.host import view as V
+    if a.recording:
+        rec = _load_recording(a.recording)
+        sensor = E.Sensor(rec.rows, rec.cols)
+        frames = V.frames_of_recording(rec, a.hold_frames)
+    else:
+        sensor = E.Sensor.from_info(dev.info())
+        frames = V.frames_of_device(dev, a)
+    t0 = time.monotonic()
+    ctx = streaming(dev) if dev is not None else None
+    try:
+        if ctx is not None:
+            ctx.__enter__()
+        if a.png_dir:
+            n = V.render_to_pngs(frames, sensor, a.png_dir, limit=a.frames or None, vmax=a.vmax)
+        else:
+            try:
+                n = V.show_live(frames, sensor, limit=a.frames or None, vmax=a.vmax)
+            except RuntimeError as e:
+                raise FmtError(str(e)) from None
+    finally:
+        if ctx is not None:
+            ctx.__exit__(None, None, None)
+    dt = time.monotonic() - t0
+    where = f" to {a.png_dir}" if a.png_dir else ""
+    print(f"view: {n} frames{where} in {dt:.1f} s ({n / max(dt, 1e-9):.1f} frames/s)")
+
+
+def _load_recording(path):
+    from fmt.host import recording as R
+    try:
+        return R.load(path)
+    except ValueError as e:
+        raise FmtError(str(e)) from None
+
+
 def cmd_regs(_dev, a) -> None:
     for r in regmap.REGISTERS:
         print(f"0x{r.addr:03X} {r.name:18s} {r.access:6s} {r.width:2d}  {r.desc}")
@@ -511,6 +549,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--pitch-mm", type=float, default=5.0, help="electrode pitch (axis resolution)")
     stream_opts(p)
     p.set_defaults(fn=cmd_uinput, needs=(("evdev", "evdev"),), pre=pre_uinput)
+    p = sub.add_parser("view", help="heat map with contacts, IDs, tracks, ellipses (live or a recording)")
+    p.add_argument("--recording", help="show a recording of fmtctl record (no --port needed)")
+    p.add_argument("--png-dir", help="write the frames as PNG files here (headless) instead of a window")
+    p.add_argument("--frames", type=int, default=0, help="stop after this many frames (0: never / the end)")
+    p.add_argument("--vmax", type=float, default=None, help="heat-map colour scale top (default: first frame's max)")
+    p.add_argument("--event-timeout", type=float, default=3600.0)
+    p.add_argument("--hold-frames", type=int, default=40)
+    p.set_defaults(fn=cmd_view, port_optional=lambda a: bool(a.recording))
     return ap
 
 
@@ -537,11 +583,15 @@ def main(argv=None) -> int:
     except FmtError as e:
         print(f"fmtctl: error: {e}", file=sys.stderr)
         return 2
-    if not a.port:
+    no_port = getattr(a, "port_optional", None) and a.port_optional(a)
+    if not a.port and not no_port:
         print("fmtctl: error: --port is required", file=sys.stderr)
         return 1
     dev = None
     try:
+        if no_port:
+            a.fn(None, a)
+            return 0
         timeout = a.timeout
         if timeout is None:
             timeout = 10.0 if a.port.startswith("socket://") else 1.0
