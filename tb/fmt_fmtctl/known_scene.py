@@ -6,7 +6,7 @@ import numpy as np
 
 from fmt import params
 from fmt.host import events as E
-from fmt.touch import process_frames
+from fmt.touch import process_frames  # (also used by the tests)
 
 PEAK = 9000
 

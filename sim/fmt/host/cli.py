@@ -9,12 +9,16 @@
     fmtctl --port ... calibrate --out cal.json [--frames K] [--yes]
     fmtctl --port ... load-cal cal.json
     fmtctl regs                                     (the register map; no port needed)
+    fmtctl --port ... tuio [--host H --port P] [--version 1.1|2.0]   (TUIO over OSC/UDP)
+    fmtctl --port ... uinput [--devnode /dev/uinput]                 (Linux multitouch device)
+    fmtctl --port ... view [--png-dir DIR]          (heat map + contacts; or --recording F.npz)
+    fmtctl --port ... record --out F.npz [--snapshots K] [--events N] [--seconds S]
 
 NAME is a register name of docs/REGISTERS.md (case-insensitive) or an address (0x...).
 The simulation serves the core's UART on a socket (python -m bench.core.run_sim_rtl --serve
 PORT): socket:// ports get a longer default reply timeout (10 s; the simulated UART runs
 at a few kB/s or less, and the wire time computed from --baud does not apply there).
-Protocol: docs/PROTOCOL.md.  Any failure (port unreachable, timeout, CRC error, device
+Protocol: docs/PROTOCOL.md; the host outputs and the recording format: docs/host.md.  Any failure (port unreachable, timeout, CRC error, device
 error reply) prints ONE line on stderr and exits with status 2 (1 for usage errors).
 """
 from __future__ import annotations
@@ -25,6 +29,8 @@ import struct
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 from fmt import protocol as P
 from fmt import regmap
@@ -487,6 +493,75 @@ def _load_recording(path):
         raise FmtError(str(e)) from None
 
 
+def cmd_record(dev: Device, a) -> None:
+    from fmt.host import events as E
+    from fmt.host import recording as R
+    if not (a.snapshots or a.events or a.seconds):
+        raise FmtError("record: give --snapshots, --events or --seconds (or a mix)")
+    info = dev.info()
+    regs = {r.name: dev.read(r.addr)[0] for r in regmap.REGISTERS if r.access == "rw"}
+    cal = None
+    if a.with_cal:
+        rows, cols = info["rows"], info["cols"]
+        off = [[0] * cols for _ in range(rows)]
+        gain = [[0] * cols for _ in range(rows)]
+        base = regmap.BY_NAME["CAL_ROW"].addr            # CAL_ROW, CAL_COL, CAL_OFFSET, CAL_GAIN
+        for r in range(rows):
+            for c in range(cols):
+                dev.write(base, [r, c])
+                off[r][c], gain[r][c] = dev.read(base + 2, 2)
+        dev.write(base, [regs.get("CAL_ROW", 0), regs.get("CAL_COL", 0)])
+        cal = (off, gain)
+    hms, hfr, hts, evs, ets = [], [], [], [], []
+    t0 = time.monotonic()
+
+    def drain():
+        while dev.pending:
+            fr = dev.pending.pop(0)
+            if fr.cmd == P.CMD_EVENT:
+                try:
+                    evs.append(E.from_payload(fr.payload))
+                except P.ProtocolError as e:
+                    raise FmtError(str(e)) from None
+                ets.append(time.monotonic() - t0)
+
+    def done() -> bool:
+        if a.seconds and time.monotonic() - t0 >= a.seconds:
+            return True
+        return (not a.snapshots or len(hms) >= a.snapshots) and (not a.events or len(evs) >= a.events)
+
+    stopped = ""
+    try:
+        with streaming(dev):
+            last_ev = time.monotonic()
+            while not done():
+                n0 = len(evs)
+                if not a.snapshots or len(hms) < a.snapshots:
+                    hm = dev.heatmap()
+                    hms.append(hm)
+                    hfr.append(-1 if dev.snap_frame is None else dev.snap_frame)
+                    hts.append(time.monotonic() - t0)
+                else:
+                    frames = dev._read_frames(P.EVENT_BYTES, time.monotonic() + 0.2)
+                    dev.pending += [f for f in frames if f.cmd == P.CMD_EVENT]
+                drain()
+                if len(evs) > n0:
+                    last_ev = time.monotonic()
+                elif a.events and time.monotonic() - last_ev > a.event_timeout:
+                    raise FmtError(f"no event for {a.event_timeout:.1f} s ({len(evs)} of {a.events} recorded)")
+            drain()
+    except KeyboardInterrupt:
+        stopped = " (interrupted)"
+    meta = R.new_meta(info, a.port, regs)
+    meta["report"] = {"snapshots": len(hms), "events": len(evs), "seconds": round(time.monotonic() - t0, 3)}
+    rows, cols = info["rows"], info["cols"]
+    rec = R.Recording(meta, np.array(hms, dtype=np.int64).reshape(-1, rows, cols), np.array(hfr, dtype=np.int64),
+                      np.array(hts), evs, np.array(ets), None if cal is None else (np.array(cal[0]), np.array(cal[1])))
+    path = rec.save(a.out)
+    print(f"recorded {len(hms)} heat maps and {len(evs)} events in {meta['report']['seconds']:.1f} s "
+          f"to {path}{stopped}")
+
+
 def cmd_regs(_dev, a) -> None:
     for r in regmap.REGISTERS:
         print(f"0x{r.addr:03X} {r.name:18s} {r.access:6s} {r.width:2d}  {r.desc}")
@@ -557,6 +632,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--event-timeout", type=float, default=3600.0)
     p.add_argument("--hold-frames", type=int, default=40)
     p.set_defaults(fn=cmd_view, port_optional=lambda a: bool(a.recording))
+    p = sub.add_parser("record", help="heat-map snapshots, events and settings to one .npz (docs/host.md)")
+    p.add_argument("--out", required=True, help="the recording (.npz)")
+    p.add_argument("--snapshots", type=int, default=10, help="heat-map snapshots (default 10; 0: none)")
+    p.add_argument("--events", type=int, default=0, help="keep on until this many events (default 0)")
+    p.add_argument("--seconds", type=float, default=0.0, help="stop after this long (0: no limit)")
+    p.add_argument("--with-cal", action="store_true",
+                   help="also read the field-flattening calibration (4 transactions per cell)")
+    p.add_argument("--event-timeout", type=float, default=30.0)
+    p.set_defaults(fn=cmd_record)
     return ap
 
 
