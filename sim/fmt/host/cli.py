@@ -391,11 +391,20 @@ class streaming:
         return False
 
 
+def hold_frames(dev: Device, a) -> int:
+    """--hold-frames, or (auto, < 0) from the device's registers (events.auto_hold_frames)."""
+    if a.hold_frames >= 0:
+        return a.hold_frames
+    from fmt.host import events as E
+    regs = {n: dev.read(regmap.BY_NAME[n].addr)[0] for n in ("WINDOWS_M", "REPORT_PERIOD", "TRACK_HOLD_OFF")}
+    return E.auto_hold_frames(regs, dev.info()["n_fft"])
+
+
 def updates(dev: Device, a):
     """(events.Update, report) for every report of the stream, forever (until the
     caller stops or no event arrives for --event-timeout s)."""
     from fmt.host import events as E
-    grouper, contacts = E.Reports(), E.Contacts(a.hold_frames)
+    grouper, contacts = E.Reports(), E.Contacts(hold_frames(dev, a))
     for rec in dev.records(None, a.event_timeout):
         if rec is None:
             continue
@@ -461,9 +470,12 @@ def cmd_view(dev: Device | None, a) -> None:
     if a.recording:
         rec = _load_recording(a.recording)
         sensor = E.Sensor(rec.rows, rec.cols)
-        frames = V.frames_of_recording(rec, a.hold_frames)
+        hold = a.hold_frames if a.hold_frames >= 0 else E.auto_hold_frames(
+            rec.meta.get("registers", {}), int(rec.meta["info"]["n_fft"]))
+        frames = V.frames_of_recording(rec, hold)
     else:
         sensor = E.Sensor.from_info(dev.info())
+        a.hold_frames = hold_frames(dev, a)
         frames = V.frames_of_device(dev, a)
     t0 = time.monotonic()
     ctx = streaming(dev) if dev is not None else None
@@ -607,9 +619,9 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--count", type=int, default=0, help="stop after this many reports (0: never)")
         p.add_argument("--event-timeout", type=float, default=3600.0,
                        help="give up after this many s without an event (default 1 h)")
-        p.add_argument("--hold-frames", type=int, default=40,
-                       help="a contact absent from a report stays alive this many frames "
-                            "(the tracker's hold-off; a decimated stream ends it at the next report)")
+        p.add_argument("--hold-frames", type=int, default=-1,
+                       help="a contact absent from the reports stays alive this many frames (default "
+                            "-1: the tracker's hold-off + 2 report periods, from the registers)")
 
     p = sub.add_parser("tuio", help="the event stream as TUIO over OSC/UDP (python-osc)")
     p.add_argument("--host", default="127.0.0.1", help="OSC receiver (default 127.0.0.1)")
@@ -630,7 +642,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=int, default=0, help="stop after this many frames (0: never / the end)")
     p.add_argument("--vmax", type=float, default=None, help="heat-map colour scale top (default: first frame's max)")
     p.add_argument("--event-timeout", type=float, default=3600.0)
-    p.add_argument("--hold-frames", type=int, default=40)
+    p.add_argument("--hold-frames", type=int, default=-1, help="as for tuio (default: from the registers)")
     p.set_defaults(fn=cmd_view, port_optional=lambda a: bool(a.recording))
     p = sub.add_parser("record", help="heat-map snapshots, events and settings to one .npz (docs/host.md)")
     p.add_argument("--out", required=True, help="the recording (.npz)")

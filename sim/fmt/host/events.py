@@ -110,6 +110,18 @@ def group(records) -> list[list[dict]]:
     return out + g.flush()
 
 
+def auto_hold_frames(regs: dict, n_fft: int, clk_per_sample: int = 3) -> int:
+    """How long a contact absent from the reports stays alive, in frames, from the
+    registers (name -> value): the tracker's hold-off (TRACK_HOLD_OFF) plus two report
+    periods (REPORT_PERIOD clk over a frame of clk_per_sample x N x WINDOWS_M clk).  The
+    UART also drops an event that arrives while it is sending, so a report may lack a
+    contact that is still there."""
+    m = max(1, int(regs.get("WINDOWS_M", 1)))
+    frame_clk = clk_per_sample * n_fft * m
+    per = int(regs.get("REPORT_PERIOD", 0))
+    return int(regs.get("TRACK_HOLD_OFF", 33)) + 2 * (-(-per // frame_clk))
+
+
 @dataclass
 class Contact:
     key: int                  # tracker ID 0..254, or BLOB_KEY + k for the k-th blob
@@ -148,8 +160,10 @@ class Contacts:
         self.hold = hold_frames
         self.alive: dict[int, Contact] = {}
 
-    def update(self, report: list[dict]) -> Update:
-        frame = report[0]["frame"] if report else 0
+    def update(self, report: list[dict], frame: int | None = None) -> Update:
+        """The contacts after ``report`` (``frame``: of an empty report, default 0)."""
+        if frame is None:
+            frame = report[0]["frame"] if report else 0
         before = set(self.alive)
         nxt = {k: c for k, c in self.alive.items()
                if not c.palm and ((frame - c.frame) & 0xFFFF) <= self.hold}
