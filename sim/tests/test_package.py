@@ -26,7 +26,7 @@ def test_pyproject_names_the_packages_and_the_script():
 
 def test_requirements_pin_the_host_packages():
     pins = dict(re.findall(r"^([A-Za-z0-9_.-]+)==(\S+)$", (ROOT / "requirements.txt").read_text(), re.M))
-    for name in ("python-osc", "evdev", "imageio", "numpy", "pyserial", "matplotlib"):
+    for name in ("python-osc", "evdev", "imageio", "fusesoc", "numpy", "pyserial", "matplotlib"):
         assert name in pins, name
     mk = (ROOT / "Makefile").read_text()
     assert "pip install -q --disable-pip-version-check --no-deps -e ." in mk
