@@ -163,3 +163,25 @@ def test_view_live_cli(scene, tmp_path):
     img = np.asarray(Image.open(pngs[-1]))
     assert rgb(img, ren.pixel_of(still["x_q"] / 256, still["y_q"] / 256)) == (255, 0, 0)
     assert core.snap_i == 5                                  # one snapshot per frame
+
+
+@pytest.mark.parametrize("cmd", [["tuio"], ["uinput", "--devnode", "/dev/null"], ["view", "--png-dir", "x"],
+                                 ["record", "--out", "x.npz"]])
+def test_new_commands_unreachable_port(cmd, tmp_path):
+    """Every new command on a port nobody listens on: one line, exit 2."""
+    import socket
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    r = subprocess.run([sys.executable, str(FMTCTL), "--port", f"socket://127.0.0.1:{port}", *cmd],
+                       capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    assert r.returncode == 2 and r.stdout == "" and "Traceback" not in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and "refused" in r.stderr.lower(), r.stderr
+
+
+def test_view_missing_package():
+    code = ("import sys; sys.modules['matplotlib'] = None; from fmt.host.cli import main; "
+            "sys.exit(main(['view', '--recording', 'x.npz', '--png-dir', 'x']))")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "matplotlib" in r.stderr, r.stderr

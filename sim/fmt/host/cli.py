@@ -643,7 +643,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--vmax", type=float, default=None, help="heat-map colour scale top (default: first frame's max)")
     p.add_argument("--event-timeout", type=float, default=3600.0)
     p.add_argument("--hold-frames", type=int, default=-1, help="as for tuio (default: from the registers)")
-    p.set_defaults(fn=cmd_view, port_optional=lambda a: bool(a.recording))
+    p.set_defaults(fn=cmd_view, port_optional=lambda a: bool(a.recording),
+                   needs=(("matplotlib", "matplotlib"), ("PIL", "pillow")))
     p = sub.add_parser("record", help="heat-map snapshots, events and settings to one .npz (docs/host.md)")
     p.add_argument("--out", required=True, help="the recording (.npz)")
     p.add_argument("--snapshots", type=int, default=10, help="heat-map snapshots (default 10; 0: none)")
