@@ -477,11 +477,9 @@ def cmd_view(dev: Device | None, a) -> None:
         sensor = E.Sensor.from_info(dev.info())
         a.hold_frames = hold_frames(dev, a)
         frames = V.frames_of_device(dev, a)
+    import contextlib
     t0 = time.monotonic()
-    ctx = streaming(dev) if dev is not None else None
-    try:
-        if ctx is not None:
-            ctx.__enter__()
+    with streaming(dev) if dev is not None else contextlib.nullcontext():
         if a.png_dir:
             n = V.render_to_pngs(frames, sensor, a.png_dir, limit=a.frames or None, vmax=a.vmax)
         else:
@@ -489,9 +487,6 @@ def cmd_view(dev: Device | None, a) -> None:
                 n = V.show_live(frames, sensor, limit=a.frames or None, vmax=a.vmax)
             except RuntimeError as e:
                 raise FmtError(str(e)) from None
-    finally:
-        if ctx is not None:
-            ctx.__exit__(None, None, None)
     dt = time.monotonic() - t0
     where = f" to {a.png_dir}" if a.png_dir else ""
     print(f"view: {n} frames{where} in {dt:.1f} s ({n / max(dt, 1e-9):.1f} frames/s)")
