@@ -120,11 +120,7 @@ class Sender:
 
     def __init__(self, host: str, port: int, sensor: Sensor, version: str = "1.1",
                  source: str = "fmt@localhost"):
-        try:
-            from pythonosc import udp_client  # noqa: F401
-        except ImportError:
-            raise ImportError("python-osc is not installed (pip install python-osc)") from None
-        from pythonosc.udp_client import UDPClient
+        from pythonosc.udp_client import UDPClient      # (fmtctl checks the package first)
         self.client = UDPClient(host, port)
         self.sensor, self.version, self.source = sensor, version, source
         self.bundles = 0
