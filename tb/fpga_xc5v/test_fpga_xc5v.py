@@ -1,5 +1,5 @@
 """cocotb tests of the XC5VSX95T board core (fpga/xc5vsx95t/rtl/fpga_core.v) with
-behavioural models (tb/fpga_xc5v/models.py) of the ADS5272-class ADC's serial output
+behavioural models (tb/fpga_xc5v/board_models.py) of the ADS5272-class ADC's serial output
 (lane skews in IODELAY taps, bit slip, test patterns over its control port), the
 IODELAY taps and the AD9834-class DDS chips (SPI, phase select).
 
@@ -31,7 +31,7 @@ from fmt import channel as _channel
 from fmt import scene as _scene
 from fmt.rx_array import rx_heatmaps_fixed
 
-import models
+import board_models as models
 
 TP = {"deskew": 0xA001, "sync": 0xA002, "normal": 0xA000}   # fpga_core's placeholders
 SER_W, ADC_BITS = 4, 12

@@ -34,10 +34,15 @@ module fpga_core #(
     parameter MAX_TOUCHES = `FMT_MAX_TOUCHES, // contact limit
     parameter ADC_BITS    = `FMT_ADC_BITS,    // ADC word width (12: ADS5272)
     parameter DAC_BITS    = `FMT_DAC_BITS,    // DAC port word width per row
+    parameter PHASE_BITS  = `FMT_PHASE_BITS,  // DDS phase accumulator width (fmt_core)
+    parameter SINE_BITS   = `FMT_SINE_BITS,   // DDS sine table width (fmt_core)
+    parameter AMP_BITS    = `FMT_AMP_BITS,    // DDS amplitude width (fmt_core)
     parameter PN_BITS     = `FMT_PN_BITS,     // PN LFSR length (as fmt_core)
+    parameter CLK_PER_SAMPLE = 3,             // clk per ADC sample; the lanes give ADC_BITS / CLK_PER_SAMPLE bits per clk
+    parameter M_MAX       = 255,              // largest windows per frame (fmt_core)
     parameter CH_PER_CHIP = 8,                // ADC channels per chip
     parameter CHIPS       = (COLS + CH_PER_CHIP - 1) / CH_PER_CHIP,  // ADC chips
-    parameter SER_W       = 4,                // ISERDES bits per lane per clk (ADC_BITS / 3)
+    parameter SER_W       = ADC_BITS / CLK_PER_SAMPLE,  // ISERDES bits per lane per clk (4 at 3 clk per sample)
     parameter TAPS        = 64,               // IODELAY taps
     parameter DWELL       = 16,               // word periods judged per tap
     parameter SETTLE      = 64,               // word periods after an ADC register write
@@ -48,6 +53,7 @@ module fpga_core #(
     parameter [15:0] TP_NORMAL = 16'hA000,    // ADC register word: normal data (PLACEHOLDER, README)
     parameter LSB_FIRST   = 0,                // 1: the ADC lanes send the LSB first
     parameter UART_DIV    = 1085,             // clk per UART bit (125 MHz: 115200 baud)
+    parameter UART_TIMEOUT = 40,              // control-port inter-byte timeout, bit times
     parameter EV_DEPTH    = 2048,             // event FIFO entries
     parameter BLOBS       = 1,                // blob detector built
     parameter HB_BITS     = 26                // heartbeat counter width (LED 0 = its MSB)
@@ -108,9 +114,10 @@ module fpga_core #(
     /* verilator lint_off PINCONNECTEMPTY */  // event fields: the UART streams them
     fmt_core #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
-        .ADC_BITS(ADC_BITS), .DAC_BITS(DAC_BITS), .PN_BITS(PN_BITS), .HM_W(HM_W),
-        .MAX_TOUCHES(MAX_TOUCHES), .CLK_PER_SAMPLE(3), .EV_DEPTH(EV_DEPTH), .BLOBS(BLOBS),
-        .UART_DIV(UART_DIV)
+        .ADC_BITS(ADC_BITS), .DAC_BITS(DAC_BITS), .PHASE_BITS(PHASE_BITS),
+        .SINE_BITS(SINE_BITS), .AMP_BITS(AMP_BITS), .PN_BITS(PN_BITS), .HM_W(HM_W),
+        .MAX_TOUCHES(MAX_TOUCHES), .CLK_PER_SAMPLE(CLK_PER_SAMPLE), .M_MAX(M_MAX),
+        .EV_DEPTH(EV_DEPTH), .BLOBS(BLOBS), .UART_DIV(UART_DIV), .UART_TIMEOUT(UART_TIMEOUT)
     ) u_core (
         .clk(clk), .rst(core_rst_q), .ce_o(ce), .dac_o(dac_o), .adc_i(adc_words),
         .ev_valid_o(), .ev_ready_i(1'b1), .ev_frame_o(), .ev_time_o(), .ev_id_o(),
