@@ -62,7 +62,7 @@ async def _run(dut, frames: int, seed: int, skew=None, slip=None, dds_check=Fals
     dut.trig_i.value = 0
     dut.adc_data_bits_i.value = 0
     dut.adc_frame_bits_i.value = 0
-    core_adc, core_rx, core_tx, beats, eofs, psel = [], [], [], [], [], []
+    core_adc, core_rx, core_tx, beats, eofs, psel, ce_cyc = [], [], [], [], [], [], []
     trained_at = None
     mask = (1 << cfg.hm_width) - 1
     max_cycles = 40000 + frames * cfg.n_fft * 3
@@ -84,6 +84,7 @@ async def _run(dut, frames: int, seed: int, skew=None, slip=None, dds_check=Fals
         if ce and running:
             # the next rising edge is a ce edge: fmt_core takes these words and signs
             core_adc.append(_int(dut.adc_words))
+            ce_cyc.append(cyc + 1)                   # the rising edge that takes them
             core_rx.append(_int(dut.u_core.rx_sign))
             core_tx.append(_int(dut.u_core.u_tx.tx_sign_o))
             psel.append(_int(dut.dds_psel_o))
@@ -125,7 +126,12 @@ async def _run(dut, frames: int, seed: int, skew=None, slip=None, dds_check=Fals
     for f in range(n_frames):
         for r in range(cfg.rows):
             assert got[(f, r)] == [int(x) for x in hm[f, r]], (f, r, got[(f, r)], hm[f, r])
-    dut._log.info(f"{n_frames} heat maps bit-exact; core sample 0 = ADC sample {i0}")
+    # receive path: first serial bit of sample i leaving the ADC (no lane delay) -> the ce
+    # edge that gives it to fmt_core, in clk (the bit stream starts at clk 0)
+    lat = {ce_cyc[k] - (ADC_BITS * (i0 + k + adc.w_norm) + adc.slip[0]) / SER_W for k in range(n)}
+    dut._log.info(f"{n_frames} heat maps bit-exact; core sample 0 = ADC sample {i0}; "
+                  f"receive path {sorted(lat)} clk")
+    assert len(lat) == 1
     return cfg, chips, dds_spi, core_tx, psel
 
 

@@ -19,7 +19,7 @@
 // + this receive path).
 // DAC port: dac_o = fmt_core dac_o (row r at [r*DAC_BITS +: DAC_BITS], signed, new word
 // after each dac_ce_o) for boards that carry DACs instead of DDS chips.
-// LEDs: 0 heartbeat (~1 Hz at 125 MHz), 1 ADC trained, 2 DDS programmed, 3 training
+// LEDs: 0 heartbeat (1.9 Hz at 125 MHz), 1 ADC trained, 2 DDS programmed, 3 training
 // restarted, 4 frame lane lost, 5..7 fmt_core status bits 0..2.
 `default_nettype none
 `include "fmt_defaults.vh"
