@@ -21,8 +21,8 @@
 //     run is shorter than MIN_EYE taps restarts the training, err_o).
 //  2. TP_SYNC (SYNC_WORD on every data lane, the frame clock's own shape): each lane's
 //     word boundary b (0 .. ADC_BITS-1 bits before the newest bit of a period) is found
-//     and must hold for LOCK periods (else restart).  A data lane takes its word at
-//     e = b_f + ADC_BITS + d, b_f the boundary of chip 0's frame lane (one reference for
+//     and must hold for LOCK periods (else restart).  A data lane takes the word ending
+//     at e = B + d, B = chip 0's frame-lane boundary b_f, + ADC_BITS if b_f < ADC_BITS/2 (one reference for
 //     all chips: every lane's word of one sample clock edge is taken in the same period)
 //     and d = b - b_f wrapped to -ADC_BITS/2 .. ADC_BITS/2-1: every lane may be skewed by
 //     up to half a word against chip 0's frame clock (whole bits; the delay scan removes
@@ -31,8 +31,9 @@
 //     its boundary (else lost_o, sticky until the next training).
 // Output: adc_o changes one clk after each word period's strobe (word_stb_o) and holds for
 // WPC clk; bit order MSB first on the lane (LSB_FIRST = 1 reverses).
-// Storage: (COLS + CHIPS) x (4 x ADC_BITS)-bit lane histories, per-lane run counters,
-// COLS x ADC_BITS output words.  Latency: a word's last bit -> adc_o 2 .. 2 + WPC clk plus
+// Storage: (COLS + CHIPS) x (2 x ADC_BITS)-bit lane histories, per-lane run counters,
+// COLS x 2 x ADC_BITS word registers (previous word, output); per data lane a 12:1 word
+// select (its boundary) and a 2:1 (latest or previous word).  Latency: a word's last bit -> adc_o 2 .. 2 + WPC clk plus
 // its lane offset.  No model twin: tb/fpga_xc5v checks it against the ADC's serial model.
 `default_nettype none
 
@@ -73,7 +74,7 @@ module fmt_adc_deser #(
 );
     localparam NL    = COLS + CHIPS;            // lanes
     localparam WPC   = ADC_BITS / SER_W;        // clk per word
-    localparam HW    = 4 * ADC_BITS;            // history bits per lane
+    localparam HW    = 2 * ADC_BITS;            // history bits per lane
     localparam HALF  = ADC_BITS / 2;
     localparam WPC_W = (WPC > 1) ? $clog2(WPC) : 1;
     localparam TAP_W = $clog2(TAPS + 1);
@@ -143,7 +144,7 @@ module fmt_adc_deser #(
     reg  [TAP_W-1:0] best_s_q [0:NL-1];
     reg  [TAP_W-1:0] best_n_q [0:NL-1];
     reg  [TAP_W-1:0] cent_q  [0:NL-1];
-    reg  [E_W-1:0]   e_q     [0:NL-1];
+    reg  [COLS-1:0]  sp_q;                        // data lane gives its previous word
     reg              eye_ok;
     always @(*) begin
         eye_ok = 1'b1;
@@ -151,29 +152,27 @@ module fmt_adc_deser #(
             if (best_n_q[l] < MIN_T) eye_ok = 1'b0;
     end
 
-    // word offsets from the boundaries (data lanes; frame lanes keep theirs)
-    reg  [E_W-1:0]   e_new [0:NL-1];
+    // which word a data lane gives: its latest complete word (ending b bits before the
+    // newest) or the one before (ending b + ADC_BITS bits before): the one that ends at
+    // e = B + d, B = b_f (+ ADC_BITS when b_f < ADC_BITS/2) the reference boundary in
+    // HALF .. HALF + ADC_BITS - 1, so e is in 0 .. 2 ADC_BITS - 2: the previous word when
+    // e >= ADC_BITS
+    reg  [COLS-1:0]  sp_new;
     reg  [B_W:0]     dd;
-    reg  [E_W-1:0]   bf;
+    reg  [B_W+1:0]   ee;
     always @(*) begin
         dd = {(B_W+1){1'b0}};
-        bf = {E_W{1'b0}};
-        for (l = 0; l < NL; l = l + 1) begin
-            if (l < COLS) begin
-                bf = {{(E_W-B_W){1'b0}}, b_q[COLS]};
-                // d = b - b_f mod ADC_BITS, in 0 .. ADC_BITS-1
-                if (b_q[l] >= b_q[COLS])
-                    dd = {1'b0, b_q[l]} - {1'b0, b_q[COLS]};
-                else
-                    dd = {1'b0, b_q[l]} + ADC_BITS[B_W:0] - {1'b0, b_q[COLS]};
-                // e = b_f + ADC_BITS + d (d < HALF) or b_f + d (d >= HALF: d - ADC_BITS)
-                if (dd < HALF[B_W:0])
-                    e_new[l] = bf + ADC_BITS[E_W-1:0] + {{(E_W-B_W-1){1'b0}}, dd};
-                else
-                    e_new[l] = bf + {{(E_W-B_W-1){1'b0}}, dd};
-            end else begin
-                e_new[l] = {{(E_W-B_W){1'b0}}, b_q[l]};
-            end
+        ee = {(B_W+2){1'b0}};
+        for (l = 0; l < COLS; l = l + 1) begin
+            // d = b - b_f mod ADC_BITS, in 0 .. ADC_BITS-1 (d >= HALF stands for d - ADC_BITS)
+            if (b_q[l] >= b_q[COLS])
+                dd = {1'b0, b_q[l]} - {1'b0, b_q[COLS]};
+            else
+                dd = {1'b0, b_q[l]} + ADC_BITS[B_W:0] - {1'b0, b_q[COLS]};
+            ee = {2'b00, b_q[COLS]} + {1'b0, dd};
+            if ({1'b0, b_q[COLS]} < HALF[B_W:0]) ee = ee + ADC_BITS[B_W+1:0];
+            if (dd >= HALF[B_W:0])               ee = ee - ADC_BITS[B_W+1:0];
+            sp_new[l] = (ee >= ADC_BITS[B_W+1:0]);
         end
     end
 
@@ -192,11 +191,11 @@ module fmt_adc_deser #(
             skip_q    <= 1'b1;
             good_q    <= {NL{1'b1}};
             if (rst) err_q <= 1'b0;
+            sp_q      <= {COLS{1'b0}};
             spi_word_q <= TP_DESKEW;
             for (l = 0; l < NL; l = l + 1) begin
                 prev_q[l]   <= {ADC_BITS{1'b0}};
                 b_q[l]      <= {B_W{1'b0}};
-                e_q[l]      <= {E_W{1'b0}};
                 cur_s_q[l]  <= {TAP_W{1'b0}};
                 cur_n_q[l]  <= {TAP_W{1'b0}};
                 best_s_q[l] <= {TAP_W{1'b0}};
@@ -302,7 +301,7 @@ module fmt_adc_deser #(
                         spi_word_q <= TP_DESKEW;
                         st_q  <= S_SPI1;
                     end else if (cnt_q == LOCK_C) begin
-                        for (l = 0; l < NL; l = l + 1) e_q[l] <= e_new[l];
+                        sp_q <= sp_new;
                         spi_word_q <= TP_NORMAL;
                         st_q       <= S_SPI3;
                     end
@@ -319,11 +318,14 @@ module fmt_adc_deser #(
     // ---------------------------------------------------------------- output words
     reg  [ADC_BITS-1:0] w_q [0:COLS-1];
     reg                 stb_q;
+    reg  [ADC_BITS-1:0] pw_q [0:COLS-1];     // the lane's word of the previous period
+    reg  [ADC_BITS-1:0] cur  [0:COLS-1];     // the lane's latest complete word
     reg  [ADC_BITS-1:0] wraw [0:COLS-1];
     reg  [ADC_BITS-1:0] wsel [0:COLS-1];
     always @(*) begin
         for (l = 0; l < COLS; l = l + 1) begin
-            wraw[l] = hist_q[l][e_q[l] +: ADC_BITS];
+            cur[l]  = hist_q[l][{{(E_W-B_W){1'b0}}, b_q[l]} +: ADC_BITS];
+            wraw[l] = sp_q[l] ? pw_q[l] : cur[l];
             for (b = 0; b < ADC_BITS; b = b + 1)
                 wsel[l][b] = (LSB_FIRST != 0) ? wraw[l][ADC_BITS-1-b] : wraw[l][b];
         end
@@ -331,7 +333,10 @@ module fmt_adc_deser #(
     always @(posedge clk) begin
         stb_q <= per;
         if (per)
-            for (l = 0; l < COLS; l = l + 1) w_q[l] <= wsel[l];
+            for (l = 0; l < COLS; l = l + 1) begin
+                pw_q[l] <= cur[l];
+                w_q[l]  <= wsel[l];
+            end
     end
     genvar g;
     generate
