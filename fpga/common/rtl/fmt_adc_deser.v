@@ -98,13 +98,13 @@ module fmt_adc_deser #(
     reg  [WPC_W-1:0] ph_q;
     wire             per = (ph_q == {WPC_W{1'b0}});   // the histories end on a word period
     reg  [HW-1:0]    hist_q [0:NL-1];
-    integer l, b;
+    integer lh, lc, bc, le, ls, lf, lo, bo, lq;   // one loop variable per process
     always @(posedge clk) begin
         if (rst || ph_q == WPC_LAST) ph_q <= {WPC_W{1'b0}};
         else                        ph_q <= ph_q + 1'b1;
-        for (l = 0; l < NL; l = l + 1)
-            hist_q[l] <= {hist_q[l][HW-SER_W-1:0],
-                          (l < COLS) ? data_bits_i[l*SER_W +: SER_W] : frame_bits_i[(l-COLS)*SER_W +: SER_W]};
+        for (lh = 0; lh < NL; lh = lh + 1)
+            hist_q[lh] <= {hist_q[lh][HW-SER_W-1:0],
+                          (lh < COLS) ? data_bits_i[lh*SER_W +: SER_W] : frame_bits_i[(lh-COLS)*SER_W +: SER_W]};
     end
 
     // per-lane checks of the current period (combinational)
@@ -114,18 +114,18 @@ module fmt_adc_deser #(
     reg  [B_W-1:0]      b_q  [0:NL-1];
     reg  [NL-1:0]       hold;
     always @(*) begin
-        for (l = 0; l < NL; l = l + 1) begin
-            stable[l] = (hist_q[l][ADC_BITS-1:0] == prev_q[l]) &&
-                        (hist_q[l][ADC_BITS-1:0] != {ADC_BITS{1'b0}}) &&
-                        (hist_q[l][ADC_BITS-1:0] != {ADC_BITS{1'b1}});
-            fnd[l]  = 1'b0;
-            bnew[l] = {B_W{1'b0}};
-            for (b = ADC_BITS - 1; b >= 0; b = b - 1)
-                if (hist_q[l][b +: ADC_BITS] == SYNC_WORD) begin
-                    fnd[l]  = 1'b1;
-                    bnew[l] = b[B_W-1:0];
+        for (lc = 0; lc < NL; lc = lc + 1) begin
+            stable[lc] = (hist_q[lc][ADC_BITS-1:0] == prev_q[lc]) &&
+                        (hist_q[lc][ADC_BITS-1:0] != {ADC_BITS{1'b0}}) &&
+                        (hist_q[lc][ADC_BITS-1:0] != {ADC_BITS{1'b1}});
+            fnd[lc]  = 1'b0;
+            bnew[lc] = {B_W{1'b0}};
+            for (bc = ADC_BITS - 1; bc >= 0; bc = bc - 1)
+                if (hist_q[lc][bc +: ADC_BITS] == SYNC_WORD) begin
+                    fnd[lc]  = 1'b1;
+                    bnew[lc] = bc[B_W-1:0];
                 end
-            hold[l] = (hist_q[l][{{(E_W-B_W){1'b0}}, b_q[l]} +: ADC_BITS] == SYNC_WORD);
+            hold[lc] = (hist_q[lc][{{(E_W-B_W){1'b0}}, b_q[lc]} +: ADC_BITS] == SYNC_WORD);
         end
     end
 
@@ -148,8 +148,8 @@ module fmt_adc_deser #(
     reg              eye_ok;
     always @(*) begin
         eye_ok = 1'b1;
-        for (l = 0; l < NL; l = l + 1)
-            if (best_n_q[l] < MIN_T) eye_ok = 1'b0;
+        for (le = 0; le < NL; le = le + 1)
+            if (best_n_q[le] < MIN_T) eye_ok = 1'b0;
     end
 
     // which word a data lane gives: its latest complete word (ending b bits before the
@@ -163,16 +163,16 @@ module fmt_adc_deser #(
     always @(*) begin
         dd = {(B_W+1){1'b0}};
         ee = {(B_W+2){1'b0}};
-        for (l = 0; l < COLS; l = l + 1) begin
+        for (ls = 0; ls < COLS; ls = ls + 1) begin
             // d = b - b_f mod ADC_BITS, in 0 .. ADC_BITS-1 (d >= HALF stands for d - ADC_BITS)
-            if (b_q[l] >= b_q[COLS])
-                dd = {1'b0, b_q[l]} - {1'b0, b_q[COLS]};
+            if (b_q[ls] >= b_q[COLS])
+                dd = {1'b0, b_q[ls]} - {1'b0, b_q[COLS]};
             else
-                dd = {1'b0, b_q[l]} + ADC_BITS[B_W:0] - {1'b0, b_q[COLS]};
+                dd = {1'b0, b_q[ls]} + ADC_BITS[B_W:0] - {1'b0, b_q[COLS]};
             ee = {2'b00, b_q[COLS]} + {1'b0, dd};
             if ({1'b0, b_q[COLS]} < HALF[B_W:0]) ee = ee + ADC_BITS[B_W+1:0];
             if (dd >= HALF[B_W:0])               ee = ee - ADC_BITS[B_W+1:0];
-            sp_new[l] = (ee >= ADC_BITS[B_W+1:0]);
+            sp_new[ls] = (ee >= ADC_BITS[B_W+1:0]);
         end
     end
 
@@ -193,18 +193,18 @@ module fmt_adc_deser #(
             if (rst) err_q <= 1'b0;
             sp_q      <= {COLS{1'b0}};
             spi_word_q <= TP_DESKEW;
-            for (l = 0; l < NL; l = l + 1) begin
-                prev_q[l]   <= {ADC_BITS{1'b0}};
-                b_q[l]      <= {B_W{1'b0}};
-                cur_s_q[l]  <= {TAP_W{1'b0}};
-                cur_n_q[l]  <= {TAP_W{1'b0}};
-                best_s_q[l] <= {TAP_W{1'b0}};
-                best_n_q[l] <= {TAP_W{1'b0}};
-                cent_q[l]   <= {TAP_W{1'b0}};
+            for (lf = 0; lf < NL; lf = lf + 1) begin
+                prev_q[lf]   <= {ADC_BITS{1'b0}};
+                b_q[lf]      <= {B_W{1'b0}};
+                cur_s_q[lf]  <= {TAP_W{1'b0}};
+                cur_n_q[lf]  <= {TAP_W{1'b0}};
+                best_s_q[lf] <= {TAP_W{1'b0}};
+                best_n_q[lf] <= {TAP_W{1'b0}};
+                cent_q[lf]   <= {TAP_W{1'b0}};
             end
         end else begin
             if (per)
-                for (l = 0; l < NL; l = l + 1) prev_q[l] <= hist_q[l][ADC_BITS-1:0];
+                for (lf = 0; lf < NL; lf = lf + 1) prev_q[lf] <= hist_q[lf][ADC_BITS-1:0];
             case (st_q)
                 // one register write, then wait until the transfer ends
                 S_SPI1, S_SPI2, S_SPI3: begin
@@ -234,16 +234,16 @@ module fmt_adc_deser #(
                         good_q <= good_q & stable;
                         cnt_q  <= cnt_q + 1'b1;
                         if (cnt_q == DWELL_C - 1'b1) begin
-                            for (l = 0; l < NL; l = l + 1) begin
-                                if (good_q[l] && stable[l]) begin
-                                    if (cur_n_q[l] == {TAP_W{1'b0}}) cur_s_q[l] <= tap_q;
-                                    cur_n_q[l] <= cur_n_q[l] + 1'b1;
-                                    if (cur_n_q[l] + 1'b1 > best_n_q[l]) begin
-                                        best_n_q[l] <= cur_n_q[l] + 1'b1;
-                                        best_s_q[l] <= (cur_n_q[l] == {TAP_W{1'b0}}) ? tap_q : cur_s_q[l];
+                            for (lf = 0; lf < NL; lf = lf + 1) begin
+                                if (good_q[lf] && stable[lf]) begin
+                                    if (cur_n_q[lf] == {TAP_W{1'b0}}) cur_s_q[lf] <= tap_q;
+                                    cur_n_q[lf] <= cur_n_q[lf] + 1'b1;
+                                    if (cur_n_q[lf] + 1'b1 > best_n_q[lf]) begin
+                                        best_n_q[lf] <= cur_n_q[lf] + 1'b1;
+                                        best_s_q[lf] <= (cur_n_q[lf] == {TAP_W{1'b0}}) ? tap_q : cur_s_q[lf];
                                     end
                                 end else begin
-                                    cur_n_q[l] <= {TAP_W{1'b0}};
+                                    cur_n_q[lf] <= {TAP_W{1'b0}};
                                 end
                             end
                             st_q <= S_STEP;
@@ -258,8 +258,8 @@ module fmt_adc_deser #(
                     tap_q    <= tap_q + 1'b1;
                     if (tap_q == TAPS_T - 1'b1) begin
                         st_q <= S_CENT;
-                        for (l = 0; l < NL; l = l + 1)
-                            cent_q[l] <= best_s_q[l] + {1'b0, best_n_q[l][TAP_W-1:1]};
+                        for (lf = 0; lf < NL; lf = lf + 1)
+                            cent_q[lf] <= best_s_q[lf] + {1'b0, best_n_q[lf][TAP_W-1:1]};
                     end else begin
                         st_q <= S_SCAN;
                     end
@@ -274,7 +274,7 @@ module fmt_adc_deser #(
                             st_q  <= S_SPI1;
                         end
                     end else begin
-                        for (l = 0; l < NL; l = l + 1) dly_ce_q[l] <= (tap_q < cent_q[l]);
+                        for (lf = 0; lf < NL; lf = lf + 1) dly_ce_q[lf] <= (tap_q < cent_q[lf]);
                         tap_q <= tap_q + 1'b1;
                         if (tap_q == TAPS_T - 1'b1) begin
                             spi_word_q <= TP_SYNC;
@@ -285,7 +285,7 @@ module fmt_adc_deser #(
                 // word boundaries: found in one period, held for LOCK periods
                 S_FIND: if (per) begin
                     if (&fnd) begin
-                        for (l = 0; l < NL; l = l + 1) b_q[l] <= bnew[l];
+                        for (lf = 0; lf < NL; lf = lf + 1) b_q[lf] <= bnew[lf];
                         cnt_q <= {CNT_W{1'b0}};
                         st_q  <= S_LOCK;
                     end else begin
@@ -307,8 +307,8 @@ module fmt_adc_deser #(
                     end
                 end
                 S_RUN: if (per) begin
-                    for (l = COLS; l < NL; l = l + 1)
-                        if (!hold[l]) lost_q <= 1'b1;
+                    for (lf = COLS; lf < NL; lf = lf + 1)
+                        if (!hold[lf]) lost_q <= 1'b1;
                 end
                 default: st_q <= S_SPI1;
             endcase
@@ -323,19 +323,19 @@ module fmt_adc_deser #(
     reg  [ADC_BITS-1:0] wraw [0:COLS-1];
     reg  [ADC_BITS-1:0] wsel [0:COLS-1];
     always @(*) begin
-        for (l = 0; l < COLS; l = l + 1) begin
-            cur[l]  = hist_q[l][{{(E_W-B_W){1'b0}}, b_q[l]} +: ADC_BITS];
-            wraw[l] = sp_q[l] ? pw_q[l] : cur[l];
-            for (b = 0; b < ADC_BITS; b = b + 1)
-                wsel[l][b] = (LSB_FIRST != 0) ? wraw[l][ADC_BITS-1-b] : wraw[l][b];
+        for (lo = 0; lo < COLS; lo = lo + 1) begin
+            cur[lo]  = hist_q[lo][{{(E_W-B_W){1'b0}}, b_q[lo]} +: ADC_BITS];
+            wraw[lo] = sp_q[lo] ? pw_q[lo] : cur[lo];
+            for (bo = 0; bo < ADC_BITS; bo = bo + 1)
+                wsel[lo][bo] = (LSB_FIRST != 0) ? wraw[lo][ADC_BITS-1-bo] : wraw[lo][bo];
         end
     end
     always @(posedge clk) begin
         stb_q <= per;
         if (per)
-            for (l = 0; l < COLS; l = l + 1) begin
-                pw_q[l] <= cur[l];
-                w_q[l]  <= wsel[l];
+            for (lq = 0; lq < COLS; lq = lq + 1) begin
+                pw_q[lq] <= cur[lq];
+                w_q[lq]  <= wsel[lq];
             end
     end
     genvar g;
