@@ -133,7 +133,7 @@ module fmt_blob #(
     // ---- sizes -------------------------------------------------------------------------
     // label slots 1..NL: every label live in two rows (P and C) plus the labels closed
     // at a row end that the close engine has not released yet (<= 6 cycles)
-    localparam NL     = 2 * ((COLS + 1) / 2) + 6;
+    localparam NL     = 2 * ((COLS + 1) / 2) + 12;
     localparam LBL_W  = $clog2(NL + 1);
     localparam SZ_W   = HM_W + AREA_W;               // sum z
     localparam SX_W   = SZ_W + COL_IDX_W;            // sum z*c
@@ -165,10 +165,17 @@ module fmt_blob #(
     localparam O_PC   = O_PR + ROW_IDX_W;
     localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
     localparam E_W    = O_FC + COL_IDX_W;
+    // event FIFO between the extraction (E, X1..X5) and the labelling (L1, L2)
+    localparam FD     = 32;                          // entries (>= events of a row + 6)
+    localparam FP_W   = 5;                           // FIFO pointer width
+    localparam FE_W   = 5 + 3 * COL_IDX_W + ROW_IDX_W + AREA_W + SZ_W + SX_W + SY_W + HM_W
+                      + COL_IDX_W;                   // entry: see F_* below
 
     localparam integer ROWS_I = ROWS;
     localparam integer MB_I   = MAX_BLOBS;
     localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
+    localparam integer FD_I = FD;
+    localparam [FP_W:0]        FD_R     = FD_I[FP_W:0];
     localparam [ROW_IDX_W:0]   ROWS_R   = ROWS_I[ROW_IDX_W:0];
     localparam [AREA_W-1:0]    MB_A     = MB_I[AREA_W-1:0];
     localparam [CNT_W-1:0]     MB_C     = MB_I[CNT_W-1:0];
@@ -222,159 +229,109 @@ module fmt_blob #(
 
     wire [ADDR_W-1:0] wr_addr = (wb_q ? ROWS_A : {ADDR_W{1'b0}})
                               + {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
+    // the on-cells of every row (z >= blob_threshold_i as the row arrives)
+    (* ram_style = "distributed" *)
+    reg [COLS-1:0]       on_mem [0:2*ROWS-1];
+    reg [COLS-1:0]       hm_on;
+    always @(*) begin : c_hm_on
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
+    end
     always @(posedge clk) begin
-        if (hm_valid_i) mem[wr_addr] <= hm_data_i;
+        if (hm_valid_i) begin
+            mem[wr_addr]    <= hm_data_i;
+            on_mem[wr_addr] <= hm_on;
+        end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
 
     localparam [1:0] S_RUN = 2'd0, S_EMIT = 2'd1, S_WAIT = 2'd2;
     reg [1:0] state_q;
 
-    // ---- F: fetch ----------------------------------------------------------------------
-    reg [ROW_IDX_W:0]   fr_q;                 // next row to fetch (ROWS = all fetched)
-    reg                 nx_v_q;
-    reg [ROW_IDX_W-1:0] nx_row_q;
-    reg [RW-1:0]        nx_z_q;
-    reg                 cur_v_q;
-    reg [ROW_IDX_W-1:0] cur_row_q;
-    reg [RW-1:0]        cur_z_q;
-    reg [COLS-1:0]      rem_q;                // on-cells of the current row not yet labelled
-    wire                row_done;             // the label stage finishes its row this cycle
-    wire                take  = nx_v_q && (!cur_v_q || row_done);
-    wire                fr_in = (fr_q < ROWS_R);
+    // ---- F: fetch: the row (block RAM: read register, then its output register) and
+    // its on-cells (thresholded as the row arrived, on_mem); the second stage also
+    // prepares the row's event starts against the previous row's on-cells ---------------
+    wire                 f2_take;             // E takes the row in F2
+    reg  [ROW_IDX_W:0]   fr_q;                // next row to fetch (ROWS = all fetched)
+    reg                  f1_v_q, f2_v_q;
+    reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
+    reg  [RW-1:0]        f1_z_q, f2_z_q;
+    reg  [COLS-1:0]      f1_c_q, f2_c_q, f2_es_q, f2_fa_q;
+    reg  [COLS-1:0]      lastc_q;             // on-cells of the row before f1's row
+    wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
+    wire                 fr_in = (fr_q < ROWS_R);
     wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
-    wire                fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!nx_v_q || take);
-    wire [ADDR_W-1:0]   rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
-                                + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
+    wire                 fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!f1_v_q || f1_mv);
+    wire [ADDR_W-1:0]    rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
+                                 + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
+    // Events of a row (C: its on-cells, P: the previous row's): A = C & P; each C run
+    // gives a run event at its start, labelled from its first A column (fa, none: a
+    // new label), and every further A run inside it a merge event at the A run's start.
+    // fa by one addition: the carry of a C run start runs through the run's C-only
+    // cells and lands on its first A cell (or beyond the run: no A cell).
+    wire [COLS-1:0]      pp   = (f1_row_q == {ROW_IDX_W{1'b0}}) ? {COLS{1'b0}} : lastc_q;
+    wire [COLS-1:0]      ca   = f1_c_q & pp;
+    wire [COLS-1:0]      cy   = f1_c_q & ~pp;
+    wire [COLS-1:0]      ccs  = f1_c_q & ~{f1_c_q[COLS-2:0], 1'b0};
+    /* verilator lint_off UNUSEDSIGNAL */     // land[COLS]: a carry beyond the last column
+    wire [COLS:0]        land = {1'b0, cy} + {1'b0, ccs};
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [COLS-1:0]      fa_f1 = land[COLS-1:0] & ~cy & f1_c_q;
+    wire [COLS-1:0]      es_f1 = ccs | (ca & ~{ca[COLS-2:0], 1'b0} & ~fa_f1);
     always @(posedge clk) begin
-        if (fetch) nx_z_q <= mem[rd_addr];
-    end
-    reg [COLS-1:0] nx_on;
-    always @(*) begin : c_nx_on
-        integer i;
-        for (i = 0; i < COLS; i = i + 1)
-            nx_on[i] = (nx_z_q[i*HM_W +: HM_W] >= blob_threshold_i);
-    end
-
-    // ---- L: labelling ------------------------------------------------------------------
-    reg [COLS*LBL_W-1:0] p_q, c_q;            // labels of the previous / current row
-    reg [NL:1]           livep_q, livec_q;    // labels present in P / in C
-    reg [NL:1]           free_q;              // free label slots
-    reg [NL:1]           pend_q;              // closed labels waiting for the close engine
-
-    // rem + lowest set bit clears the lowest run (its carry stops above the run)
-    wire [COLS-1:0] r_low = rem_q & (~rem_q + 1'b1);
-    wire [COLS-1:0] r_sum = rem_q + r_low;
-    wire [COLS-1:0] run_m = rem_q & ~r_sum;                // lowest run of rem_q
-    wire has_run = |rem_q;
-
-    reg [LBL_W-1:0] la, lb, lfree;
-    reg [NL:1] lb_bit, lfree_bit;
-    always @(*) begin : c_runlbl
-        integer i;
-        la = {LBL_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1)
-            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) la = p_q[i*LBL_W +: LBL_W];
-        lb = {LBL_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1)
-            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}} && p_q[i*LBL_W +: LBL_W] != la)
-                lb = p_q[i*LBL_W +: LBL_W];
-        lfree = {LBL_W{1'b0}};
-        for (i = NL; i >= 1; i = i - 1)
-            if (free_q[i]) lfree = i[LBL_W-1:0];
-        for (i = 1; i <= NL; i = i + 1) begin
-            lb_bit[i]    = (lb == i[LBL_W-1:0]);
-            lfree_bit[i] = (lfree == i[LBL_W-1:0]);
+        if (fetch) begin
+            f1_z_q   <= mem[rd_addr];
+            f1_c_q   <= on_mem[rd_addr];
+            f1_row_q <= fr_row;
+        end
+        if (f1_mv) begin
+            f2_z_q   <= f1_z_q;
+            f2_c_q   <= f1_c_q;
+            f2_es_q  <= es_f1;
+            f2_fa_q  <= fa_f1;
+            f2_row_q <= f1_row_q;
+            lastc_q  <= f1_c_q;
         end
     end
-    wire ha = (la != {LBL_W{1'b0}});
-    wire hb = (lb != {LBL_W{1'b0}});
-    wire fa = (lfree != {LBL_W{1'b0}});
-    wire do_merge = cur_v_q && has_run && hb;
-    wire do_run   = cur_v_q && has_run && !hb && (ha || fa);
-    wire do_new   = do_run && !ha;
-    wire [LBL_W-1:0] lrun = ha ? la : lfree;
-    wire last_row = (cur_row_q == LAST_ROW);
-    assign row_done = cur_v_q && (!has_run || (do_run && ((rem_q & ~run_m) == {COLS{1'b0}})));
 
-    // next label vectors and live masks of this cycle's step
-    reg [COLS*LBL_W-1:0] p_nx, c_nx;
-    reg [NL:1]           livep_nx, livec_nx;
-    always @(*) begin : c_step
-        integer i;
-        i = 0;                                // the loops run conditionally: no latch for i
-        p_nx = p_q;
-        c_nx = c_q;
-        livep_nx = livep_q;
-        livec_nx = livec_q;
-        if (do_merge) begin
-            for (i = 0; i < COLS; i = i + 1) begin
-                if (p_q[i*LBL_W +: LBL_W] == lb) p_nx[i*LBL_W +: LBL_W] = la;
-                if (c_q[i*LBL_W +: LBL_W] == lb) c_nx[i*LBL_W +: LBL_W] = la;
-            end
-            for (i = 1; i <= NL; i = i + 1) begin
-                if (i[LBL_W-1:0] == la && livec_q[i] == 1'b0) livec_nx[i] = |(livec_q & lb_bit);
-            end
-            livep_nx = livep_nx & ~lb_bit;
-            livec_nx = livec_nx & ~lb_bit;
-        end
-        if (do_run) begin
-            for (i = 0; i < COLS; i = i + 1)
-                if (run_m[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
-            for (i = 1; i <= NL; i = i + 1)
-                if (i[LBL_W-1:0] == lrun) livec_nx[i] = 1'b1;
-        end
-    end
-    wire [NL:1] close_k = last_row ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
-
-    // Records for the membership pass: the labels of every row at its end (after its
-    // merges), and, written at the end of row r+1 about the labels of row r, which of
-    // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
-    // by the merges of row r+1).
-    reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
-    always @(*) begin : c_alias
-        integer i;
-        for (i = 1; i <= NL; i = i + 1) begin
-            alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
-            alias_nx[(i-1)*LBL_W +: LBL_W] =
-                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == lb) ? la : alias_q[(i-1)*LBL_W +: LBL_W];
-        end
-    end
-    wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
-    (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*LBL_W-1:0]     lr_mem [0:2*ROWS-1];   // two banks, as mem
-    (* ram_style = "block" *)
-    reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
-    wire [ADDR_W-1:0] lr_wa = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
-                            + {{(ADDR_W-ROW_IDX_W){1'b0}}, cur_row_q};
-    always @(posedge clk) begin
-        if (row_done) lr_mem[lr_wa] <= c_nx;
-        if (row_done && cur_row_q != {ROW_IDX_W{1'b0}})
-            fr_mem[cur_row_q - 1'b1] <= {cont_rec, alias_nx};
-    end
-
-    // ---- X1: command register ---------------------------------------------------------
-    localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
-    reg                 x1_v_q, x1_end_q, x1_last_q;
-    reg [1:0]           x1_op_q;
-    reg [LBL_W-1:0]     x1_a_q, x1_b_q;
-    reg [COLS-1:0]      x1_m_q;
-    reg [RW-1:0]        x1_zm_q;
-    reg [ROW_IDX_W-1:0] x1_row_q;
-    reg [NL:1]          x1_k_q;
-    reg [RW-1:0]        zm;
+    // ---- E: event extraction, one event per cycle (lowest remaining event start) -------
+    reg                  e1_v_q, e1_first_q;
+    reg  [ROW_IDX_W-1:0] e1_row_q;
+    reg  [RW-1:0]        e1_z_q;
+    reg  [COLS-1:0]      e1_c_q, e1_fa_q;
+    reg  [COLS-1:0]      e1_rem_q;            // event starts not yet emitted (with b)
+    reg  [COLS-1:0]      e1_b_q;              // this event's start (one-hot; 0: empty row)
+    reg  [COLS-1:0]      e1_ge_q;             // columns >= e1_b_q
+    reg  [FP_W:0]        res_q;               // events emitted by E and not taken by L1
+    wire                 ev_last = ((e1_rem_q & ~e1_b_q) == {COLS{1'b0}});
+    wire                 ev_go   = e1_v_q && (res_q < FD_R);
+    assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
+    wire [COLS-1:0]      e1_remn = f2_take ? f2_es_q : (e1_rem_q & ~e1_b_q);
+    wire [COLS-1:0]      e1_neg  = ~e1_remn + 1'b1;      // lowest bit and up: one carry
+    wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
+    wire                 ev_run  = |(e1_b_q & e1_cs);
+    wire [COLS-1:0]      cge     = e1_c_q & e1_ge_q;
+    wire [COLS-1:0]      crun    = cge & ~(cge + e1_b_q); // the C run starting at b
+    wire [COLS-1:0]      ev_m    = ev_run ? crun : {COLS{1'b0}};
+    wire [COLS-1:0]      ev_lc   = ev_run ? (e1_fa_q & crun) : e1_b_q;
+    reg  [RW-1:0]        zm;
     always @(*) begin : c_zm
         integer i;
         for (i = 0; i < COLS; i = i + 1)
-            zm[i*HM_W +: HM_W] = run_m[i] ? cur_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
+            zm[i*HM_W +: HM_W] = ev_m[i] ? e1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
     end
 
+    // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
+    // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
+    localparam EF_W = 5;                      // event flags: run, hy, last, first, last row
+    reg                 x1_v_q;
+    reg [EF_W-1:0]      x1_f_q;
+    reg [COLS-1:0]      x1_m_q, x1_lc_q;
+    reg [RW-1:0]        x1_zm_q;
+    reg [ROW_IDX_W-1:0] x1_row_q;
     // ---- X2: group sums, run extent ---------------------------------------------------
-    reg                 x2_v_q, x2_end_q, x2_last_q;
-    reg [1:0]           x2_op_q;
-    reg [LBL_W-1:0]     x2_a_q, x2_b_q;
     reg [ROW_IDX_W-1:0] x2_row_q;
-    reg [NL:1]          x2_k_q;
     reg [NG*GSZ_W-1:0]  x2_gs_q;
     reg [NG*GSX_W-1:0]  x2_gx_q;
     reg [NG*HM_W-1:0]   x2_gm_q;
@@ -398,6 +355,16 @@ module fmt_blob #(
     reg [GS*HM_W-1:0]   gz;
     reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
     reg [HM_W+1:0]      gv0, gv1, go;
+    reg                 x2_v_q;
+    reg [EF_W-1:0]      x2_f_q;
+    reg [COL_IDX_W-1:0] x2_lc_q;
+    reg [COL_IDX_W-1:0] lc_enc;
+    always @(*) begin : c_lc_enc
+        integer i;
+        lc_enc = {COL_IDX_W{1'b0}};
+        for (i = 0; i < COLS; i = i + 1)
+            if (x1_lc_q[i]) lc_enc = lc_enc | i[COL_IDX_W-1:0];   // one-hot: OR of indices
+    end
     always @(*) begin : c_x2
         integer i, g;
         gs = {(NG*GSZ_W){1'b0}};
@@ -452,11 +419,10 @@ module fmt_blob #(
     end
 
     // ---- X3: totals -----------------------------------------------------------------------
-    reg                 x3_v_q, x3_end_q, x3_last_q;
-    reg [1:0]           x3_op_q;
-    reg [LBL_W-1:0]     x3_a_q, x3_b_q;
+    reg                 x3_v_q;
+    reg [EF_W-1:0]      x3_f_q;
+    reg [COL_IDX_W-1:0] x3_lc_q;
     reg [ROW_IDX_W-1:0] x3_row_q;
-    reg [NL:1]          x3_k_q;
     reg [AREA_W-1:0]    x3_cnt_q;
     reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q, x3_pc_q;
     reg [HM_W-1:0]      x3_pk_q;
@@ -486,37 +452,209 @@ module fmt_blob #(
         end
     end
 
-    // ---- X4: sum z*r --------------------------------------------------------------------
+
+    // ---- X4, X5: sum z*r = r * sum z, shift and add (low and high row bits, then both)
+    localparam RH = ROW_IDX_W / 2;            // row bits of the first partial product
+    reg                 y4_v_q, y5_v_q;
+    /* verilator lint_off UNUSEDSIGNAL */     // y4_e_q's sum z*r field is 0 (y4_ylo/hi)
+    reg [FE_W-1:0]      y4_e_q;               // the event (its sum z*r field: 0 in X4)
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [FE_W-1:0]      y5_e_q;
+    reg [SY_W-1:0]      y4_ylo_q, y4_yhi_q;
+    reg [SY_W-1:0]      ylo, yhi;
+    always @(*) begin : c_sy
+        integer b;
+        ylo = {SY_W{1'b0}};
+        yhi = {SY_W{1'b0}};
+        for (b = 0; b < ROW_IDX_W; b = b + 1) begin
+            if (x3_row_q[b] && b < RH)  ylo = ylo + ({{(SY_W-SZ_W){1'b0}}, x3_s_q} << b);
+            if (x3_row_q[b] && b >= RH) yhi = yhi + ({{(SY_W-SZ_W){1'b0}}, x3_s_q} << b);
+        end
+    end
+    // FIFO entry: flags, label column, row, area, sums, peak and its column, extent
+    localparam F_FL  = 0;
+    localparam F_LC  = F_FL + EF_W;
+    localparam F_ROW = F_LC + COL_IDX_W;
+    localparam F_CNT = F_ROW + ROW_IDX_W;
+    localparam F_SZ  = F_CNT + AREA_W;
+    localparam F_SX  = F_SZ + SZ_W;
+    localparam F_SY  = F_SX + SX_W;
+    localparam F_PK  = F_SY + SY_W;
+    localparam F_PC  = F_PK + HM_W;
+    localparam F_CMN = F_PC + COL_IDX_W;
+    localparam F_CMX = F_CMN + COL_IDX_W;
+    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, x3_pc_q, x3_pk_q, {SY_W{1'b0}}, x3_sx_q,
+                             x3_s_q, x3_cnt_q, x3_row_q, x3_lc_q, x3_f_q};
+    wire [FE_W-1:0] y4_ev;
+    assign y4_ev[F_SY-1:0]         = y4_e_q[F_SY-1:0];
+    assign y4_ev[F_SY +: SY_W]     = y4_ylo_q + y4_yhi_q;
+    assign y4_ev[FE_W-1:F_PK]      = y4_e_q[FE_W-1:F_PK];
+
+    // ---- the event FIFO (distributed RAM), read into L1 --------------------------------
+    (* ram_style = "distributed" *)
+    reg [FE_W-1:0]  fmem [0:FD-1];
+    reg [FP_W-1:0]  fwp_q, frp_q;
+    reg [FP_W:0]    fcnt_q;
+    wire            l1_free;
+    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l1_free;
+    always @(posedge clk) begin
+        if (y5_v_q) fmem[fwp_q] <= y5_e_q;
+    end
+
+    // ---- L: labelling, one event per cycle -----------------------------------------------
+    // L1 looks up the P label under the event's label column (P and C eagerly renamed,
+    // forwarded from this cycle's L2 step); L2 applies the event:
+    //   run event, a P label y -> ADD(y): the C run's cells get y
+    //   run event, no P label  -> NEW(n): n = a free label (prefetched, n0_q)
+    //   merge event, y != x    -> MERGE(x <- y): x = the C run's label; y is renamed x
+    //                             in P, C and alias, and is free again
+    //   the row's last event ends the row: P's labels no longer in C are closed, P = C.
+    reg [COLS*LBL_W-1:0] p_q, c_q;            // labels of the previous / current row
+    reg [NL:1]           livep_q, livec_q;    // labels present in P / in C
+    reg [NL:1]           free_q;              // free label slots (n0_q excluded)
+    reg [NL:1]           pend_q;              // closed labels waiting for the close engine
+    reg [LBL_W-1:0]      n0_q;                // the next NEW label
+    reg                  n0v_q;
+    reg [LBL_W-1:0]      x_q;                 // label of the current C run
+    reg                  l1_v_q;
+    reg [FE_W-1:0]       l1_e_q;
+    reg                  l2_v_q;
+    /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
+    reg [FE_W-1:0]       l2_e_q;
+    wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];    // L1 uses the first flag only
+    wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
+    wire             new_wait;                // a NEW waits for a free label (testbench)
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [LBL_W-1:0]      l2_y_q;              // the P label under the event (if hy)
+    reg [COLS-1:0]       l2_m_q;              // the C run's columns (run events)
+    wire [COL_IDX_W-1:0] l1_lc = l1_e_q[F_LC +: COL_IDX_W];
+    wire                 l2_isrun = l2_f[0], l2_hy = l2_f[1], l2_last = l2_f[2],
+                         l2_lastrow = l2_f[4];
+    wire [ROW_IDX_W-1:0] l2_row = l2_e_q[F_ROW +: ROW_IDX_W];
+    wire [COL_IDX_W-1:0] l2_cmin = l2_e_q[F_CMN +: COL_IDX_W];
+    // L2 step
+    wire             l2_stall = l2_v_q && l2_isrun && !l2_hy && !n0v_q;   // NEW waits
+    wire             step     = l2_v_q && !l2_stall;
+    wire             do_run   = step && l2_isrun;
+    wire             do_new   = do_run && !l2_hy;
+    wire             do_merge = step && !l2_isrun && l2_hy && (l2_y_q != x_q);
+    wire             row_done = step && l2_last;
+    wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
+    assign           new_wait = l2_stall;
+    reg  [NL:1]      vbit, rbit;              // one-hot of the merge victim, the run label
+    always @(*) begin : c_bits
+        integer i;
+        for (i = 1; i <= NL; i = i + 1) begin
+            vbit[i] = (l2_y_q == i[LBL_W-1:0]);
+            rbit[i] = (lrun == i[LBL_W-1:0]);
+        end
+    end
+    // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
+    // this cycle (C becomes P); this cycle's step forwarded
+    wire             bnd = l1_f[3] && l2_v_q;
+    reg  [LBL_W-1:0] y1_raw;
+    reg  [COLS-1:0]  l1_m;
+    always @(*) begin : c_l1
+        integer i;
+        y1_raw = {LBL_W{1'b0}};
+        for (i = 0; i < COLS; i = i + 1)
+            if (l1_lc == i[COL_IDX_W-1:0])
+                y1_raw = bnd ? c_q[i*LBL_W +: LBL_W] : p_q[i*LBL_W +: LBL_W];
+        for (i = 0; i < COLS; i = i + 1)
+            l1_m[i] = (i[COL_IDX_W-1:0] >= l1_e_q[F_CMN +: COL_IDX_W])
+                   && (i[COL_IDX_W-1:0] <= l1_e_q[F_CMX +: COL_IDX_W]);
+    end
+    wire             l1_hit = bnd && do_run && l2_m_q[l1_lc];
+    wire [LBL_W-1:0] y1 = l1_hit ? lrun
+                        : ((do_merge && y1_raw == l2_y_q) ? x_q : y1_raw);
+    wire             l2_ld = l1_v_q && (!l2_v_q || step);
+    assign           l1_free = !l1_v_q || l2_ld;
+
+    // next label vectors and live masks of this cycle's step
+    reg [COLS*LBL_W-1:0] p_nx, c_nx;
+    reg [NL:1]           livep_nx, livec_nx;
+    always @(*) begin : c_step
+        integer i;
+        p_nx = p_q;
+        c_nx = c_q;
+        for (i = 0; i < COLS; i = i + 1) begin
+            if (do_merge && p_q[i*LBL_W +: LBL_W] == l2_y_q) p_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_merge && c_q[i*LBL_W +: LBL_W] == l2_y_q) c_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
+        end
+        livep_nx = livep_q & ~(do_merge ? vbit : {NL{1'b0}});
+        livec_nx = (livec_q & ~(do_merge ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
+    end
+    wire [NL:1] close_k = l2_lastrow ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
+    // free labels: the lowest one is prefetched into n0_q
+    wire        n0_fill = !n0v_q || do_new;
+    wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
+    reg  [LBL_W-1:0] f_enc;
+    always @(*) begin : c_fenc
+        integer i;
+        f_enc = {LBL_W{1'b0}};
+        for (i = 1; i <= NL; i = i + 1)
+            if (f_low[i]) f_enc = f_enc | i[LBL_W-1:0];
+    end
+
+    // Records for the membership pass: the labels of every row at its end (after its
+    // merges), and, written at the end of row r+1 about the labels of row r, which of
+    // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
+    // by the merges of row r+1).
+    reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
+    always @(*) begin : c_alias
+        integer i;
+        for (i = 1; i <= NL; i = i + 1) begin
+            alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
+            alias_nx[(i-1)*LBL_W +: LBL_W] =
+                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == l2_y_q) ? x_q : alias_q[(i-1)*LBL_W +: LBL_W];
+        end
+    end
+    wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
+    (* ram_style = "block" *)                 // one write, one synchronous read
+    reg [COLS*LBL_W-1:0]     lr_mem [0:2*ROWS-1];   // two banks, as mem
+    (* ram_style = "block" *)
+    reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
+    wire [ADDR_W-1:0] lr_wa = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
+                            + {{(ADDR_W-ROW_IDX_W){1'b0}}, l2_row};
+    always @(posedge clk) begin
+        if (row_done) lr_mem[lr_wa] <= c_nx;
+        if (row_done && l2_row != {ROW_IDX_W{1'b0}})
+            fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
+    end
+
+    // ---- K: command register (the accumulator update of the step) -------------------------
+    localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
     reg [LBL_W-1:0]     x4_a_q, x4_b_q;
     reg [NL:1]          x4_k_q;
     reg [ROW_IDX_W-1:0] x4_row_q;
-    reg [E_W-1:0]       x4_e_q;               // the run as an entry
+    reg [E_W-1:0]       x4_e_q;                // the run as an entry
     reg [E_W-1:0]       run_e;
     // the second operand of an update: the run (ADD) or label B's entry (MERGE); one
     // combine() serves both
     wire [E_W-1:0]      acc_y;
     always @(*) begin
         run_e = {E_W{1'b0}};
-        run_e[O_AREA +: AREA_W]   = x3_cnt_q;
-        run_e[O_SZ +: SZ_W]       = x3_s_q;
-        run_e[O_SX +: SX_W]       = x3_sx_q;
-        run_e[O_SY +: SY_W]       = {{(SY_W-SZ_W){1'b0}}, x3_s_q} * x3_row_q;
-        run_e[O_RMIN +: ROW_IDX_W] = x3_row_q;
-        run_e[O_RMAX +: ROW_IDX_W] = x3_row_q;
-        run_e[O_CMIN +: COL_IDX_W] = x3_cmin_q;
-        run_e[O_CMAX +: COL_IDX_W] = x3_cmax_q;
-        run_e[O_PEAK +: HM_W]      = x3_pk_q;
-        run_e[O_PR +: ROW_IDX_W]   = x3_row_q;
-        run_e[O_PC +: COL_IDX_W]   = x3_pc_q;
-        run_e[O_FC +: COL_IDX_W]   = x3_cmin_q;
+        run_e[O_AREA +: AREA_W]    = l2_e_q[F_CNT +: AREA_W];
+        run_e[O_SZ +: SZ_W]        = l2_e_q[F_SZ +: SZ_W];
+        run_e[O_SX +: SX_W]        = l2_e_q[F_SX +: SX_W];
+        run_e[O_SY +: SY_W]        = l2_e_q[F_SY +: SY_W];
+        run_e[O_RMIN +: ROW_IDX_W] = l2_row;
+        run_e[O_RMAX +: ROW_IDX_W] = l2_row;
+        run_e[O_CMIN +: COL_IDX_W] = l2_cmin;
+        run_e[O_CMAX +: COL_IDX_W] = l2_e_q[F_CMX +: COL_IDX_W];
+        run_e[O_PEAK +: HM_W]      = l2_e_q[F_PK +: HM_W];
+        run_e[O_PR +: ROW_IDX_W]   = l2_row;
+        run_e[O_PC +: COL_IDX_W]   = l2_e_q[F_PC +: COL_IDX_W];
+        run_e[O_FC +: COL_IDX_W]   = l2_cmin;
     end
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
     // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
     // or else the close engine's label (a closed label waits while a MERGE is applied)
-    reg [E_W-1:0] acc_q [1:NL];
+    reg [E_W-1:0] acc_q [0:NL];             // (0: never written, keeps the reads in range)
     wire            b_merge = x4_v_q && (x4_op_q == OP_MERGE);
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
@@ -535,7 +673,7 @@ module fmt_blob #(
     assign acc_b_lbl = b_merge ? x4_b_q : cpick;
     reg           cl_v_q;
     reg [E_W-1:0] cl_e_q;
-    reg [ROW_IDX_W-1:0] crow_q [1:NL];        // row at whose end the label was closed
+    reg [ROW_IDX_W-1:0] crow_q [0:NL];        // row at whose end the label was closed (0: unused)
     reg [ROW_IDX_W-1:0] cl_row_q;
     reg [LBL_W-1:0]     cl_lbl_q;
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
@@ -722,7 +860,8 @@ module fmt_blob #(
         q_st_pad[NL:1] = q_st_q;
     end
 
-    wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
+    wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
+                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l1_v_q || l2_v_q || x4_v_q
                    || cl_v_q || (|pend_q);
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
@@ -734,32 +873,46 @@ module fmt_blob #(
     always @(posedge clk) begin : s_main
         integer i;
         // ---- datapath registers (no reset needed) ----
-        if (take) begin
-            cur_z_q   <= nx_z_q;
-            cur_row_q <= nx_row_q;
+        if (f2_take) begin
+            e1_z_q   <= f2_z_q;
+            e1_c_q   <= f2_c_q;
+            e1_fa_q  <= f2_fa_q;
+            e1_row_q <= f2_row_q;
         end
-        if (fetch) nx_row_q <= fr_row;
-        x1_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
-        x1_a_q   <= do_merge ? la : lrun;
-        x1_b_q   <= lb;
-        x1_m_q   <= (do_run) ? run_m : {COLS{1'b0}};
+        if (f2_take || ev_go) begin
+            e1_rem_q <= e1_remn;
+            e1_b_q   <= e1_remn & e1_neg;
+            e1_ge_q  <= e1_remn | e1_neg;
+            e1_first_q <= f2_take;
+        end
+        x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, |ev_lc, ev_run};
+        x1_m_q   <= ev_m;
+        x1_lc_q  <= ev_lc;
         x1_zm_q  <= zm;
-        x1_row_q <= cur_row_q;
-        x1_end_q <= row_done;
-        x1_last_q <= row_done && last_row;
-        x1_k_q   <= close_k;
-        x2_op_q <= x1_op_q;  x2_a_q <= x1_a_q;  x2_b_q <= x1_b_q;  x2_row_q <= x1_row_q;
-        x2_end_q <= x1_end_q;  x2_last_q <= x1_last_q;  x2_k_q <= x1_k_q;
+        x1_row_q <= e1_row_q;
+        x2_f_q <= x1_f_q;  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
         x2_gs_q <= gs;  x2_gx_q <= gx;  x2_gm_q <= gm;  x2_gc_q <= gc;
         x2_cnt_q <= cnt;  x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
-        x3_op_q <= x2_op_q;  x3_a_q <= x2_a_q;  x3_b_q <= x2_b_q;  x3_row_q <= x2_row_q;
-        x3_end_q <= x2_end_q;  x3_last_q <= x2_last_q;  x3_k_q <= x2_k_q;
+        x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= x2_cnt_q;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
         x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= tpk;  x3_pc_q <= tpc;
-        x4_op_q <= x3_op_q;  x4_a_q <= x3_a_q;  x4_b_q <= x3_b_q;
-        x4_end_q <= x3_end_q;  x4_last_q <= x3_last_q;  x4_k_q <= x3_k_q;
-        x4_e_q <= run_e;
-        x4_row_q <= x3_row_q;
+        y4_e_q <= x3_ev;  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        y5_e_q <= y4_ev;
+        if (fpop) l1_e_q <= fmem[frp_q];
+        if (l2_ld) begin
+            l2_e_q <= l1_e_q;
+            l2_y_q <= y1;
+            l2_m_q <= l1_m;
+        end
+        if (do_run) x_q <= lrun;
+        x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
+        x4_a_q   <= do_merge ? x_q : lrun;
+        x4_b_q   <= l2_y_q;
+        x4_e_q   <= run_e;
+        x4_row_q <= l2_row;
+        x4_end_q <= row_done;
+        x4_last_q <= row_done && l2_lastrow;
+        x4_k_q   <= close_k;
         // accumulators
         if (x4_v_q) begin
             case (x4_op_q)
@@ -802,9 +955,18 @@ module fmt_blob #(
             pb_q     <= 1'b0;
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
-            nx_v_q   <= 1'b0;
-            cur_v_q  <= 1'b0;
-            rem_q    <= {COLS{1'b0}};
+            f1_v_q   <= 1'b0;
+            f2_v_q   <= 1'b0;
+            e1_v_q   <= 1'b0;
+            y4_v_q   <= 1'b0;
+            y5_v_q   <= 1'b0;
+            fwp_q    <= {FP_W{1'b0}};
+            frp_q    <= {FP_W{1'b0}};
+            fcnt_q   <= {(FP_W+1){1'b0}};
+            res_q    <= {(FP_W+1){1'b0}};
+            l1_v_q   <= 1'b0;
+            l2_v_q   <= 1'b0;
+            n0v_q    <= 1'b0;
             p_q      <= {(COLS*LBL_W){1'b0}};
             c_q      <= {(COLS*LBL_W){1'b0}};
             livep_q  <= {NL{1'b0}};
@@ -857,26 +1019,34 @@ module fmt_blob #(
                 if (pb_q != wb_q && !releasing) overrun_o <= 1'b1;
             end
 
-            // ---- fetch / current row ----
+            // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
-            if (fetch) nx_v_q <= 1'b1;
-            else if (take) nx_v_q <= 1'b0;
-            if (take) begin
-                cur_v_q <= 1'b1;
-                rem_q   <= nx_on;
-            end else if (row_done) begin
-                cur_v_q <= 1'b0;
-                rem_q   <= {COLS{1'b0}};
-            end else if (do_run) begin
-                rem_q   <= rem_q & ~run_m;
-            end
+            if (fetch) f1_v_q <= 1'b1;
+            else if (f1_mv) f1_v_q <= 1'b0;
+            if (f1_mv) f2_v_q <= 1'b1;
+            else if (f2_take) f2_v_q <= 1'b0;
+            if (f2_take) e1_v_q <= 1'b1;
+            else if (ev_go && ev_last) e1_v_q <= 1'b0;
+            x1_v_q <= ev_go;
+            x2_v_q <= x1_v_q;
+            x3_v_q <= x2_v_q;
+            y4_v_q <= x3_v_q;
+            y5_v_q <= y4_v_q;
+            if (y5_v_q) fwp_q <= fwp_q + 1'b1;
+            if (fpop)   frp_q <= frp_q + 1'b1;
+            fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
+            res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
+            if (fpop) l1_v_q <= 1'b1;
+            else if (l2_ld) l1_v_q <= 1'b0;
+            if (l2_ld) l2_v_q <= 1'b1;
+            else if (step) l2_v_q <= 1'b0;
 
             // ---- labelling state ----
             alias_q <= row_done ? alias_id : alias_nx;
             if (row_done) begin
-                p_q     <= last_row ? {(COLS*LBL_W){1'b0}} : c_nx;
+                p_q     <= l2_lastrow ? {(COLS*LBL_W){1'b0}} : c_nx;
                 c_q     <= {(COLS*LBL_W){1'b0}};
-                livep_q <= last_row ? {NL{1'b0}} : livec_nx;
+                livep_q <= l2_lastrow ? {NL{1'b0}} : livec_nx;
                 livec_q <= {NL{1'b0}};
             end else begin
                 p_q     <= p_nx;
@@ -884,13 +1054,14 @@ module fmt_blob #(
                 livep_q <= livep_nx;
                 livec_q <= livec_nx;
             end
-            free_q <= (free_q & ~(do_new ? lfree_bit : {NL{1'b0}}))
-                    | (do_merge ? lb_bit : {NL{1'b0}})
+            if (n0_fill) begin
+                n0_q  <= f_enc;
+                n0v_q <= |free_q;
+            end
+            free_q <= (free_q & ~(n0_fill ? f_low : {NL{1'b0}}))
+                    | (do_merge ? vbit : {NL{1'b0}})
                     | cpick_bit;
-            x1_v_q <= do_merge || do_run || row_done;
-            x2_v_q <= x1_v_q;
-            x3_v_q <= x2_v_q;
-            x4_v_q <= x3_v_q;
+            x4_v_q <= do_merge || do_run || row_done;
             pend_q <= (pend_q & ~cpick_bit) | ((x4_v_q && x4_end_q) ? x4_k_q : {NL{1'b0}});
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
@@ -978,6 +1149,7 @@ module fmt_blob #(
                 livep_q <= {NL{1'b0}};
                 livec_q <= {NL{1'b0}};
                 free_q  <= {NL{1'b1}};
+                n0v_q   <= 1'b0;
                 alias_q <= alias_id;
             end
         end
