@@ -166,16 +166,14 @@ module fmt_blob #(
     localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
     localparam E_W    = O_FC + COL_IDX_W;
     // event FIFO between the extraction (E, X1..X5) and the labelling (L1, L2)
-    localparam FD     = 32;                          // entries (>= events of a row + 6)
     localparam FP_W   = 5;                           // FIFO pointer width
+    localparam FD     = 1 << FP_W;                   // entries (>= events of a row + 6)
     localparam FE_W   = 5 + 3 * COL_IDX_W + ROW_IDX_W + AREA_W + SZ_W + SX_W + SY_W + HM_W
                       + COL_IDX_W;                   // entry: see F_* below
 
     localparam integer ROWS_I = ROWS;
     localparam integer MB_I   = MAX_BLOBS;
     localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
-    localparam integer FD_I = FD;
-    localparam [FP_W:0]        FD_R     = FD_I[FP_W:0];
     localparam [ROW_IDX_W:0]   ROWS_R   = ROWS_I[ROW_IDX_W:0];
     localparam [AREA_W-1:0]    MB_A     = MB_I[AREA_W-1:0];
     localparam [CNT_W-1:0]     MB_C     = MB_I[CNT_W-1:0];
@@ -257,7 +255,7 @@ module fmt_blob #(
     reg                  f1_v_q, f2_v_q;
     reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
     reg  [RW-1:0]        f1_z_q, f2_z_q;
-    reg  [COLS-1:0]      f1_c_q, f2_c_q, f2_es_q, f2_fa_q;
+    reg  [COLS-1:0]      f1_c_q, f2_c_q, f2_es_q, f2_fa_q, f2_b_q, f2_ge_q;
     reg  [COLS-1:0]      lastc_q;             // on-cells of the row before f1's row
     wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
     wire                 fr_in = (fr_q < ROWS_R);
@@ -279,6 +277,7 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [COLS-1:0]      fa_f1 = land[COLS-1:0] & ~cy & f1_c_q;
     wire [COLS-1:0]      es_f1 = ccs | (ca & ~{ca[COLS-2:0], 1'b0} & ~fa_f1);
+    wire [COLS-1:0]      es_neg = ~es_f1 + 1'b1;      // the first event: lowest bit and up
     always @(posedge clk) begin
         if (fetch) begin
             f1_z_q   <= mem[rd_addr];
@@ -290,6 +289,8 @@ module fmt_blob #(
             f2_c_q   <= f1_c_q;
             f2_es_q  <= es_f1;
             f2_fa_q  <= fa_f1;
+            f2_b_q   <= es_f1 & es_neg;
+            f2_ge_q  <= es_f1 | es_neg;
             f2_row_q <= f1_row_q;
             lastc_q  <= f1_c_q;
         end
@@ -305,10 +306,10 @@ module fmt_blob #(
     reg  [COLS-1:0]      e1_ge_q;             // columns >= e1_b_q
     reg  [FP_W:0]        res_q;               // events emitted by E and not taken by L1
     wire                 ev_last = ((e1_rem_q & ~e1_b_q) == {COLS{1'b0}});
-    wire                 ev_go   = e1_v_q && (res_q < FD_R);
+    wire                 ev_go   = e1_v_q && !res_q[FP_W];   // res_q < FD
     assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
-    wire [COLS-1:0]      e1_remn = f2_take ? f2_es_q : (e1_rem_q & ~e1_b_q);
-    wire [COLS-1:0]      e1_neg  = ~e1_remn + 1'b1;      // lowest bit and up: one carry
+    wire [COLS-1:0]      e1_remr = e1_rem_q & ~e1_b_q;
+    wire [COLS-1:0]      e1_neg  = ~e1_remr + 1'b1;      // lowest bit and up: one carry
     wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
     wire                 ev_run  = |(e1_b_q & e1_cs);
     wire [COLS-1:0]      cge     = e1_c_q & e1_ge_q;
@@ -336,13 +337,11 @@ module fmt_blob #(
     reg [NG*GSX_W-1:0]  x2_gx_q;
     reg [NG*HM_W-1:0]   x2_gm_q;
     reg [NG*COL_IDX_W-1:0] x2_gc_q;
-    reg [AREA_W-1:0]    x2_cnt_q;
     reg [COL_IDX_W-1:0] x2_cmin_q, x2_cmax_q;
     reg [NG*GSZ_W-1:0]  gs;
     reg [NG*GSX_W-1:0]  gx;
     reg [NG*HM_W-1:0]   gm;
     reg [NG*COL_IDX_W-1:0] gc;
-    reg [AREA_W-1:0]    cnt;
     reg [COL_IDX_W-1:0] cmin, cmax;
     reg [HM_W-1:0]      pm1 [0:3];            // peak tournament: winners, decisions
     reg [HM_W-1:0]      pm2 [0:1];
@@ -407,15 +406,15 @@ module fmt_blob #(
             pcol = g * GS + 4 * pd3 + 2 * pi1 + pd1[{pd3, pi1}];
             gc[g*COL_IDX_W +: COL_IDX_W] = pcol[COL_IDX_W-1:0];
         end
-        cnt = {AREA_W{1'b0}};
+        // the run's first and last column: one-hot, OR of the indices
         cmin = {COL_IDX_W{1'b0}};
         cmax = {COL_IDX_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1) begin
-            cnt = cnt + {{(AREA_W-1){1'b0}}, x1_m_q[i]};
-            if (x1_m_q[i]) cmin = i[COL_IDX_W-1:0];
+        for (i = 0; i < COLS; i = i + 1) begin
+            if (x1_m_q[i] && (i == 0 || !x1_m_q[(i > 0) ? i - 1 : 0]))
+                cmin = cmin | i[COL_IDX_W-1:0];
+            if (x1_m_q[i] && (i == COLS - 1 || !x1_m_q[(i < COLS - 1) ? i + 1 : 0]))
+                cmax = cmax | i[COL_IDX_W-1:0];
         end
-        for (i = 0; i < COLS; i = i + 1)
-            if (x1_m_q[i]) cmax = i[COL_IDX_W-1:0];
     end
 
     // ---- X3: totals -----------------------------------------------------------------------
@@ -500,6 +499,13 @@ module fmt_blob #(
     always @(posedge clk) begin
         if (y5_v_q) fmem[fwp_q] <= y5_e_q;
     end
+    wire [FE_W-1:0]  f_rd = fmem[frp_q];
+    reg  [COLS-1:0]  lc_oh;                   // the label column, decoded
+    always @(*) begin : c_lc_oh
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            lc_oh[i] = (f_rd[F_LC +: COL_IDX_W] == i[COL_IDX_W-1:0]);
+    end
 
     // ---- L: labelling, one event per cycle -----------------------------------------------
     // L1 looks up the P label under the event's label column (P and C eagerly renamed,
@@ -518,6 +524,7 @@ module fmt_blob #(
     reg [LBL_W-1:0]      x_q;                 // label of the current C run
     reg                  l1_v_q;
     reg [FE_W-1:0]       l1_e_q;
+    reg [COLS-1:0]       l1_oh_q;             // the label column, one-hot
     reg                  l2_v_q;
     /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
     reg [FE_W-1:0]       l2_e_q;
@@ -527,7 +534,6 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     reg [LBL_W-1:0]      l2_y_q;              // the P label under the event (if hy)
     reg [COLS-1:0]       l2_m_q;              // the C run's columns (run events)
-    wire [COL_IDX_W-1:0] l1_lc = l1_e_q[F_LC +: COL_IDX_W];
     wire                 l2_isrun = l2_f[0], l2_hy = l2_f[1], l2_last = l2_f[2],
                          l2_lastrow = l2_f[4];
     wire [ROW_IDX_W-1:0] l2_row = l2_e_q[F_ROW +: ROW_IDX_W];
@@ -552,21 +558,27 @@ module fmt_blob #(
     // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
     // this cycle (C becomes P); this cycle's step forwarded
     wire             bnd = l1_f[3] && l2_v_q;
-    reg  [LBL_W-1:0] y1_raw;
+    // (one-hot select, the compares with the victim done per column beside it)
+    reg  [LBL_W-1:0] raw_p, raw_c;
+    reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
     reg  [COLS-1:0]  l1_m;
     always @(*) begin : c_l1
         integer i;
-        y1_raw = {LBL_W{1'b0}};
-        for (i = 0; i < COLS; i = i + 1)
-            if (l1_lc == i[COL_IDX_W-1:0])
-                y1_raw = bnd ? c_q[i*LBL_W +: LBL_W] : p_q[i*LBL_W +: LBL_W];
-        for (i = 0; i < COLS; i = i + 1)
+        raw_p = {LBL_W{1'b0}};
+        raw_c = {LBL_W{1'b0}};
+        for (i = 0; i < COLS; i = i + 1) begin
+            raw_p = raw_p | (l1_oh_q[i] ? p_q[i*LBL_W +: LBL_W] : {LBL_W{1'b0}});
+            raw_c = raw_c | (l1_oh_q[i] ? c_q[i*LBL_W +: LBL_W] : {LBL_W{1'b0}});
+            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
+            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
             l1_m[i] = (i[COL_IDX_W-1:0] >= l1_e_q[F_CMN +: COL_IDX_W])
                    && (i[COL_IDX_W-1:0] <= l1_e_q[F_CMX +: COL_IDX_W]);
+        end
     end
-    wire             l1_hit = bnd && do_run && l2_m_q[l1_lc];
+    wire             ren_at = bnd ? |(l1_oh_q & ren_c) : |(l1_oh_q & ren_p);
+    wire             l1_hit = bnd && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun
-                        : ((do_merge && y1_raw == l2_y_q) ? x_q : y1_raw);
+                        : ((do_merge && ren_at) ? x_q : (bnd ? raw_c : raw_p));
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     assign           l1_free = !l1_v_q || l2_ld;
 
@@ -578,14 +590,13 @@ module fmt_blob #(
         p_nx = p_q;
         c_nx = c_q;
         for (i = 0; i < COLS; i = i + 1) begin
-            if (do_merge && p_q[i*LBL_W +: LBL_W] == l2_y_q) p_nx[i*LBL_W +: LBL_W] = x_q;
-            if (do_merge && c_q[i*LBL_W +: LBL_W] == l2_y_q) c_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_merge && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_merge && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = x_q;
             if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
         end
         livep_nx = livep_q & ~(do_merge ? vbit : {NL{1'b0}});
         livec_nx = (livec_q & ~(do_merge ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
     end
-    wire [NL:1] close_k = l2_lastrow ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
@@ -628,7 +639,8 @@ module fmt_blob #(
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
     reg [LBL_W-1:0]     x4_a_q, x4_b_q;
-    reg [NL:1]          x4_k_q;
+    reg [NL:1]          x4_lp_q, x4_lc_q;     // P's and C's labels after the step
+    wire [NL:1]         x4_k = x4_last_q ? (x4_lp_q | x4_lc_q) : (x4_lp_q & ~x4_lc_q);
     reg [ROW_IDX_W-1:0] x4_row_q;
     reg [E_W-1:0]       x4_e_q;                // the run as an entry
     reg [E_W-1:0]       run_e;
@@ -659,18 +671,23 @@ module fmt_blob #(
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
     assign acc_y = (x4_op_q == OP_MERGE) ? acc_b : x4_e_q;
-    reg [LBL_W-1:0] cpick;
-    reg [NL:1]      cpick_bit;
+    // the close engine's next label (lowest pending), picked one cycle ahead
+    reg  [LBL_W-1:0] pk_q;
+    reg              pk_v_q;
+    wire             cl_go   = pk_v_q && !b_merge;
+    wire             pk_fill = !pk_v_q || cl_go;
+    wire [NL:1]      p_low   = pend_q & (~pend_q + 1'b1);
+    reg  [LBL_W-1:0] p_enc;
+    reg  [NL:1]      cpick_bit;               // the label the close engine frees
     always @(*) begin : c_cpick
         integer i;
-        cpick = {LBL_W{1'b0}};
-        for (i = NL; i >= 1; i = i - 1)
-            if (pend_q[i]) cpick = i[LBL_W-1:0];
-        for (i = 1; i <= NL; i = i + 1)
-            cpick_bit[i] = (cpick == i[LBL_W-1:0]) && pend_q[i] && !b_merge;
+        p_enc = {LBL_W{1'b0}};
+        for (i = 1; i <= NL; i = i + 1) begin
+            if (p_low[i]) p_enc = p_enc | i[LBL_W-1:0];
+            cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
+        end
     end
-    wire cl_go = (|pend_q) && !b_merge;
-    assign acc_b_lbl = b_merge ? x4_b_q : cpick;
+    assign acc_b_lbl = b_merge ? x4_b_q : pk_q;
     reg           cl_v_q;
     reg [E_W-1:0] cl_e_q;
     reg [ROW_IDX_W-1:0] crow_q [0:NL];        // row at whose end the label was closed (0: unused)
@@ -862,10 +879,11 @@ module fmt_blob #(
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
                    || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l1_v_q || l2_v_q || x4_v_q
-                   || cl_v_q || (|pend_q);
+                   || cl_v_q || (|pend_q) || pk_v_q;
+    reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
-    wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
-    wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
+    wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
+    wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && idle_q
                    && fr_in && !arr_p[fr_row];
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
@@ -879,26 +897,32 @@ module fmt_blob #(
             e1_fa_q  <= f2_fa_q;
             e1_row_q <= f2_row_q;
         end
-        if (f2_take || ev_go) begin
-            e1_rem_q <= e1_remn;
-            e1_b_q   <= e1_remn & e1_neg;
-            e1_ge_q  <= e1_remn | e1_neg;
-            e1_first_q <= f2_take;
+        if (f2_take) begin
+            e1_rem_q <= f2_es_q;
+            e1_b_q   <= f2_b_q;
+            e1_ge_q  <= f2_ge_q;
+            e1_first_q <= 1'b1;
+        end else if (ev_go) begin
+            e1_rem_q <= e1_remr;
+            e1_b_q   <= e1_remr & e1_neg;
+            e1_ge_q  <= e1_remr | e1_neg;
+            e1_first_q <= 1'b0;
         end
-        x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, |ev_lc, ev_run};
+        x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
         x1_m_q   <= ev_m;
         x1_lc_q  <= ev_lc;
         x1_zm_q  <= zm;
         x1_row_q <= e1_row_q;
-        x2_f_q <= x1_f_q;  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
+        x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
         x2_gs_q <= gs;  x2_gx_q <= gx;  x2_gm_q <= gm;  x2_gc_q <= gc;
-        x2_cnt_q <= cnt;  x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
+        x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
-        x3_cnt_q <= x2_cnt_q;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
+        x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
         x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= tpk;  x3_pc_q <= tpc;
         y4_e_q <= x3_ev;  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
         y5_e_q <= y4_ev;
-        if (fpop) l1_e_q <= fmem[frp_q];
+        if (fpop) l1_e_q <= f_rd;
+        if (fpop) l1_oh_q <= lc_oh;
         if (l2_ld) begin
             l2_e_q <= l1_e_q;
             l2_y_q <= y1;
@@ -912,7 +936,8 @@ module fmt_blob #(
         x4_row_q <= l2_row;
         x4_end_q <= row_done;
         x4_last_q <= row_done && l2_lastrow;
-        x4_k_q   <= close_k;
+        x4_lp_q  <= livep_nx;
+        x4_lc_q  <= livec_nx;
         // accumulators
         if (x4_v_q) begin
             case (x4_op_q)
@@ -924,12 +949,12 @@ module fmt_blob #(
         end
         if (cl_go) begin
             cl_e_q   <= acc_b;
-            cl_row_q <= crow_q[cpick];
-            cl_lbl_q <= cpick;
+            cl_row_q <= crow_q[pk_q];
+            cl_lbl_q <= pk_q;
         end
         if (x4_v_q && x4_end_q) begin
             for (i = 1; i <= NL; i = i + 1)
-                if (x4_k_q[i]) crow_q[i] <= x4_row_q;
+                if (x4_k[i]) crow_q[i] <= x4_row_q;
         end
         // emission side registers
         dl_i_q[0] <= em_i_q;
@@ -967,6 +992,8 @@ module fmt_blob #(
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
+            pk_v_q   <= 1'b0;
+            idle_q   <= 1'b0;
             p_q      <= {(COLS*LBL_W){1'b0}};
             c_q      <= {(COLS*LBL_W){1'b0}};
             livep_q  <= {NL{1'b0}};
@@ -1062,7 +1089,13 @@ module fmt_blob #(
                     | (do_merge ? vbit : {NL{1'b0}})
                     | cpick_bit;
             x4_v_q <= do_merge || do_run || row_done;
-            pend_q <= (pend_q & ~cpick_bit) | ((x4_v_q && x4_end_q) ? x4_k_q : {NL{1'b0}});
+            pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
+                    | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
+            if (pk_fill) begin
+                pk_q   <= p_enc;
+                pk_v_q <= |pend_q;
+            end
+            idle_q <= !pipe_busy && !fetch;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 

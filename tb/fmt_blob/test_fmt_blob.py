@@ -466,8 +466,8 @@ async def latency(dut):
         runs = int((on[:, 1:] & ~on[:, :-1]).sum() + on[:, 0].sum())
         dut._log.info(f"latency: last row -> blob_eof {from_row} cycles, hm_eof -> blob_eof "
                       f"{from_eof} cycles, last row -> mask_ready {mlat} cycles, {n} blobs, {runs} runs")
-        assert from_row <= tb.rows + 2 * runs + tb.div_lat + 12 + min(n, tb.mb), "latency bound"
-        assert mlat <= 2 * tb.rows + 2 * runs + 12, "mask latency bound"
+        assert from_row <= tb.rows + 2 * runs + tb.div_lat + 20 + min(n, tb.mb), "latency bound"
+        assert mlat <= 2 * tb.rows + 2 * runs + 20, "mask latency bound"
     # worst cases: processing time (rows in order, one per cycle) against 3N cycles
     period = 3 * (1 << bits)
     maps = shape_maps(tb.rows, tb.cols)
