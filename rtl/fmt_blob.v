@@ -229,7 +229,7 @@ module fmt_blob #(
                               + {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
     // the on-cells of every row (z >= blob_threshold_i as the row arrives)
     (* ram_style = "distributed" *)
-    reg [COLS-1:0]       on_mem [0:2*ROWS-1];
+    reg [COLS-1:0]       on_mem [0:(2<<ROW_IDX_W)-1];    // address {bank, row}
     reg [COLS-1:0]       hm_on;
     always @(*) begin : c_hm_on
         integer i;
@@ -239,7 +239,7 @@ module fmt_blob #(
     always @(posedge clk) begin
         if (hm_valid_i) begin
             mem[wr_addr]    <= hm_data_i;
-            on_mem[wr_addr] <= hm_on;
+            on_mem[{wb_q, hm_row_i}] <= hm_on;
         end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
@@ -256,7 +256,9 @@ module fmt_blob #(
     reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
     reg  [RW-1:0]        f1_z_q, f2_z_q;
     reg  [COLS-1:0]      f1_c_q, f2_c_q, f2_es_q, f2_fa_q, f2_b_q, f2_ge_q;
-    reg  [COLS-1:0]      lastc_q;             // on-cells of the row before f1's row
+    reg                  f2_one_q;            // the row has at most one event
+    reg  [COLS-1:0]      lastc_q;             // on-cells of the row fetched before (0: none)
+    reg  [COLS-1:0]      f1_es_q, f1_fa_q;
     wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
     wire                 fr_in = (fr_q < ROWS_R);
     wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
@@ -268,31 +270,33 @@ module fmt_blob #(
     // new label), and every further A run inside it a merge event at the A run's start.
     // fa by one addition: the carry of a C run start runs through the run's C-only
     // cells and lands on its first A cell (or beyond the run: no A cell).
-    wire [COLS-1:0]      pp   = (f1_row_q == {ROW_IDX_W{1'b0}}) ? {COLS{1'b0}} : lastc_q;
-    wire [COLS-1:0]      ca   = f1_c_q & pp;
-    wire [COLS-1:0]      cy   = f1_c_q & ~pp;
-    wire [COLS-1:0]      ccs  = f1_c_q & ~{f1_c_q[COLS-2:0], 1'b0};
+    wire [COLS-1:0]      on_f = on_mem[{pb_q, fr_row}];
+    wire [COLS-1:0]      ca   = on_f & lastc_q;
+    wire [COLS-1:0]      cy   = on_f & ~lastc_q;
+    wire [COLS-1:0]      ccs  = on_f & ~{on_f[COLS-2:0], 1'b0};
     /* verilator lint_off UNUSEDSIGNAL */     // land[COLS]: a carry beyond the last column
     wire [COLS:0]        land = {1'b0, cy} + {1'b0, ccs};
     /* verilator lint_on UNUSEDSIGNAL */
-    wire [COLS-1:0]      fa_f1 = land[COLS-1:0] & ~cy & f1_c_q;
-    wire [COLS-1:0]      es_f1 = ccs | (ca & ~{ca[COLS-2:0], 1'b0} & ~fa_f1);
-    wire [COLS-1:0]      es_neg = ~es_f1 + 1'b1;      // the first event: lowest bit and up
+    wire [COLS-1:0]      fa_f = land[COLS-1:0] & ~cy & on_f;
+    wire [COLS-1:0]      es_f = ccs | (ca & ~{ca[COLS-2:0], 1'b0} & ~fa_f);
+    wire [COLS-1:0]      es_neg = ~f1_es_q + 1'b1;    // the first event: lowest bit and up
     always @(posedge clk) begin
         if (fetch) begin
             f1_z_q   <= mem[rd_addr];
-            f1_c_q   <= on_mem[rd_addr];
+            f1_c_q   <= on_f;
+            f1_es_q  <= es_f;
+            f1_fa_q  <= fa_f;
             f1_row_q <= fr_row;
         end
         if (f1_mv) begin
             f2_z_q   <= f1_z_q;
             f2_c_q   <= f1_c_q;
-            f2_es_q  <= es_f1;
-            f2_fa_q  <= fa_f1;
-            f2_b_q   <= es_f1 & es_neg;
-            f2_ge_q  <= es_f1 | es_neg;
+            f2_es_q  <= f1_es_q;
+            f2_fa_q  <= f1_fa_q;
+            f2_b_q   <= f1_es_q & es_neg;
+            f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
+            f2_ge_q  <= f1_es_q | es_neg;
             f2_row_q <= f1_row_q;
-            lastc_q  <= f1_c_q;
         end
     end
 
@@ -305,7 +309,8 @@ module fmt_blob #(
     reg  [COLS-1:0]      e1_b_q;              // this event's start (one-hot; 0: empty row)
     reg  [COLS-1:0]      e1_ge_q;             // columns >= e1_b_q
     reg  [FP_W:0]        res_q;               // events emitted by E and not taken by L1
-    wire                 ev_last = ((e1_rem_q & ~e1_b_q) == {COLS{1'b0}});
+    reg                  e1_last_q;           // this event is the row's last
+    wire                 ev_last = e1_last_q;
     wire                 ev_go   = e1_v_q && !res_q[FP_W];   // res_q < FD
     assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
     wire [COLS-1:0]      e1_remr = e1_rem_q & ~e1_b_q;
@@ -316,12 +321,6 @@ module fmt_blob #(
     wire [COLS-1:0]      crun    = cge & ~(cge + e1_b_q); // the C run starting at b
     wire [COLS-1:0]      ev_m    = ev_run ? crun : {COLS{1'b0}};
     wire [COLS-1:0]      ev_lc   = ev_run ? (e1_fa_q & crun) : e1_b_q;
-    reg  [RW-1:0]        zm;
-    always @(*) begin : c_zm
-        integer i;
-        for (i = 0; i < COLS; i = i + 1)
-            zm[i*HM_W +: HM_W] = ev_m[i] ? e1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
-    end
 
     // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
     // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
@@ -329,52 +328,44 @@ module fmt_blob #(
     reg                 x1_v_q;
     reg [EF_W-1:0]      x1_f_q;
     reg [COLS-1:0]      x1_m_q, x1_lc_q;
-    reg [RW-1:0]        x1_zm_q;
+    reg [RW-1:0]        x1_z_q;               // the row (masked by x1_m_q in X2)
     reg [ROW_IDX_W-1:0] x1_row_q;
     // ---- X2: group sums, run extent ---------------------------------------------------
     reg [ROW_IDX_W-1:0] x2_row_q;
     reg [NG*GSZ_W-1:0]  x2_gs_q;
     reg [NG*GSX_W-1:0]  x2_gx_q;
-    reg [NG*HM_W-1:0]   x2_gm_q;
-    reg [NG*COL_IDX_W-1:0] x2_gc_q;
     reg [COL_IDX_W-1:0] x2_cmin_q, x2_cmax_q;
     reg [NG*GSZ_W-1:0]  gs;
     reg [NG*GSX_W-1:0]  gx;
-    reg [NG*HM_W-1:0]   gm;
-    reg [NG*COL_IDX_W-1:0] gc;
     reg [COL_IDX_W-1:0] cmin, cmax;
-    reg [HM_W-1:0]      pm1 [0:3];            // peak tournament: winners, decisions
-    reg [HM_W-1:0]      pm2 [0:1];
-    reg [3:0]           pd1;
-    reg [1:0]           pd2;
-    reg                 pd3, pi1;
-    /* verilator lint_off UNUSEDSIGNAL */     // integer arithmetic: only the column bits are used
-    integer             pcol;
-    /* verilator lint_on UNUSEDSIGNAL */
+    reg [COLS-1:0]      m_first, m_last, m_t0, m_t1;
     reg [GS*HM_W-1:0]   gz;
     reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
     reg [HM_W+1:0]      gv0, gv1, go;
     reg                 x2_v_q;
     reg [EF_W-1:0]      x2_f_q;
     reg [COL_IDX_W-1:0] x2_lc_q;
+    // one-hot -> index: bit b = OR of the one-hot bits whose index has bit b (a balanced
+    // OR, not a chain)
     reg [COL_IDX_W-1:0] lc_enc;
+    reg [COLS-1:0]      lc_t;
     always @(*) begin : c_lc_enc
-        integer i;
-        lc_enc = {COL_IDX_W{1'b0}};
-        for (i = 0; i < COLS; i = i + 1)
-            if (x1_lc_q[i]) lc_enc = lc_enc | i[COL_IDX_W-1:0];   // one-hot: OR of indices
+        integer i, b;
+        for (b = 0; b < COL_IDX_W; b = b + 1) begin
+            for (i = 0; i < COLS; i = i + 1)
+                lc_t[i] = x1_lc_q[i] && (((i >> b) & 1) == 1);
+            lc_enc[b] = |lc_t;
+        end
     end
     always @(*) begin : c_x2
         integer i, g;
         gs = {(NG*GSZ_W){1'b0}};
         gx = {(NG*GSX_W){1'b0}};
-        gm = {(NG*HM_W){1'b0}};
-        gc = {(NG*COL_IDX_W){1'b0}};
         for (g = 0; g < NG; g = g + 1) begin
             // the group's 8 masked cells (0 beyond the last column)
             for (i = 0; i < GS; i = i + 1)
-                gz[i*HM_W +: HM_W] = (g * GS + i < COLS)
-                                   ? x1_zm_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS && x1_m_q[(g * GS + i < COLS) ? g * GS + i : 0])
+                                   ? x1_z_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
                                    : {HM_W{1'b0}};
             // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
             // u_i = z_2i + z_2i+1, v_0 = u_0 + u_1, v_1 = u_2 + u_3, sum = v_0 + v_1,
@@ -389,33 +380,70 @@ module fmt_blob #(
             gx[g*GSX_W +: GSX_W] = {{(GSX_W-HM_W-5){1'b0}}, gv1, 2'b00}
                                  + {{(GSX_W-HM_W-3){1'b0}}, gu[1] + gu[3], 1'b0}
                                  + {{(GSX_W-HM_W-2){1'b0}}, go};
-            // peak of the group: first maximum, by a tournament of 7 strict compares
-            // (the right one wins only when larger: the leftmost maximum); the
-            // winner's column comes from the decisions, not carried through muxes
-            for (i = 0; i < 4; i = i + 1) begin
-                pd1[i] = (gz[(2*i+1)*HM_W +: HM_W] > gz[(2*i)*HM_W +: HM_W]);
-                pm1[i] = pd1[i] ? gz[(2*i+1)*HM_W +: HM_W] : gz[(2*i)*HM_W +: HM_W];
-            end
-            for (i = 0; i < 2; i = i + 1) begin
-                pd2[i] = (pm1[2*i+1] > pm1[2*i]);
-                pm2[i] = pd2[i] ? pm1[2*i+1] : pm1[2*i];
-            end
-            pd3 = (pm2[1] > pm2[0]);
-            gm[g*HM_W +: HM_W] = pd3 ? pm2[1] : pm2[0];
-            pi1 = pd2[pd3];
-            pcol = g * GS + 4 * pd3 + 2 * pi1 + pd1[{pd3, pi1}];
-            gc[g*COL_IDX_W +: COL_IDX_W] = pcol[COL_IDX_W-1:0];
         end
-        // the run's first and last column: one-hot, OR of the indices
-        cmin = {COL_IDX_W{1'b0}};
-        cmax = {COL_IDX_W{1'b0}};
+        // the run's first and last column: one-hot, then encoded (balanced ORs)
         for (i = 0; i < COLS; i = i + 1) begin
-            if (x1_m_q[i] && (i == 0 || !x1_m_q[(i > 0) ? i - 1 : 0]))
-                cmin = cmin | i[COL_IDX_W-1:0];
-            if (x1_m_q[i] && (i == COLS - 1 || !x1_m_q[(i < COLS - 1) ? i + 1 : 0]))
-                cmax = cmax | i[COL_IDX_W-1:0];
+            m_first[i] = x1_m_q[i] && (i == 0 || !x1_m_q[(i > 0) ? i - 1 : 0]);
+            m_last[i]  = x1_m_q[i] && (i == COLS - 1 || !x1_m_q[(i < COLS - 1) ? i + 1 : 0]);
+        end
+        for (g = 0; g < COL_IDX_W; g = g + 1) begin
+            for (i = 0; i < COLS; i = i + 1) begin
+                m_t0[i] = m_first[i] && (((i >> g) & 1) == 1);
+                m_t1[i] = m_last[i] && (((i >> g) & 1) == 1);
+            end
+            cmin[g] = |m_t0;
+            cmax[g] = |m_t1;
         end
     end
+
+    // Peak of the run (largest z, the leftmost among equals): a tournament over the
+    // masked cells, two levels per stage (X2, X3, X4); an entry is {z, column}, the
+    // right one of a pair wins only when strictly larger.
+    localparam PK_W = HM_W + COL_IDX_W;
+    localparam PN0 = COLS, PN1 = (PN0 + 1) / 2, PN2 = (PN1 + 1) / 2, PN3 = (PN2 + 1) / 2;
+    localparam PN4 = (PN3 + 1) / 2, PN5 = (PN4 + 1) / 2, PN6 = (PN5 + 1) / 2;   // 1: COLS <= 64
+    function [PN0*PK_W-1:0] pk_half;          // entry k = winner of entries 2k, 2k+1 of v
+        input [PN0*PK_W-1:0] v;
+        input integer        n;               // entries in v
+        integer k, j;
+        begin
+            pk_half = {(PN0*PK_W){1'b0}};
+            for (k = 0; k < PN0; k = k + 1) begin
+                j = (2 * k + 1 < PN0) ? 2 * k + 1 : PN0 - 1;
+                if (2 * k + 1 < n && v[j*PK_W + COL_IDX_W +: HM_W]
+                                     > v[(j-1)*PK_W + COL_IDX_W +: HM_W])
+                    pk_half[k*PK_W +: PK_W] = v[j*PK_W +: PK_W];
+                else if (2 * k < n)
+                    pk_half[k*PK_W +: PK_W] = v[(2*k < PN0 ? 2*k : 0)*PK_W +: PK_W];
+            end
+        end
+    endfunction
+    reg  [PN0*PK_W-1:0] pk0;
+    always @(*) begin : c_pk0
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            pk0[i*PK_W +: PK_W] = {x1_m_q[i] ? x1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}},
+                                   i[COL_IDX_W-1:0]};
+    end
+    reg  [PN2*PK_W-1:0] x2_pk_q;
+    reg  [PN4*PK_W-1:0] x3_pk_q;
+    reg  [PK_W-1:0]     y4_pk_q;
+    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
+    wire [PN0*PK_W-1:0] pk3 = pk_half({{((PN0-PN2)*PK_W){1'b0}}, x2_pk_q}, PN2);
+    wire [PN0*PK_W-1:0] pk5 = pk_half({{((PN0-PN4)*PK_W){1'b0}}, x3_pk_q}, PN4);
+    /* verilator lint_off UNUSEDSIGNAL */     // entries beyond a level's count are 0
+    wire [PN0*PK_W-1:0] pk2 = pk_half(pk1, PN1);
+    wire [PN0*PK_W-1:0] pk4 = pk_half(pk3, PN3);
+    wire [PN0*PK_W-1:0] pk6 = pk_half(pk5, PN5);
+    /* verilator lint_on UNUSEDSIGNAL */
+    // synthesis translate_off
+    initial begin
+        if (PN6 != 1) begin
+            $display("fmt_blob: COLS %0d > 64: the peak tournament needs more levels", COLS);
+            $finish;
+        end
+    end
+    // synthesis translate_on
 
     // ---- X3: totals -----------------------------------------------------------------------
     reg                 x3_v_q;
@@ -423,20 +451,15 @@ module fmt_blob #(
     reg [COL_IDX_W-1:0] x3_lc_q;
     reg [ROW_IDX_W-1:0] x3_row_q;
     reg [AREA_W-1:0]    x3_cnt_q;
-    reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q, x3_pc_q;
-    reg [HM_W-1:0]      x3_pk_q;
+    reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
     reg [SX_W-1:0]      x3_sx_q;
     reg [SZ_W-1:0]      ts;
     reg [SX_W-1:0]      tx;
-    reg [HM_W-1:0]      tpk;
-    reg [COL_IDX_W-1:0] tpc;
     always @(*) begin : c_x3
         integer g, b;
         ts = {SZ_W{1'b0}};
         tx = {SX_W{1'b0}};
-        tpk = {HM_W{1'b0}};
-        tpc = x2_cmin_q;                      // all-zero run (threshold 0): first cell
         for (g = 0; g < NG; g = g + 1) begin
             ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
             // sum z*c = sum over groups of (sum z*(c mod 8) + 8g * sum z), shift-add
@@ -444,10 +467,6 @@ module fmt_blob #(
             for (b = 0; b < COL_IDX_W; b = b + 1)
                 if ((((g * GS) >> b) & 1) == 1)
                     tx = tx + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
-            if (x2_gm_q[g*HM_W +: HM_W] > tpk) begin
-                tpk = x2_gm_q[g*HM_W +: HM_W];
-                tpc = x2_gc_q[g*COL_IDX_W +: COL_IDX_W];
-            end
         end
     end
 
@@ -455,7 +474,7 @@ module fmt_blob #(
     // ---- X4, X5: sum z*r = r * sum z, shift and add (low and high row bits, then both)
     localparam RH = ROW_IDX_W / 2;            // row bits of the first partial product
     reg                 y4_v_q, y5_v_q;
-    /* verilator lint_off UNUSEDSIGNAL */     // y4_e_q's sum z*r field is 0 (y4_ylo/hi)
+    /* verilator lint_off UNUSEDSIGNAL */     // y4_e_q's sum z*r and peak fields are 0
     reg [FE_W-1:0]      y4_e_q;               // the event (its sum z*r field: 0 in X4)
     /* verilator lint_on UNUSEDSIGNAL */
     reg [FE_W-1:0]      y5_e_q;
@@ -482,12 +501,14 @@ module fmt_blob #(
     localparam F_PC  = F_PK + HM_W;
     localparam F_CMN = F_PC + COL_IDX_W;
     localparam F_CMX = F_CMN + COL_IDX_W;
-    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, x3_pc_q, x3_pk_q, {SY_W{1'b0}}, x3_sx_q,
+    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W){1'b0}}, x3_sx_q,
                              x3_s_q, x3_cnt_q, x3_row_q, x3_lc_q, x3_f_q};
     wire [FE_W-1:0] y4_ev;
     assign y4_ev[F_SY-1:0]         = y4_e_q[F_SY-1:0];
     assign y4_ev[F_SY +: SY_W]     = y4_ylo_q + y4_yhi_q;
-    assign y4_ev[FE_W-1:F_PK]      = y4_e_q[FE_W-1:F_PK];
+    assign y4_ev[F_PK +: HM_W]     = y4_pk_q[COL_IDX_W +: HM_W];
+    assign y4_ev[F_PC +: COL_IDX_W] = y4_pk_q[0 +: COL_IDX_W];
+    assign y4_ev[FE_W-1:F_CMN]     = y4_e_q[FE_W-1:F_CMN];
 
     // ---- the event FIFO (distributed RAM), read into L1 --------------------------------
     (* ram_style = "distributed" *)
@@ -561,14 +582,18 @@ module fmt_blob #(
     // (one-hot select, the compares with the victim done per column beside it)
     reg  [LBL_W-1:0] raw_p, raw_c;
     reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
-    reg  [COLS-1:0]  l1_m;
+    reg  [COLS-1:0]  l1_m, t_p, t_c;
     always @(*) begin : c_l1
-        integer i;
-        raw_p = {LBL_W{1'b0}};
-        raw_c = {LBL_W{1'b0}};
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 0; i < COLS; i = i + 1) begin
+                t_p[i] = l1_oh_q[i] && p_q[i*LBL_W + b];
+                t_c[i] = l1_oh_q[i] && c_q[i*LBL_W + b];
+            end
+            raw_p[b] = |t_p;
+            raw_c[b] = |t_c;
+        end
         for (i = 0; i < COLS; i = i + 1) begin
-            raw_p = raw_p | (l1_oh_q[i] ? p_q[i*LBL_W +: LBL_W] : {LBL_W{1'b0}});
-            raw_c = raw_c | (l1_oh_q[i] ? c_q[i*LBL_W +: LBL_W] : {LBL_W{1'b0}});
             ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
             ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
             l1_m[i] = (i[COL_IDX_W-1:0] >= l1_e_q[F_CMN +: COL_IDX_W])
@@ -601,11 +626,14 @@ module fmt_blob #(
     wire        n0_fill = !n0v_q || do_new;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
     reg  [LBL_W-1:0] f_enc;
+    reg  [NL:1]      f_t;
     always @(*) begin : c_fenc
-        integer i;
-        f_enc = {LBL_W{1'b0}};
-        for (i = 1; i <= NL; i = i + 1)
-            if (f_low[i]) f_enc = f_enc | i[LBL_W-1:0];
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 1; i <= NL; i = i + 1)
+                f_t[i] = f_low[i] && (((i >> b) & 1) == 1);
+            f_enc[b] = |f_t;
+        end
     end
 
     // Records for the membership pass: the labels of every row at its end (after its
@@ -623,13 +651,11 @@ module fmt_blob #(
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
     (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*LBL_W-1:0]     lr_mem [0:2*ROWS-1];   // two banks, as mem
+    reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
-    wire [ADDR_W-1:0] lr_wa = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
-                            + {{(ADDR_W-ROW_IDX_W){1'b0}}, l2_row};
     always @(posedge clk) begin
-        if (row_done) lr_mem[lr_wa] <= c_nx;
+        if (row_done) lr_mem[l2_row] <= c_nx;
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -679,13 +705,16 @@ module fmt_blob #(
     wire [NL:1]      p_low   = pend_q & (~pend_q + 1'b1);
     reg  [LBL_W-1:0] p_enc;
     reg  [NL:1]      cpick_bit;               // the label the close engine frees
+    reg  [NL:1]      p_t;
     always @(*) begin : c_cpick
-        integer i;
-        p_enc = {LBL_W{1'b0}};
-        for (i = 1; i <= NL; i = i + 1) begin
-            if (p_low[i]) p_enc = p_enc | i[LBL_W-1:0];
-            cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 1; i <= NL; i = i + 1)
+                p_t[i] = p_low[i] && (((i >> b) & 1) == 1);
+            p_enc[b] = |p_t;
         end
+        for (i = 1; i <= NL; i = i + 1)
+            cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
     end
     assign acc_b_lbl = b_merge ? x4_b_q : pk_q;
     reg           cl_v_q;
@@ -797,16 +826,21 @@ module fmt_blob #(
     // (per label, by row) holds whether it was a blob.
     reg                  bw_run_q;            // reading rows
     reg [ROW_IDX_W-1:0]  bw_r_q;              // next row to read
-    reg                  bw_v_q;              // fr_rd_q holds row bw_row_q
-    reg [ROW_IDX_W-1:0]  bw_row_q;
-    reg [NL*(LBL_W+1)-1:0] fr_rd_q;           // continuation record of row r
+    reg                  bw_v1_q, bw_v_q;     // block-RAM read of row bw_row1_q / bw_row_q
+    reg [ROW_IDX_W-1:0]  bw_row1_q, bw_row_q;
+    reg [NL*(LBL_W+1)-1:0] fr_rd1_q, fr_rd_q; // continuation record of row r
+    reg [COLS*LBL_W-1:0] lr_rd1_q, lr_rd_q;   // labels of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg                  mask_ok_q;           // the mask holds a complete frame
-    reg                  qb_q;                // lr_mem bank of the mask's frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) fr_rd_q <= fr_mem[bw_r_q];
+        if (bw_run_q) begin
+            fr_rd1_q <= fr_mem[bw_r_q];
+            lr_rd1_q <= lr_mem[bw_r_q];
+        end
+        fr_rd_q <= fr_rd1_q;                  // the block RAMs' output registers
+        lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
     wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
@@ -846,35 +880,41 @@ module fmt_blob #(
                 bw_s[g] = cfr[g];
         end
     end
-    // the status words, one per row, indexed by label
-    (* ram_style = "block" *)
-    reg [NL:1]      st_mem [0:ROWS-1];
+    // the cells of row r: the status of their label (MK), a row of the mask
+    reg                  mk_v_q;
+    reg [ROW_IDX_W-1:0]  mk_row_q;
+    reg [NL:1]           mk_s_q;
+    reg [COLS*LBL_W-1:0] mk_lr_q;
+    reg [NLP-1:0]        mk_s_pad;
+    reg [COLS-1:0]       mk_bits;
+    always @(*) begin : c_mk
+        integer c;
+        mk_s_pad = {NLP{1'b0}};
+        mk_s_pad[NL:1] = mk_s_q;
+        for (c = 0; c < COLS; c = c + 1)
+            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]];
+    end
+    (* ram_style = "distributed" *)
+    reg [COLS-1:0]       mask_mem [0:ROWS-1];
     always @(posedge clk) begin
-        if (bw_v_q) st_mem[bw_row_q] <= bw_s;
+        if (mk_v_q) mask_mem[mk_row_q] <= mk_bits;
+        mk_s_q   <= bw_s;
+        mk_lr_q  <= lr_rd_q;
+        mk_row_q <= bw_row_q;
     end
 
-    // ---- Q: cell query: label of the cell, then its status in the cell's row ---------
-    reg [COLS*LBL_W-1:0] q_lr_q;              // labels of the queried row
-    reg [NL:1]           q_st_q;              // status word of the queried row
+    // ---- Q: cell query: the row's mask word, then the cell's bit -----------------------
+    localparam NCP = 1 << COL_IDX_W;
+    reg [COLS-1:0]       q_w_q;               // mask word of the queried row
     reg [COL_IDX_W-1:0]  q_col_q;
-    wire [ADDR_W-1:0] q_addr = (qb_q ? ROWS_A : {ADDR_W{1'b0}})
-                             + {{(ADDR_W-ROW_IDX_W){1'b0}}, mask_q_row_i};
+    reg [NCP-1:0]        q_w_pad;             // columns >= COLS read 0
     always @(posedge clk) begin
-        q_lr_q  <= lr_mem[q_addr];
-        q_st_q  <= st_mem[mask_q_row_i];
+        q_w_q   <= mask_mem[mask_q_row_i];
         q_col_q <= mask_q_col_i;
     end
-    // columns >= COLS and label 0 (background) read 0
-    localparam NCP = 1 << COL_IDX_W;
-    reg [NCP*LBL_W-1:0] q_lr_pad;
-    reg [NLP-1:0]       q_st_pad;
-    reg [LBL_W-1:0]     q_lbl;
     always @(*) begin
-        q_lr_pad = {(NCP*LBL_W){1'b0}};
-        q_lr_pad[COLS*LBL_W-1:0] = q_lr_q;
-        q_lbl = q_lr_pad[q_col_q*LBL_W +: LBL_W];
-        q_st_pad = {NLP{1'b0}};
-        q_st_pad[NL:1] = q_st_q;
+        q_w_pad = {NCP{1'b0}};
+        q_w_pad[COLS-1:0] = q_w_q;
     end
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
@@ -883,8 +923,8 @@ module fmt_blob #(
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
-    wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && idle_q
-                   && fr_in && !arr_p[fr_row];
+    reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
+    wire fin_abort = (state_q == S_RUN) && abort_q;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
@@ -901,25 +941,27 @@ module fmt_blob #(
             e1_rem_q <= f2_es_q;
             e1_b_q   <= f2_b_q;
             e1_ge_q  <= f2_ge_q;
+            e1_last_q <= f2_one_q;
             e1_first_q <= 1'b1;
         end else if (ev_go) begin
             e1_rem_q <= e1_remr;
             e1_b_q   <= e1_remr & e1_neg;
             e1_ge_q  <= e1_remr | e1_neg;
+            e1_last_q <= ((e1_remr & ~e1_neg) == {COLS{1'b0}});
             e1_first_q <= 1'b0;
         end
         x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
         x1_m_q   <= ev_m;
         x1_lc_q  <= ev_lc;
-        x1_zm_q  <= zm;
+        x1_z_q   <= e1_z_q;
         x1_row_q <= e1_row_q;
         x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
-        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_gm_q <= gm;  x2_gc_q <= gc;
+        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk2[PN2*PK_W-1:0];
         x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= tpk;  x3_pc_q <= tpc;
-        y4_e_q <= x3_ev;  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= pk4[PN4*PK_W-1:0];
+        y4_e_q <= x3_ev;  y4_pk_q <= pk6[PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
         y5_e_q <= y4_ev;
         if (fpop) l1_e_q <= f_rd;
         if (fpop) l1_oh_q <= lc_oh;
@@ -980,6 +1022,7 @@ module fmt_blob #(
             pb_q     <= 1'b0;
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
+            lastc_q  <= {COLS{1'b0}};
             f1_v_q   <= 1'b0;
             f2_v_q   <= 1'b0;
             e1_v_q   <= 1'b0;
@@ -994,6 +1037,7 @@ module fmt_blob #(
             n0v_q    <= 1'b0;
             pk_v_q   <= 1'b0;
             idle_q   <= 1'b0;
+            abort_q  <= 1'b0;
             p_q      <= {(COLS*LBL_W){1'b0}};
             c_q      <= {(COLS*LBL_W){1'b0}};
             livep_q  <= {NL{1'b0}};
@@ -1020,11 +1064,12 @@ module fmt_blob #(
             dl_t_q   <= {DL{1'b0}};
             bw_run_q  <= 1'b0;
             bw_r_q    <= {ROW_IDX_W{1'b0}};
+            bw_v1_q   <= 1'b0;
             bw_v_q    <= 1'b0;
+            mk_v_q    <= 1'b0;
             bw_busy_q <= 1'b0;
             tok_q     <= 1'b0;
             mask_ok_q <= 1'b0;
-            qb_q      <= 1'b0;
             mask_q_data_o <= 1'b0;
             mask_ready_o <= 1'b0;
             mask_frame_o <= {FRAME_W{1'b0}};
@@ -1048,6 +1093,7 @@ module fmt_blob #(
 
             // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
+            if (fetch) lastc_q <= on_f;
             if (fetch) f1_v_q <= 1'b1;
             else if (f1_mv) f1_v_q <= 1'b0;
             if (f1_mv) f2_v_q <= 1'b1;
@@ -1096,6 +1142,8 @@ module fmt_blob #(
                 pk_v_q <= |pend_q;
             end
             idle_q <= !pipe_busy && !fetch;
+            abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
+                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
@@ -1121,23 +1169,25 @@ module fmt_blob #(
                 bw_r_q    <= LAST_ROW;
                 bw_busy_q <= 1'b1;
                 mask_ok_q <= 1'b0;
-                qb_q      <= pb_q;
             end
-            mask_q_data_o <= q_st_pad[q_lbl] && mask_ok_q;
+            mask_q_data_o <= q_w_pad[q_col_q] && mask_ok_q;
             if (fin_abort) begin
                 mask_ready_o <= 1'b1;
                 mask_frame_o <= frm_q[pb_q];
                 mask_ok_q    <= 1'b0;
             end
-            bw_v_q   <= bw_run_q;
-            bw_row_q <= bw_r_q;
+            bw_v1_q   <= bw_run_q;
+            bw_row1_q <= bw_r_q;
+            bw_v_q    <= bw_v1_q;
+            bw_row_q  <= bw_row1_q;
+            mk_v_q    <= bw_v_q;
             if (bw_run_q) begin
                 if (bw_r_q == {ROW_IDX_W{1'b0}}) bw_run_q <= 1'b0;
                 else                             bw_r_q   <= bw_r_q - 1'b1;
             end
-            if (bw_v_q) begin
-                sn_q  <= bw_s;
-                if (bw_row_q == {ROW_IDX_W{1'b0}}) begin
+            if (bw_v_q) sn_q <= bw_s;
+            if (mk_v_q) begin
+                if (mk_row_q == {ROW_IDX_W{1'b0}}) begin
                     bw_busy_q    <= 1'b0;
                     mask_ready_o <= 1'b1;
                     mask_frame_o <= em_frame_q;
@@ -1173,6 +1223,7 @@ module fmt_blob #(
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};
+                lastc_q      <= {COLS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
                 pb_q         <= ~pb_q;
