@@ -3,36 +3,47 @@
 // blob_stream_fixed).
 //
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,
-// stored in an inferred RAM of 2 x ROWS words of COLS*HM_W bits (two frame buffers, as
-// in fmt_localmax: the next frame may arrive while this one is finished).  The frame is
-// labelled in raster order as soon as a prefix of rows is present:
-//   F : fetch the next row (synchronous RAM read), threshold it when it becomes current
-//   L : run-serial labelling, one step per cycle.  The current row's remaining on-cells
-//       R give the next run M (lowest run of R).  The previous row's labels P (one label
-//       per column, 0 = background) under M are looked at:
-//         two different labels A, B     -> MERGE(A <- B): B is renamed A in P and in the
-//                                          current row's labels C; the run is retried
-//         one label A                   -> ADD(A): C[M] = A, the run is done
-//         none                          -> NEW(L): lowest free label, C[M] = L
-//       The row ends with its last run (or in one cycle when it has no run): the labels
-//       of P that are no longer in C are closed (their region is complete), P = C.
-//       After the last row every live label is closed.  Labels are slots 1..NL,
-//       NL = 2*ceil(COLS/2) + 6: every label that can be live in two rows (P and C,
-//       ceil(COLS/2) runs each) plus the closed labels still in the pipeline to the close
-//       engine, so the labelling does not run out of labels (a NEW waits for a free
-//       slot if it ever did -- the close engine pauses while a MERGE is applied, and a
-//       MERGE frees a label itself; nothing is ever dropped).
-//   X2..X4: masked sums of the run (area, sum z, sum z*c, sum z*r = r * sum z, peak and
-//       its first column, first/last column), 8-column groups then totals
-//   A : the command updates the per-label accumulators (a distributed RAM, one write
-//       and two asynchronous reads, one of them shared with the close engine): NEW
-//       writes the run, ADD combines the run, MERGE combines label B into A (B is free
-//       again).
-//   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
-//       inserted into a sorted list of MAX_BLOBS entries (fmt_sorted_list: area
-//       descending, ties by the raster index of the region's first cell ascending); the
-//       smallest falls off.  The
-//       list holds the keys and a slot number; the entries sit in distributed RAM.
+// stored in an inferred block RAM of 2 x ROWS words of COLS*HM_W bits (two frame
+// buffers, as in fmt_localmax), and their on-cells (z >= blob_threshold_i as the row
+// arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
+// prefix of rows is present:
+//   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
+//       against the previous row's on-cells P (A = C & P) the row's events are found:
+//       each C run gives a RUN event at its first column, with its first A column
+//       (found by one addition: the carry from the run's start runs through its C-only
+//       cells and lands on the first A cell); each further A run inside the C run gives
+//       a MERGE event at its first column.  Two events are never on adjacent columns,
+//       so a row has at most ceil(COLS/2) events (a row without any: one empty event).
+//   E : one event per cycle (lowest remaining event column, one carry chain), the C
+//       run's columns for a RUN event.
+//   X1..X5: the run's sums (area, sum z, sum z*c, sum z*r = r * sum z by shift and add,
+//       peak and its first column by a tournament of two levels per stage, extent),
+//       then the event enters a 32-entry FIFO (LUT RAM).  The extraction runs ahead of
+//       the labelling by up to the FIFO depth.
+//   L1: the label under the event's label column: the previous row's labels P (one per
+//       column, 0 = background), or the current row's labels C when the step in L2
+//       ends the previous row this cycle; that step is forwarded (its rename, its run).
+//   L2: one step per cycle (x = the label of the current C run, y = L1's label):
+//         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
+//         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
+//         MERGE, y != x         -> MERGE(x <- y): y is renamed x in P, C and alias; y is
+//                                  free again
+//       The row's last event ends it: the labels of P no longer in C are closed (their
+//       region is complete), P = C; after the last row every live label is closed.
+//       Labels are slots 1..NL, NL = 2*ceil(COLS/2) + 12: P and C hold at most
+//       ceil(COLS/2) labels each, and the labels closed at a row end plus the new
+//       labels of the next row stay below that bound but for a few cycles of pipeline
+//       (the close engine frees one label per cycle from 3 cycles after the row end;
+//       one label is prefetched).  A NEW would wait for a free label (tb/fmt_blob checks
+//       that it never does); nothing is ever dropped.
+//   A : the command updates the per-label accumulators (LUT RAM, one write, two reads,
+//       one of them shared with the close engine): NEW writes the run, ADD combines the
+//       run, MERGE combines label y into x.
+//   C : the close engine takes one closed label per cycle (picked one cycle ahead):
+//       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
+//       (fmt_sorted_list: area descending, ties by the raster index of the region's
+//       first cell ascending); the smallest falls off.  The list holds the keys and a
+//       slot number; the entries sit in LUT RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
 // same for cy) by one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8) shared
@@ -40,21 +51,19 @@
 // then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the label
-// of every cell at the end of its row (lr_mem, two frame banks like the heat map, so
-// the next frame's labelling never overwrites a mask still being queried); at the end
-// of row r+1, for each label of row r, whether it continued into row r+1 and as which
-// label (after the merges of row r+1) (fr_mem); and the close engine stores, per label
-// and row r, whether the label closed at the end of row r was a blob (cf_mem).  After
-// the frame a pass from the last row up gives, one row per cycle, the status of every
-// label of row r: the status of its continuation in row r+1 (known from the previous
-// step) or, when it did not continue, its close record.  The pass stores it as a status
-// word per row, indexed by label (st_mem, ROWS x NL bits).  The mask (every blob, also
-// those beyond MAX_BLOBS: blobs.blob_mask_fixed) is read one cell at a time through a
-// query port: (mask_q_row_i, mask_q_col_i) -> the cell's label (lr_mem) and its row's
-// status word (st_mem) one cycle later -> mask_q_data_o = the label's status bit two
-// cycles after the address; one query per cycle, pipelined.  mask_ready_o (with
-// mask_frame_o) marks the mask written; it stays readable until the next frame's pass
-// starts (that frame is labelled; never before its last row), queries in between
+// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
+// of row r, whether it continued into row r+1 and as which label (after the merges of
+// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
+// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
+// the last row up gives, one row per cycle, the status of every label of row r: the
+// status of its continuation in row r+1 (known from the previous step) or, when it did
+// not continue, its close record; one stage later every cell of the row gets its
+// label's status, a row of the mask (mask_mem, LUT RAM, ROWS x COLS bits: every blob,
+// also those beyond MAX_BLOBS: blobs.blob_mask_fixed).  Query port: (mask_q_row_i,
+// mask_q_col_i) -> the row's mask word one cycle later -> mask_q_data_o = the cell's
+// bit two cycles after the address; one query per cycle, pipelined.  mask_ready_o
+// (with mask_frame_o) marks the mask written; it stays readable until the next frame's
+// pass starts (that frame is labelled; never before its last row), queries in between
 // return 0.  An incomplete frame gives mask_ready_o with an all-zero mask.
 //
 // Fixed point: blob_cx_o, blob_cy_o are unsigned Q8.8 cells from the centre of cell
@@ -63,18 +72,22 @@
 // blob_threshold_i must be >= 1 (sum z > 0); with 0 an all-zero region would divide
 // by 0 (fmt_div then returns all ones) -- the model refuses threshold 0.
 //
-// Latency (processing-clock cycles, measured by tb/fmt_blob): the labelling takes
-// max(1, runs + merges) cycles per row and starts as soon as rows 0..r are present;
-// after the last labelled row: 4 pipeline cycles, one cycle per closed label, then
-// the emission (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass
-// (ROWS + 2).
+// Latency (processing-clock cycles, measured by tb/fmt_blob): a row is fetched as soon
+// as rows 0..r are present; the extraction and the labelling take max(1, events)
+// cycles per row each (no bubble between rows: L1 forwards the step of L2), the
+// extraction ahead; from a row's fetch to its first step 12 cycles; after the last
+// row's last step: 3 cycles to the close engine, one cycle per closed label, then the emission
+// (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 43..48 cycles, -> mask_ready_o 56..61 cycles.  Worst case (checkerboard: 600 runs,
-// every label slot live) 681 cycles from the first row beat to the end: within the
+// 46..55 cycles, -> mask_ready_o 63..70 cycles.  Worst case per frame: at most
+// ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
+// first row beat to the end: checkerboard (600 RUN events, every label slot live) 690,
+// combs 651, weave (the most merges with the most runs) 651 cycles: within the
 // 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
-// Settings are used live: change them between frames.
+// Settings are used live: change them between frames (the threshold applies to a row
+// when it arrives, min-cells when its region closes).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -578,7 +591,7 @@ module fmt_blob #(
     end
     // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
     // this cycle (C becomes P); this cycle's step forwarded
-    wire             bnd = l1_f[3] && l2_v_q;
+    wire             bnd = l1_f[3];           // first event of its row: C (see c_q)
     // (one-hot select, the compares with the victim done per column beside it)
     reg  [LBL_W-1:0] raw_p, raw_c;
     reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
@@ -600,10 +613,10 @@ module fmt_blob #(
                    && (i[COL_IDX_W-1:0] <= l1_e_q[F_CMX +: COL_IDX_W]);
         end
     end
-    wire             ren_at = bnd ? |(l1_oh_q & ren_c) : |(l1_oh_q & ren_p);
+    wire [LBL_W-1:0] y1_raw = bnd ? raw_c : raw_p;
     wire             l1_hit = bnd && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun
-                        : ((do_merge && ren_at) ? x_q : (bnd ? raw_c : raw_p));
+                        : ((do_merge && y1_raw == l2_y_q) ? x_q : y1_raw);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     assign           l1_free = !l1_v_q || l2_ld;
 
@@ -654,8 +667,15 @@ module fmt_blob #(
     reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
+    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
+    reg  [COLS*LBL_W-1:0] lr_on;
+    always @(*) begin : c_lr_on
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            lr_on[i*LBL_W +: LBL_W] = {LBL_W{on_l2[i]}};
+    end
     always @(posedge clk) begin
-        if (row_done) lr_mem[l2_row] <= c_nx;
+        if (row_done) lr_mem[l2_row] <= c_nx & lr_on;
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -664,6 +684,7 @@ module fmt_blob #(
     localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
+    reg                 x4_mrg_q;             // x4_op_q == OP_MERGE (a step was a merge)
     reg [LBL_W-1:0]     x4_a_q, x4_b_q;
     reg [NL:1]          x4_lp_q, x4_lc_q;     // P's and C's labels after the step
     wire [NL:1]         x4_k = x4_last_q ? (x4_lp_q | x4_lc_q) : (x4_lp_q & ~x4_lc_q);
@@ -693,10 +714,10 @@ module fmt_blob #(
     // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
     // or else the close engine's label (a closed label waits while a MERGE is applied)
     reg [E_W-1:0] acc_q [0:NL];             // (0: never written, keeps the reads in range)
-    wire            b_merge = x4_v_q && (x4_op_q == OP_MERGE);
+    wire            b_merge = x4_mrg_q;      // (x4_op_q == OP_MERGE)
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
-    assign acc_y = (x4_op_q == OP_MERGE) ? acc_b : x4_e_q;
+    assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
     // the close engine's next label (lowest pending), picked one cycle ahead
     reg  [LBL_W-1:0] pk_q;
     reg              pk_v_q;
@@ -972,6 +993,7 @@ module fmt_blob #(
         end
         if (do_run) x_q <= lrun;
         x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
+        x4_mrg_q <= do_merge;
         x4_a_q   <= do_merge ? x_q : lrun;
         x4_b_q   <= l2_y_q;
         x4_e_q   <= run_e;
@@ -981,8 +1003,8 @@ module fmt_blob #(
         x4_lp_q  <= livep_nx;
         x4_lc_q  <= livec_nx;
         // accumulators
-        if (x4_v_q) begin
-            case (x4_op_q)
+        begin
+            case (x4_op_q)                    // (OP_NONE when no step)
                 OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
                 OP_ADD,
                 OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_y);
@@ -1118,7 +1140,7 @@ module fmt_blob #(
             alias_q <= row_done ? alias_id : alias_nx;
             if (row_done) begin
                 p_q     <= l2_lastrow ? {(COLS*LBL_W){1'b0}} : c_nx;
-                c_q     <= {(COLS*LBL_W){1'b0}};
+                c_q     <= c_nx;              // kept: the next row's first event reads it
                 livep_q <= l2_lastrow ? {NL{1'b0}} : livec_nx;
                 livec_q <= {NL{1'b0}};
             end else begin
