@@ -664,18 +664,12 @@ module fmt_blob #(
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
     (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*LBL_W-1:0]     lr_mem [0:ROWS-1];
+    reg [COLS*(LBL_W+1)-1:0] lr_mem [0:ROWS-1];     // {on-cells, labels} of a row
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
     wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
-    reg  [COLS*LBL_W-1:0] lr_on;
-    always @(*) begin : c_lr_on
-        integer i;
-        for (i = 0; i < COLS; i = i + 1)
-            lr_on[i*LBL_W +: LBL_W] = {LBL_W{on_l2[i]}};
-    end
     always @(posedge clk) begin
-        if (row_done) lr_mem[l2_row] <= c_nx & lr_on;
+        if (row_done) lr_mem[l2_row] <= {on_l2, c_nx};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -850,7 +844,7 @@ module fmt_blob #(
     reg                  bw_v1_q, bw_v_q;     // block-RAM read of row bw_row1_q / bw_row_q
     reg [ROW_IDX_W-1:0]  bw_row1_q, bw_row_q;
     reg [NL*(LBL_W+1)-1:0] fr_rd1_q, fr_rd_q; // continuation record of row r
-    reg [COLS*LBL_W-1:0] lr_rd1_q, lr_rd_q;   // labels of row r
+    reg [COLS*(LBL_W+1)-1:0] lr_rd1_q, lr_rd_q;   // on-cells and labels of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg                  mask_ok_q;           // the mask holds a complete frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
@@ -905,7 +899,7 @@ module fmt_blob #(
     reg                  mk_v_q;
     reg [ROW_IDX_W-1:0]  mk_row_q;
     reg [NL:1]           mk_s_q;
-    reg [COLS*LBL_W-1:0] mk_lr_q;
+    reg [COLS*(LBL_W+1)-1:0] mk_lr_q;     // (C keeps older labels in off columns)
     reg [NLP-1:0]        mk_s_pad;
     reg [COLS-1:0]       mk_bits;
     always @(*) begin : c_mk
@@ -913,7 +907,7 @@ module fmt_blob #(
         mk_s_pad = {NLP{1'b0}};
         mk_s_pad[NL:1] = mk_s_q;
         for (c = 0; c < COLS; c = c + 1)
-            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]];
+            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]] && mk_lr_q[COLS*LBL_W + c];
     end
     (* ram_style = "distributed" *)
     reg [COLS-1:0]       mask_mem [0:ROWS-1];
