@@ -528,8 +528,8 @@ module fmt_blob #(
     reg [FE_W-1:0]  fmem [0:FD-1];
     reg [FP_W-1:0]  fwp_q, frp_q;
     reg [FP_W:0]    fcnt_q;
-    wire            l1_free;
-    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l1_free;
+    wire            l0_free;
+    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l0_free;
     always @(posedge clk) begin
         if (y5_v_q) fmem[fwp_q] <= y5_e_q;
     end
@@ -556,13 +556,19 @@ module fmt_blob #(
     reg [LBL_W-1:0]      n0_q;                // the next NEW label
     reg                  n0v_q;
     reg [LBL_W-1:0]      x_q;                 // label of the current C run
+    reg                  l0_v_q;
+    reg [FE_W-1:0]       l0_e_q;
+    reg [COLS-1:0]       l0_oh_q;             // the label column, one-hot
     reg                  l1_v_q;
     reg [FE_W-1:0]       l1_e_q;
-    reg [COLS-1:0]       l1_oh_q;             // the label column, one-hot
+    reg [COLS-1:0]       l1_oh_q;
+    reg [COLS-1:0]       l1_m_q;              // the C run's columns
+    reg [LBL_W-1:0]      l1_y_q;              // the label, up to date but for this cycle's step
     reg                  l2_v_q;
     /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
     reg [FE_W-1:0]       l2_e_q;
-    wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];    // L1 uses the first flag only
+    wire [EF_W-1:0]      l0_f  = l0_e_q[F_FL +: EF_W];    // L0, L1 use the first flag only
+    wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
     wire             new_wait;                // a NEW waits for a free label (testbench)
     /* verilator lint_on UNUSEDSIGNAL */
@@ -591,7 +597,10 @@ module fmt_blob #(
     end
     // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
     // this cycle (C becomes P); this cycle's step forwarded
-    wire             bnd = l1_f[3];           // first event of its row: C (see c_q)
+    // L0 reads C when its event is the first of its row, or when L1 holds that first
+    // event (L2 may end the previous row this cycle); the step of this cycle is applied,
+    // L1 applies the next one
+    wire             bnd = l0_f[3] || (l1_v_q && l1_f[3]);
     // (one-hot select, the compares with the victim done per column beside it)
     reg  [LBL_W-1:0] raw_p, raw_c;
     reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
@@ -600,8 +609,8 @@ module fmt_blob #(
         integer i, b;
         for (b = 0; b < LBL_W; b = b + 1) begin
             for (i = 0; i < COLS; i = i + 1) begin
-                t_p[i] = l1_oh_q[i] && p_q[i*LBL_W + b];
-                t_c[i] = l1_oh_q[i] && c_q[i*LBL_W + b];
+                t_p[i] = l0_oh_q[i] && p_q[i*LBL_W + b];
+                t_c[i] = l0_oh_q[i] && c_q[i*LBL_W + b];
             end
             raw_p[b] = |t_p;
             raw_c[b] = |t_c;
@@ -609,16 +618,21 @@ module fmt_blob #(
         for (i = 0; i < COLS; i = i + 1) begin
             ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
             ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
-            l1_m[i] = (i[COL_IDX_W-1:0] >= l1_e_q[F_CMN +: COL_IDX_W])
-                   && (i[COL_IDX_W-1:0] <= l1_e_q[F_CMX +: COL_IDX_W]);
+            l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
+                   && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
     end
-    wire [LBL_W-1:0] y1_raw = bnd ? raw_c : raw_p;
-    wire             l1_hit = bnd && do_run && |(l1_oh_q & l2_m_q);
+    wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
+    wire             l0_hit = bnd && do_run && |(l0_oh_q & l2_m_q);
+    wire [LBL_W-1:0] y0 = l0_hit ? lrun
+                        : ((do_merge && y0_raw == l2_y_q) ? x_q : y0_raw);
+    // L1: this cycle's step (a run of the previous row only for the row's first event)
+    wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun
-                        : ((do_merge && y1_raw == l2_y_q) ? x_q : y1_raw);
+                        : ((do_merge && l1_y_q == l2_y_q) ? x_q : l1_y_q);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
-    assign           l1_free = !l1_v_q || l2_ld;
+    wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    assign           l0_free = !l0_v_q || l1_ld;
 
     // next label vectors and live masks of this cycle's step
     reg [COLS*LBL_W-1:0] p_nx, c_nx;
@@ -933,7 +947,7 @@ module fmt_blob #(
     end
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
-                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l1_v_q || l2_v_q || x4_v_q
+                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
                    || cl_v_q || (|pend_q) || pk_v_q;
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
@@ -978,12 +992,20 @@ module fmt_blob #(
         x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= pk4[PN4*PK_W-1:0];
         y4_e_q <= x3_ev;  y4_pk_q <= pk6[PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
         y5_e_q <= y4_ev;
-        if (fpop) l1_e_q <= f_rd;
-        if (fpop) l1_oh_q <= lc_oh;
+        if (fpop) l0_e_q <= f_rd;
+        if (fpop) l0_oh_q <= lc_oh;
+        if (l1_ld) begin
+            l1_e_q  <= l0_e_q;
+            l1_oh_q <= l0_oh_q;
+            l1_m_q  <= l1_m;
+            l1_y_q  <= y0;
+        end else begin
+            l1_y_q  <= y1;                    // held: this cycle's step applied
+        end
         if (l2_ld) begin
             l2_e_q <= l1_e_q;
             l2_y_q <= y1;
-            l2_m_q <= l1_m;
+            l2_m_q <= l1_m_q;
         end
         if (do_run) x_q <= lrun;
         x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
@@ -1048,6 +1070,7 @@ module fmt_blob #(
             frp_q    <= {FP_W{1'b0}};
             fcnt_q   <= {(FP_W+1){1'b0}};
             res_q    <= {(FP_W+1){1'b0}};
+            l0_v_q   <= 1'b0;
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
@@ -1125,7 +1148,9 @@ module fmt_blob #(
             if (fpop)   frp_q <= frp_q + 1'b1;
             fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
             res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
-            if (fpop) l1_v_q <= 1'b1;
+            if (fpop) l0_v_q <= 1'b1;
+            else if (l1_ld) l0_v_q <= 1'b0;
+            if (l1_ld) l1_v_q <= 1'b1;
             else if (l2_ld) l1_v_q <= 1'b0;
             if (l2_ld) l2_v_q <= 1'b1;
             else if (step) l2_v_q <= 1'b0;
