@@ -624,8 +624,9 @@ module fmt_blob #(
     end
     wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
     wire             l0_hit = bnd && do_run && |(l0_oh_q & l2_m_q);
-    wire [LBL_W-1:0] y0 = l0_hit ? lrun
-                        : ((do_merge && y0_raw == l2_y_q) ? x_q : y0_raw);
+    // (the victim compare per column beside the select, not after it)
+    wire             ren0 = bnd ? |(l0_oh_q & ren_c) : |(l0_oh_q & ren_p);
+    wire [LBL_W-1:0] y0 = l0_hit ? lrun : ((do_merge && ren0) ? x_q : y0_raw);
     // L1: this cycle's step (a run of the previous row only for the row's first event)
     wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun
@@ -994,13 +995,11 @@ module fmt_blob #(
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
-        if (l1_ld) begin
+        if (l1_ld) begin                      // (L1 holds only while L2 waits: no step)
             l1_e_q  <= l0_e_q;
             l1_oh_q <= l0_oh_q;
             l1_m_q  <= l1_m;
             l1_y_q  <= y0;
-        end else begin
-            l1_y_q  <= y1;                    // held: this cycle's step applied
         end
         if (l2_ld) begin
             l2_e_q <= l1_e_q;
