@@ -79,10 +79,10 @@
 // row's last step: 3 cycles to the close engine, one cycle per closed label, then the emission
 // (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 46..55 cycles, -> mask_ready_o 63..70 cycles.  Worst case per frame: at most
+// 47..56 cycles, -> mask_ready_o 64..71 cycles.  Worst case per frame: at most
 // ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
-// first row beat to the end: checkerboard (600 RUN events, every label slot live) 690,
-// combs 651, weave (the most merges with the most runs) 651 cycles: within the
+// first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
+// combs 652, weave (the most merges with the most runs) 652 cycles: within the
 // 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
