@@ -3,36 +3,47 @@
 // blob_stream_fixed).
 //
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,
-// stored in an inferred RAM of 2 x ROWS words of COLS*HM_W bits (two frame buffers, as
-// in fmt_localmax: the next frame may arrive while this one is finished).  The frame is
-// labelled in raster order as soon as a prefix of rows is present:
-//   F : fetch the next row (synchronous RAM read), threshold it when it becomes current
-//   L : run-serial labelling, one step per cycle.  The current row's remaining on-cells
-//       R give the next run M (lowest run of R).  The previous row's labels P (one label
-//       per column, 0 = background) under M are looked at:
-//         two different labels A, B     -> MERGE(A <- B): B is renamed A in P and in the
-//                                          current row's labels C; the run is retried
-//         one label A                   -> ADD(A): C[M] = A, the run is done
-//         none                          -> NEW(L): lowest free label, C[M] = L
-//       The row ends with its last run (or in one cycle when it has no run): the labels
-//       of P that are no longer in C are closed (their region is complete), P = C.
-//       After the last row every live label is closed.  Labels are slots 1..NL,
-//       NL = 2*ceil(COLS/2) + 6: every label that can be live in two rows (P and C,
-//       ceil(COLS/2) runs each) plus the closed labels still in the pipeline to the close
-//       engine, so the labelling does not run out of labels (a NEW waits for a free
-//       slot if it ever did -- the close engine pauses while a MERGE is applied, and a
-//       MERGE frees a label itself; nothing is ever dropped).
-//   X2..X4: masked sums of the run (area, sum z, sum z*c, sum z*r = r * sum z, peak and
-//       its first column, first/last column), 8-column groups then totals
-//   A : the command updates the per-label accumulators (a distributed RAM, one write
-//       and two asynchronous reads, one of them shared with the close engine): NEW
-//       writes the run, ADD combines the run, MERGE combines label B into A (B is free
-//       again).
-//   C : the close engine takes one closed label per cycle: if its area >= min_cells it is
-//       inserted into a sorted list of MAX_BLOBS entries (fmt_sorted_list: area
-//       descending, ties by the raster index of the region's first cell ascending); the
-//       smallest falls off.  The
-//       list holds the keys and a slot number; the entries sit in distributed RAM.
+// stored in an inferred block RAM of 2 x ROWS words of COLS*HM_W bits (two frame
+// buffers, as in fmt_localmax), and their on-cells (z >= blob_threshold_i as the row
+// arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
+// prefix of rows is present:
+//   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
+//       against the previous row's on-cells P (A = C & P) the row's events are found:
+//       each C run gives a RUN event at its first column, with its first A column
+//       (found by one addition: the carry from the run's start runs through its C-only
+//       cells and lands on the first A cell); each further A run inside the C run gives
+//       a MERGE event at its first column.  Two events are never on adjacent columns,
+//       so a row has at most ceil(COLS/2) events (a row without any: one empty event).
+//   E : one event per cycle (lowest remaining event column, one carry chain), the C
+//       run's columns for a RUN event.
+//   X1..X5: the run's sums (area, sum z, sum z*c, sum z*r = r * sum z by shift and add,
+//       peak and its first column by a tournament of two levels per stage, extent),
+//       then the event enters a 32-entry FIFO (LUT RAM).  The extraction runs ahead of
+//       the labelling by up to the FIFO depth.
+//   L1: the label under the event's label column: the previous row's labels P (one per
+//       column, 0 = background), or the current row's labels C when the step in L2
+//       ends the previous row this cycle; that step is forwarded (its rename, its run).
+//   L2: one step per cycle (x = the label of the current C run, y = L1's label):
+//         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
+//         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
+//         MERGE, y != x         -> MERGE(x <- y): y is renamed x in P, C and alias; y is
+//                                  free again
+//       The row's last event ends it: the labels of P no longer in C are closed (their
+//       region is complete), P = C; after the last row every live label is closed.
+//       Labels are slots 1..NL, NL = 2*ceil(COLS/2) + 12: P and C hold at most
+//       ceil(COLS/2) labels each, and the labels closed at a row end plus the new
+//       labels of the next row stay below that bound but for a few cycles of pipeline
+//       (the close engine frees one label per cycle from 3 cycles after the row end;
+//       one label is prefetched).  A NEW would wait for a free label (tb/fmt_blob checks
+//       that it never does); nothing is ever dropped.
+//   A : the command updates the per-label accumulators (LUT RAM, one write, two reads,
+//       one of them shared with the close engine): NEW writes the run, ADD combines the
+//       run, MERGE combines label y into x.
+//   C : the close engine takes one closed label per cycle (picked one cycle ahead):
+//       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
+//       (fmt_sorted_list: area descending, ties by the raster index of the region's
+//       first cell ascending); the smallest falls off.  The list holds the keys and a
+//       slot number; the entries sit in LUT RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
 // same for cy) by one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8) shared
@@ -40,21 +51,19 @@
 // then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the label
-// of every cell at the end of its row (lr_mem, two frame banks like the heat map, so
-// the next frame's labelling never overwrites a mask still being queried); at the end
-// of row r+1, for each label of row r, whether it continued into row r+1 and as which
-// label (after the merges of row r+1) (fr_mem); and the close engine stores, per label
-// and row r, whether the label closed at the end of row r was a blob (cf_mem).  After
-// the frame a pass from the last row up gives, one row per cycle, the status of every
-// label of row r: the status of its continuation in row r+1 (known from the previous
-// step) or, when it did not continue, its close record.  The pass stores it as a status
-// word per row, indexed by label (st_mem, ROWS x NL bits).  The mask (every blob, also
-// those beyond MAX_BLOBS: blobs.blob_mask_fixed) is read one cell at a time through a
-// query port: (mask_q_row_i, mask_q_col_i) -> the cell's label (lr_mem) and its row's
-// status word (st_mem) one cycle later -> mask_q_data_o = the label's status bit two
-// cycles after the address; one query per cycle, pipelined.  mask_ready_o (with
-// mask_frame_o) marks the mask written; it stays readable until the next frame's pass
-// starts (that frame is labelled; never before its last row), queries in between
+// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
+// of row r, whether it continued into row r+1 and as which label (after the merges of
+// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
+// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
+// the last row up gives, one row per cycle, the status of every label of row r: the
+// status of its continuation in row r+1 (known from the previous step) or, when it did
+// not continue, its close record; one stage later every cell of the row gets its
+// label's status, a row of the mask (mask_mem, LUT RAM, ROWS x COLS bits: every blob,
+// also those beyond MAX_BLOBS: blobs.blob_mask_fixed).  Query port: (mask_q_row_i,
+// mask_q_col_i) -> the row's mask word one cycle later -> mask_q_data_o = the cell's
+// bit two cycles after the address; one query per cycle, pipelined.  mask_ready_o
+// (with mask_frame_o) marks the mask written; it stays readable until the next frame's
+// pass starts (that frame is labelled; never before its last row), queries in between
 // return 0.  An incomplete frame gives mask_ready_o with an all-zero mask.
 //
 // Fixed point: blob_cx_o, blob_cy_o are unsigned Q8.8 cells from the centre of cell
@@ -63,18 +72,22 @@
 // blob_threshold_i must be >= 1 (sum z > 0); with 0 an all-zero region would divide
 // by 0 (fmt_div then returns all ones) -- the model refuses threshold 0.
 //
-// Latency (processing-clock cycles, measured by tb/fmt_blob): the labelling takes
-// max(1, runs + merges) cycles per row and starts as soon as rows 0..r are present;
-// after the last labelled row: 4 pipeline cycles, one cycle per closed label, then
-// the emission (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass
-// (ROWS + 2).
+// Latency (processing-clock cycles, measured by tb/fmt_blob): a row is fetched as soon
+// as rows 0..r are present; the extraction and the labelling take max(1, events)
+// cycles per row each (no bubble between rows: L1 forwards the step of L2), the
+// extraction ahead; from a row's fetch to its first step 12 cycles; after the last
+// row's last step: 3 cycles to the close engine, one cycle per closed label, then the emission
+// (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 43..48 cycles, -> mask_ready_o 56..61 cycles.  Worst case (checkerboard: 600 runs,
-// every label slot live) 681 cycles from the first row beat to the end: within the
+// 47..56 cycles, -> mask_ready_o 64..71 cycles.  Worst case per frame: at most
+// ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
+// first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
+// combs 652, weave (the most merges with the most runs) 652 cycles: within the
 // 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
-// Settings are used live: change them between frames.
+// Settings are used live: change them between frames (the threshold applies to a row
+// when it arrives, min-cells when its region closes).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -133,7 +146,7 @@ module fmt_blob #(
     // ---- sizes -------------------------------------------------------------------------
     // label slots 1..NL: every label live in two rows (P and C) plus the labels closed
     // at a row end that the close engine has not released yet (<= 6 cycles)
-    localparam NL     = 2 * ((COLS + 1) / 2) + 6;
+    localparam NL     = 2 * ((COLS + 1) / 2) + 12;
     localparam LBL_W  = $clog2(NL + 1);
     localparam SZ_W   = HM_W + AREA_W;               // sum z
     localparam SX_W   = SZ_W + COL_IDX_W;            // sum z*c
@@ -165,6 +178,11 @@ module fmt_blob #(
     localparam O_PC   = O_PR + ROW_IDX_W;
     localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
     localparam E_W    = O_FC + COL_IDX_W;
+    // event FIFO between the extraction (E, X1..X5) and the labelling (L1, L2)
+    localparam FP_W   = 5;                           // FIFO pointer width
+    localparam FD     = 1 << FP_W;                   // entries (>= events of a row + 6)
+    localparam FE_W   = 5 + 3 * COL_IDX_W + ROW_IDX_W + AREA_W + SZ_W + SX_W + SY_W + HM_W
+                      + COL_IDX_W;                   // entry: see F_* below
 
     localparam integer ROWS_I = ROWS;
     localparam integer MB_I   = MAX_BLOBS;
@@ -222,193 +240,145 @@ module fmt_blob #(
 
     wire [ADDR_W-1:0] wr_addr = (wb_q ? ROWS_A : {ADDR_W{1'b0}})
                               + {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
+    // the on-cells of every row (z >= blob_threshold_i as the row arrives)
+    (* ram_style = "distributed" *)
+    reg [COLS-1:0]       on_mem [0:(2<<ROW_IDX_W)-1];    // address {bank, row}
+    reg [COLS-1:0]       hm_on;
+    always @(*) begin : c_hm_on
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
+    end
     always @(posedge clk) begin
-        if (hm_valid_i) mem[wr_addr] <= hm_data_i;
+        if (hm_valid_i) begin
+            mem[wr_addr]    <= hm_data_i;
+            on_mem[{wb_q, hm_row_i}] <= hm_on;
+        end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
 
     localparam [1:0] S_RUN = 2'd0, S_EMIT = 2'd1, S_WAIT = 2'd2;
     reg [1:0] state_q;
 
-    // ---- F: fetch ----------------------------------------------------------------------
-    reg [ROW_IDX_W:0]   fr_q;                 // next row to fetch (ROWS = all fetched)
-    reg                 nx_v_q;
-    reg [ROW_IDX_W-1:0] nx_row_q;
-    reg [RW-1:0]        nx_z_q;
-    reg                 cur_v_q;
-    reg [ROW_IDX_W-1:0] cur_row_q;
-    reg [RW-1:0]        cur_z_q;
-    reg [COLS-1:0]      rem_q;                // on-cells of the current row not yet labelled
-    wire                row_done;             // the label stage finishes its row this cycle
-    wire                take  = nx_v_q && (!cur_v_q || row_done);
-    wire                fr_in = (fr_q < ROWS_R);
+    // ---- F: fetch: the row (block RAM: read register, then its output register) and
+    // its on-cells (thresholded as the row arrived, on_mem); the second stage also
+    // prepares the row's event starts against the previous row's on-cells ---------------
+    wire                 f2_take;             // E takes the row in F2
+    reg  [ROW_IDX_W:0]   fr_q;                // next row to fetch (ROWS = all fetched)
+    reg                  f1_v_q, f2_v_q;
+    reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
+    reg  [RW-1:0]        f1_z_q, f2_z_q;
+    reg  [COLS-1:0]      f1_c_q, f2_c_q, f2_es_q, f2_fa_q, f2_b_q, f2_ge_q;
+    reg                  f2_one_q;            // the row has at most one event
+    reg  [COLS-1:0]      lastc_q;             // on-cells of the row fetched before (0: none)
+    reg  [COLS-1:0]      f1_es_q, f1_fa_q;
+    wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
+    wire                 fr_in = (fr_q < ROWS_R);
     wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
-    wire                fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!nx_v_q || take);
-    wire [ADDR_W-1:0]   rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
-                                + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
+    wire                 fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!f1_v_q || f1_mv);
+    wire [ADDR_W-1:0]    rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
+                                 + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
+    // Events of a row (C: its on-cells, P: the previous row's): A = C & P; each C run
+    // gives a run event at its start, labelled from its first A column (fa, none: a
+    // new label), and every further A run inside it a merge event at the A run's start.
+    // fa by one addition: the carry of a C run start runs through the run's C-only
+    // cells and lands on its first A cell (or beyond the run: no A cell).
+    wire [COLS-1:0]      on_f = on_mem[{pb_q, fr_row}];
+    wire [COLS-1:0]      ca   = on_f & lastc_q;
+    wire [COLS-1:0]      cy   = on_f & ~lastc_q;
+    wire [COLS-1:0]      ccs  = on_f & ~{on_f[COLS-2:0], 1'b0};
+    /* verilator lint_off UNUSEDSIGNAL */     // land[COLS]: a carry beyond the last column
+    wire [COLS:0]        land = {1'b0, cy} + {1'b0, ccs};
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [COLS-1:0]      fa_f = land[COLS-1:0] & ~cy & on_f;
+    wire [COLS-1:0]      es_f = ccs | (ca & ~{ca[COLS-2:0], 1'b0} & ~fa_f);
+    wire [COLS-1:0]      es_neg = ~f1_es_q + 1'b1;    // the first event: lowest bit and up
     always @(posedge clk) begin
-        if (fetch) nx_z_q <= mem[rd_addr];
-    end
-    reg [COLS-1:0] nx_on;
-    always @(*) begin : c_nx_on
-        integer i;
-        for (i = 0; i < COLS; i = i + 1)
-            nx_on[i] = (nx_z_q[i*HM_W +: HM_W] >= blob_threshold_i);
-    end
-
-    // ---- L: labelling ------------------------------------------------------------------
-    reg [COLS*LBL_W-1:0] p_q, c_q;            // labels of the previous / current row
-    reg [NL:1]           livep_q, livec_q;    // labels present in P / in C
-    reg [NL:1]           free_q;              // free label slots
-    reg [NL:1]           pend_q;              // closed labels waiting for the close engine
-
-    // rem + lowest set bit clears the lowest run (its carry stops above the run)
-    wire [COLS-1:0] r_low = rem_q & (~rem_q + 1'b1);
-    wire [COLS-1:0] r_sum = rem_q + r_low;
-    wire [COLS-1:0] run_m = rem_q & ~r_sum;                // lowest run of rem_q
-    wire has_run = |rem_q;
-
-    reg [LBL_W-1:0] la, lb, lfree;
-    reg [NL:1] lb_bit, lfree_bit;
-    always @(*) begin : c_runlbl
-        integer i;
-        la = {LBL_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1)
-            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}}) la = p_q[i*LBL_W +: LBL_W];
-        lb = {LBL_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1)
-            if (run_m[i] && p_q[i*LBL_W +: LBL_W] != {LBL_W{1'b0}} && p_q[i*LBL_W +: LBL_W] != la)
-                lb = p_q[i*LBL_W +: LBL_W];
-        lfree = {LBL_W{1'b0}};
-        for (i = NL; i >= 1; i = i - 1)
-            if (free_q[i]) lfree = i[LBL_W-1:0];
-        for (i = 1; i <= NL; i = i + 1) begin
-            lb_bit[i]    = (lb == i[LBL_W-1:0]);
-            lfree_bit[i] = (lfree == i[LBL_W-1:0]);
+        if (fetch) begin
+            f1_z_q   <= mem[rd_addr];
+            f1_c_q   <= on_f;
+            f1_es_q  <= es_f;
+            f1_fa_q  <= fa_f;
+            f1_row_q <= fr_row;
+        end
+        if (f1_mv) begin
+            f2_z_q   <= f1_z_q;
+            f2_c_q   <= f1_c_q;
+            f2_es_q  <= f1_es_q;
+            f2_fa_q  <= f1_fa_q;
+            f2_b_q   <= f1_es_q & es_neg;
+            f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
+            f2_ge_q  <= f1_es_q | es_neg;
+            f2_row_q <= f1_row_q;
         end
     end
-    wire ha = (la != {LBL_W{1'b0}});
-    wire hb = (lb != {LBL_W{1'b0}});
-    wire fa = (lfree != {LBL_W{1'b0}});
-    wire do_merge = cur_v_q && has_run && hb;
-    wire do_run   = cur_v_q && has_run && !hb && (ha || fa);
-    wire do_new   = do_run && !ha;
-    wire [LBL_W-1:0] lrun = ha ? la : lfree;
-    wire last_row = (cur_row_q == LAST_ROW);
-    assign row_done = cur_v_q && (!has_run || (do_run && ((rem_q & ~run_m) == {COLS{1'b0}})));
 
-    // next label vectors and live masks of this cycle's step
-    reg [COLS*LBL_W-1:0] p_nx, c_nx;
-    reg [NL:1]           livep_nx, livec_nx;
-    always @(*) begin : c_step
-        integer i;
-        i = 0;                                // the loops run conditionally: no latch for i
-        p_nx = p_q;
-        c_nx = c_q;
-        livep_nx = livep_q;
-        livec_nx = livec_q;
-        if (do_merge) begin
-            for (i = 0; i < COLS; i = i + 1) begin
-                if (p_q[i*LBL_W +: LBL_W] == lb) p_nx[i*LBL_W +: LBL_W] = la;
-                if (c_q[i*LBL_W +: LBL_W] == lb) c_nx[i*LBL_W +: LBL_W] = la;
-            end
-            for (i = 1; i <= NL; i = i + 1) begin
-                if (i[LBL_W-1:0] == la && livec_q[i] == 1'b0) livec_nx[i] = |(livec_q & lb_bit);
-            end
-            livep_nx = livep_nx & ~lb_bit;
-            livec_nx = livec_nx & ~lb_bit;
-        end
-        if (do_run) begin
-            for (i = 0; i < COLS; i = i + 1)
-                if (run_m[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
-            for (i = 1; i <= NL; i = i + 1)
-                if (i[LBL_W-1:0] == lrun) livec_nx[i] = 1'b1;
-        end
-    end
-    wire [NL:1] close_k = last_row ? (livep_nx | livec_nx) : (livep_nx & ~livec_nx);
+    // ---- E: event extraction, one event per cycle (lowest remaining event start) -------
+    reg                  e1_v_q, e1_first_q;
+    reg  [ROW_IDX_W-1:0] e1_row_q;
+    reg  [RW-1:0]        e1_z_q;
+    reg  [COLS-1:0]      e1_c_q, e1_fa_q;
+    reg  [COLS-1:0]      e1_rem_q;            // event starts not yet emitted (with b)
+    reg  [COLS-1:0]      e1_b_q;              // this event's start (one-hot; 0: empty row)
+    reg  [COLS-1:0]      e1_ge_q;             // columns >= e1_b_q
+    reg  [FP_W:0]        res_q;               // events emitted by E and not taken by L1
+    reg                  e1_last_q;           // this event is the row's last
+    wire                 ev_last = e1_last_q;
+    wire                 ev_go   = e1_v_q && !res_q[FP_W];   // res_q < FD
+    assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
+    wire [COLS-1:0]      e1_remr = e1_rem_q & ~e1_b_q;
+    wire [COLS-1:0]      e1_neg  = ~e1_remr + 1'b1;      // lowest bit and up: one carry
+    wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
+    wire                 ev_run  = |(e1_b_q & e1_cs);
+    wire [COLS-1:0]      cge     = e1_c_q & e1_ge_q;
+    wire [COLS-1:0]      crun    = cge & ~(cge + e1_b_q); // the C run starting at b
+    wire [COLS-1:0]      ev_m    = ev_run ? crun : {COLS{1'b0}};
+    wire [COLS-1:0]      ev_lc   = ev_run ? (e1_fa_q & crun) : e1_b_q;
 
-    // Records for the membership pass: the labels of every row at its end (after its
-    // merges), and, written at the end of row r+1 about the labels of row r, which of
-    // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
-    // by the merges of row r+1).
-    reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
-    always @(*) begin : c_alias
-        integer i;
-        for (i = 1; i <= NL; i = i + 1) begin
-            alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
-            alias_nx[(i-1)*LBL_W +: LBL_W] =
-                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == lb) ? la : alias_q[(i-1)*LBL_W +: LBL_W];
-        end
-    end
-    wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
-    (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*LBL_W-1:0]     lr_mem [0:2*ROWS-1];   // two banks, as mem
-    (* ram_style = "block" *)
-    reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
-    wire [ADDR_W-1:0] lr_wa = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
-                            + {{(ADDR_W-ROW_IDX_W){1'b0}}, cur_row_q};
-    always @(posedge clk) begin
-        if (row_done) lr_mem[lr_wa] <= c_nx;
-        if (row_done && cur_row_q != {ROW_IDX_W{1'b0}})
-            fr_mem[cur_row_q - 1'b1] <= {cont_rec, alias_nx};
-    end
-
-    // ---- X1: command register ---------------------------------------------------------
-    localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
-    reg                 x1_v_q, x1_end_q, x1_last_q;
-    reg [1:0]           x1_op_q;
-    reg [LBL_W-1:0]     x1_a_q, x1_b_q;
-    reg [COLS-1:0]      x1_m_q;
-    reg [RW-1:0]        x1_zm_q;
+    // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
+    // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
+    localparam EF_W = 5;                      // event flags: run, hy, last, first, last row
+    reg                 x1_v_q;
+    reg [EF_W-1:0]      x1_f_q;
+    reg [COLS-1:0]      x1_m_q, x1_lc_q;
+    reg [RW-1:0]        x1_z_q;               // the row (masked by x1_m_q in X2)
     reg [ROW_IDX_W-1:0] x1_row_q;
-    reg [NL:1]          x1_k_q;
-    reg [RW-1:0]        zm;
-    always @(*) begin : c_zm
-        integer i;
-        for (i = 0; i < COLS; i = i + 1)
-            zm[i*HM_W +: HM_W] = run_m[i] ? cur_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
-    end
-
     // ---- X2: group sums, run extent ---------------------------------------------------
-    reg                 x2_v_q, x2_end_q, x2_last_q;
-    reg [1:0]           x2_op_q;
-    reg [LBL_W-1:0]     x2_a_q, x2_b_q;
     reg [ROW_IDX_W-1:0] x2_row_q;
-    reg [NL:1]          x2_k_q;
     reg [NG*GSZ_W-1:0]  x2_gs_q;
     reg [NG*GSX_W-1:0]  x2_gx_q;
-    reg [NG*HM_W-1:0]   x2_gm_q;
-    reg [NG*COL_IDX_W-1:0] x2_gc_q;
-    reg [AREA_W-1:0]    x2_cnt_q;
     reg [COL_IDX_W-1:0] x2_cmin_q, x2_cmax_q;
     reg [NG*GSZ_W-1:0]  gs;
     reg [NG*GSX_W-1:0]  gx;
-    reg [NG*HM_W-1:0]   gm;
-    reg [NG*COL_IDX_W-1:0] gc;
-    reg [AREA_W-1:0]    cnt;
     reg [COL_IDX_W-1:0] cmin, cmax;
-    reg [HM_W-1:0]      pm1 [0:3];            // peak tournament: winners, decisions
-    reg [HM_W-1:0]      pm2 [0:1];
-    reg [3:0]           pd1;
-    reg [1:0]           pd2;
-    reg                 pd3, pi1;
-    /* verilator lint_off UNUSEDSIGNAL */     // integer arithmetic: only the column bits are used
-    integer             pcol;
-    /* verilator lint_on UNUSEDSIGNAL */
+    reg [COLS-1:0]      m_first, m_last, m_t0, m_t1;
     reg [GS*HM_W-1:0]   gz;
     reg [HM_W+1:0]      gu [0:3];             // HM_W + 2 bits: gu[1] + gu[3] below fits
     reg [HM_W+1:0]      gv0, gv1, go;
+    reg                 x2_v_q;
+    reg [EF_W-1:0]      x2_f_q;
+    reg [COL_IDX_W-1:0] x2_lc_q;
+    // one-hot -> index: bit b = OR of the one-hot bits whose index has bit b (a balanced
+    // OR, not a chain)
+    reg [COL_IDX_W-1:0] lc_enc;
+    reg [COLS-1:0]      lc_t;
+    always @(*) begin : c_lc_enc
+        integer i, b;
+        for (b = 0; b < COL_IDX_W; b = b + 1) begin
+            for (i = 0; i < COLS; i = i + 1)
+                lc_t[i] = x1_lc_q[i] && (((i >> b) & 1) == 1);
+            lc_enc[b] = |lc_t;
+        end
+    end
     always @(*) begin : c_x2
         integer i, g;
         gs = {(NG*GSZ_W){1'b0}};
         gx = {(NG*GSX_W){1'b0}};
-        gm = {(NG*HM_W){1'b0}};
-        gc = {(NG*COL_IDX_W){1'b0}};
         for (g = 0; g < NG; g = g + 1) begin
             // the group's 8 masked cells (0 beyond the last column)
             for (i = 0; i < GS; i = i + 1)
-                gz[i*HM_W +: HM_W] = (g * GS + i < COLS)
-                                   ? x1_zm_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS && x1_m_q[(g * GS + i < COLS) ? g * GS + i : 0])
+                                   ? x1_z_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
                                    : {HM_W{1'b0}};
             // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
             // u_i = z_2i + z_2i+1, v_0 = u_0 + u_1, v_1 = u_2 + u_3, sum = v_0 + v_1,
@@ -423,55 +393,86 @@ module fmt_blob #(
             gx[g*GSX_W +: GSX_W] = {{(GSX_W-HM_W-5){1'b0}}, gv1, 2'b00}
                                  + {{(GSX_W-HM_W-3){1'b0}}, gu[1] + gu[3], 1'b0}
                                  + {{(GSX_W-HM_W-2){1'b0}}, go};
-            // peak of the group: first maximum, by a tournament of 7 strict compares
-            // (the right one wins only when larger: the leftmost maximum); the
-            // winner's column comes from the decisions, not carried through muxes
-            for (i = 0; i < 4; i = i + 1) begin
-                pd1[i] = (gz[(2*i+1)*HM_W +: HM_W] > gz[(2*i)*HM_W +: HM_W]);
-                pm1[i] = pd1[i] ? gz[(2*i+1)*HM_W +: HM_W] : gz[(2*i)*HM_W +: HM_W];
-            end
-            for (i = 0; i < 2; i = i + 1) begin
-                pd2[i] = (pm1[2*i+1] > pm1[2*i]);
-                pm2[i] = pd2[i] ? pm1[2*i+1] : pm1[2*i];
-            end
-            pd3 = (pm2[1] > pm2[0]);
-            gm[g*HM_W +: HM_W] = pd3 ? pm2[1] : pm2[0];
-            pi1 = pd2[pd3];
-            pcol = g * GS + 4 * pd3 + 2 * pi1 + pd1[{pd3, pi1}];
-            gc[g*COL_IDX_W +: COL_IDX_W] = pcol[COL_IDX_W-1:0];
         end
-        cnt = {AREA_W{1'b0}};
-        cmin = {COL_IDX_W{1'b0}};
-        cmax = {COL_IDX_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1) begin
-            cnt = cnt + {{(AREA_W-1){1'b0}}, x1_m_q[i]};
-            if (x1_m_q[i]) cmin = i[COL_IDX_W-1:0];
+        // the run's first and last column: one-hot, then encoded (balanced ORs)
+        for (i = 0; i < COLS; i = i + 1) begin
+            m_first[i] = x1_m_q[i] && (i == 0 || !x1_m_q[(i > 0) ? i - 1 : 0]);
+            m_last[i]  = x1_m_q[i] && (i == COLS - 1 || !x1_m_q[(i < COLS - 1) ? i + 1 : 0]);
         end
-        for (i = 0; i < COLS; i = i + 1)
-            if (x1_m_q[i]) cmax = i[COL_IDX_W-1:0];
+        for (g = 0; g < COL_IDX_W; g = g + 1) begin
+            for (i = 0; i < COLS; i = i + 1) begin
+                m_t0[i] = m_first[i] && (((i >> g) & 1) == 1);
+                m_t1[i] = m_last[i] && (((i >> g) & 1) == 1);
+            end
+            cmin[g] = |m_t0;
+            cmax[g] = |m_t1;
+        end
     end
 
+    // Peak of the run (largest z, the leftmost among equals): a tournament over the
+    // masked cells, two levels per stage (X2, X3, X4); an entry is {z, column}, the
+    // right one of a pair wins only when strictly larger.
+    localparam PK_W = HM_W + COL_IDX_W;
+    localparam PN0 = COLS, PN1 = (PN0 + 1) / 2, PN2 = (PN1 + 1) / 2, PN3 = (PN2 + 1) / 2;
+    localparam PN4 = (PN3 + 1) / 2, PN5 = (PN4 + 1) / 2, PN6 = (PN5 + 1) / 2;   // 1: COLS <= 64
+    function [PN0*PK_W-1:0] pk_half;          // entry k = winner of entries 2k, 2k+1 of v
+        input [PN0*PK_W-1:0] v;
+        input integer        n;               // entries in v
+        integer k, j;
+        begin
+            pk_half = {(PN0*PK_W){1'b0}};
+            for (k = 0; k < PN0; k = k + 1) begin
+                j = (2 * k + 1 < PN0) ? 2 * k + 1 : PN0 - 1;
+                if (2 * k + 1 < n && v[j*PK_W + COL_IDX_W +: HM_W]
+                                     > v[(j-1)*PK_W + COL_IDX_W +: HM_W])
+                    pk_half[k*PK_W +: PK_W] = v[j*PK_W +: PK_W];
+                else if (2 * k < n)
+                    pk_half[k*PK_W +: PK_W] = v[(2*k < PN0 ? 2*k : 0)*PK_W +: PK_W];
+            end
+        end
+    endfunction
+    reg  [PN0*PK_W-1:0] pk0;
+    always @(*) begin : c_pk0
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            pk0[i*PK_W +: PK_W] = {x1_m_q[i] ? x1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}},
+                                   i[COL_IDX_W-1:0]};
+    end
+    reg  [PN2*PK_W-1:0] x2_pk_q;
+    reg  [PN4*PK_W-1:0] x3_pk_q;
+    reg  [PK_W-1:0]     y4_pk_q;
+    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
+    wire [PN0*PK_W-1:0] pk3 = pk_half({{((PN0-PN2)*PK_W){1'b0}}, x2_pk_q}, PN2);
+    wire [PN0*PK_W-1:0] pk5 = pk_half({{((PN0-PN4)*PK_W){1'b0}}, x3_pk_q}, PN4);
+    /* verilator lint_off UNUSEDSIGNAL */     // entries beyond a level's count are 0
+    wire [PN0*PK_W-1:0] pk2 = pk_half(pk1, PN1);
+    wire [PN0*PK_W-1:0] pk4 = pk_half(pk3, PN3);
+    wire [PN0*PK_W-1:0] pk6 = pk_half(pk5, PN5);
+    /* verilator lint_on UNUSEDSIGNAL */
+    // synthesis translate_off
+    initial begin
+        if (PN6 != 1) begin
+            $display("fmt_blob: COLS %0d > 64: the peak tournament needs more levels", COLS);
+            $finish;
+        end
+    end
+    // synthesis translate_on
+
     // ---- X3: totals -----------------------------------------------------------------------
-    reg                 x3_v_q, x3_end_q, x3_last_q;
-    reg [1:0]           x3_op_q;
-    reg [LBL_W-1:0]     x3_a_q, x3_b_q;
+    reg                 x3_v_q;
+    reg [EF_W-1:0]      x3_f_q;
+    reg [COL_IDX_W-1:0] x3_lc_q;
     reg [ROW_IDX_W-1:0] x3_row_q;
-    reg [NL:1]          x3_k_q;
     reg [AREA_W-1:0]    x3_cnt_q;
-    reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q, x3_pc_q;
-    reg [HM_W-1:0]      x3_pk_q;
+    reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
     reg [SX_W-1:0]      x3_sx_q;
     reg [SZ_W-1:0]      ts;
     reg [SX_W-1:0]      tx;
-    reg [HM_W-1:0]      tpk;
-    reg [COL_IDX_W-1:0] tpc;
     always @(*) begin : c_x3
         integer g, b;
         ts = {SZ_W{1'b0}};
         tx = {SX_W{1'b0}};
-        tpk = {HM_W{1'b0}};
-        tpc = x2_cmin_q;                      // all-zero run (threshold 0): first cell
         for (g = 0; g < NG; g = g + 1) begin
             ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
             // sum z*c = sum over groups of (sum z*(c mod 8) + 8g * sum z), shift-add
@@ -479,63 +480,276 @@ module fmt_blob #(
             for (b = 0; b < COL_IDX_W; b = b + 1)
                 if ((((g * GS) >> b) & 1) == 1)
                     tx = tx + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
-            if (x2_gm_q[g*HM_W +: HM_W] > tpk) begin
-                tpk = x2_gm_q[g*HM_W +: HM_W];
-                tpc = x2_gc_q[g*COL_IDX_W +: COL_IDX_W];
-            end
         end
     end
 
-    // ---- X4: sum z*r --------------------------------------------------------------------
+
+    // ---- X4, X5: sum z*r = r * sum z, shift and add (low and high row bits, then both)
+    localparam RH = ROW_IDX_W / 2;            // row bits of the first partial product
+    reg                 y4_v_q, y5_v_q;
+    /* verilator lint_off UNUSEDSIGNAL */     // y4_e_q's sum z*r and peak fields are 0
+    reg [FE_W-1:0]      y4_e_q;               // the event (its sum z*r field: 0 in X4)
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [FE_W-1:0]      y5_e_q;
+    reg [SY_W-1:0]      y4_ylo_q, y4_yhi_q;
+    reg [SY_W-1:0]      ylo, yhi;
+    always @(*) begin : c_sy
+        integer b;
+        ylo = {SY_W{1'b0}};
+        yhi = {SY_W{1'b0}};
+        for (b = 0; b < ROW_IDX_W; b = b + 1) begin
+            if (x3_row_q[b] && b < RH)  ylo = ylo + ({{(SY_W-SZ_W){1'b0}}, x3_s_q} << b);
+            if (x3_row_q[b] && b >= RH) yhi = yhi + ({{(SY_W-SZ_W){1'b0}}, x3_s_q} << b);
+        end
+    end
+    // FIFO entry: flags, label column, row, area, sums, peak and its column, extent
+    localparam F_FL  = 0;
+    localparam F_LC  = F_FL + EF_W;
+    localparam F_ROW = F_LC + COL_IDX_W;
+    localparam F_CNT = F_ROW + ROW_IDX_W;
+    localparam F_SZ  = F_CNT + AREA_W;
+    localparam F_SX  = F_SZ + SZ_W;
+    localparam F_SY  = F_SX + SX_W;
+    localparam F_PK  = F_SY + SY_W;
+    localparam F_PC  = F_PK + HM_W;
+    localparam F_CMN = F_PC + COL_IDX_W;
+    localparam F_CMX = F_CMN + COL_IDX_W;
+    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W){1'b0}}, x3_sx_q,
+                             x3_s_q, x3_cnt_q, x3_row_q, x3_lc_q, x3_f_q};
+    wire [FE_W-1:0] y4_ev;
+    assign y4_ev[F_SY-1:0]         = y4_e_q[F_SY-1:0];
+    assign y4_ev[F_SY +: SY_W]     = y4_ylo_q + y4_yhi_q;
+    assign y4_ev[F_PK +: HM_W]     = y4_pk_q[COL_IDX_W +: HM_W];
+    assign y4_ev[F_PC +: COL_IDX_W] = y4_pk_q[0 +: COL_IDX_W];
+    assign y4_ev[FE_W-1:F_CMN]     = y4_e_q[FE_W-1:F_CMN];
+
+    // ---- the event FIFO (distributed RAM), read into L1 --------------------------------
+    (* ram_style = "distributed" *)
+    reg [FE_W-1:0]  fmem [0:FD-1];
+    reg [FP_W-1:0]  fwp_q, frp_q;
+    reg [FP_W:0]    fcnt_q;
+    wire            l0_free;
+    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l0_free;
+    always @(posedge clk) begin
+        if (y5_v_q) fmem[fwp_q] <= y5_e_q;
+    end
+    wire [FE_W-1:0]  f_rd = fmem[frp_q];
+    reg  [COLS-1:0]  lc_oh;                   // the label column, decoded
+    always @(*) begin : c_lc_oh
+        integer i;
+        for (i = 0; i < COLS; i = i + 1)
+            lc_oh[i] = (f_rd[F_LC +: COL_IDX_W] == i[COL_IDX_W-1:0]);
+    end
+
+    // ---- L: labelling, one event per cycle -----------------------------------------------
+    // L1 looks up the P label under the event's label column (P and C eagerly renamed,
+    // forwarded from this cycle's L2 step); L2 applies the event:
+    //   run event, a P label y -> ADD(y): the C run's cells get y
+    //   run event, no P label  -> NEW(n): n = a free label (prefetched, n0_q)
+    //   merge event, y != x    -> MERGE(x <- y): x = the C run's label; y is renamed x
+    //                             in P, C and alias, and is free again
+    //   the row's last event ends the row: P's labels no longer in C are closed, P = C.
+    reg [COLS*LBL_W-1:0] p_q, c_q;            // labels of the previous / current row
+    reg [NL:1]           livep_q, livec_q;    // labels present in P / in C
+    reg [NL:1]           free_q;              // free label slots (n0_q excluded)
+    reg [NL:1]           pend_q;              // closed labels waiting for the close engine
+    reg [LBL_W-1:0]      n0_q;                // the next NEW label
+    reg                  n0v_q;
+    reg [LBL_W-1:0]      x_q;                 // label of the current C run
+    reg                  l0_v_q;
+    reg [FE_W-1:0]       l0_e_q;
+    reg [COLS-1:0]       l0_oh_q;             // the label column, one-hot
+    reg                  l1_v_q;
+    reg [FE_W-1:0]       l1_e_q;
+    reg [COLS-1:0]       l1_oh_q;
+    reg [COLS-1:0]       l1_m_q;              // the C run's columns
+    reg [LBL_W-1:0]      l1_y_q;              // the label, up to date but for this cycle's step
+    reg                  l2_v_q;
+    /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
+    reg [FE_W-1:0]       l2_e_q;
+    wire [EF_W-1:0]      l0_f  = l0_e_q[F_FL +: EF_W];    // L0, L1 use the first flag only
+    wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];
+    wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
+    wire             new_wait;                // a NEW waits for a free label (testbench)
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg [LBL_W-1:0]      l2_y_q;              // the P label under the event (if hy)
+    reg [COLS-1:0]       l2_m_q;              // the C run's columns (run events)
+    wire                 l2_isrun = l2_f[0], l2_hy = l2_f[1], l2_last = l2_f[2],
+                         l2_lastrow = l2_f[4];
+    wire [ROW_IDX_W-1:0] l2_row = l2_e_q[F_ROW +: ROW_IDX_W];
+    wire [COL_IDX_W-1:0] l2_cmin = l2_e_q[F_CMN +: COL_IDX_W];
+    // L2 step
+    wire             l2_stall = l2_v_q && l2_isrun && !l2_hy && !n0v_q;   // NEW waits
+    wire             step     = l2_v_q && !l2_stall;
+    wire             do_run   = step && l2_isrun;
+    wire             do_new   = do_run && !l2_hy;
+    wire             do_merge = step && !l2_isrun && l2_hy && (l2_y_q != x_q);
+    wire             row_done = step && l2_last;
+    wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
+    assign           new_wait = l2_stall;
+    reg  [NL:1]      vbit, rbit;              // one-hot of the merge victim, the run label
+    always @(*) begin : c_bits
+        integer i;
+        for (i = 1; i <= NL; i = i + 1) begin
+            vbit[i] = (l2_y_q == i[LBL_W-1:0]);
+            rbit[i] = (lrun == i[LBL_W-1:0]);
+        end
+    end
+    // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
+    // this cycle (C becomes P); this cycle's step forwarded
+    // L0 reads C when its event is the first of its row, or when L1 holds that first
+    // event (L2 may end the previous row this cycle); the step of this cycle is applied,
+    // L1 applies the next one
+    wire             bnd = l0_f[3] || (l1_v_q && l1_f[3]);
+    // (one-hot select, the compares with the victim done per column beside it)
+    reg  [LBL_W-1:0] raw_p, raw_c;
+    reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
+    reg  [COLS-1:0]  l1_m, t_p, t_c;
+    always @(*) begin : c_l1
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 0; i < COLS; i = i + 1) begin
+                t_p[i] = l0_oh_q[i] && p_q[i*LBL_W + b];
+                t_c[i] = l0_oh_q[i] && c_q[i*LBL_W + b];
+            end
+            raw_p[b] = |t_p;
+            raw_c[b] = |t_c;
+        end
+        for (i = 0; i < COLS; i = i + 1) begin
+            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
+            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
+            l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
+                   && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
+        end
+    end
+    wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
+    wire             l0_hit = bnd && do_run && |(l0_oh_q & l2_m_q);
+    // (the victim compare per column beside the select, not after it)
+    wire             ren0 = bnd ? |(l0_oh_q & ren_c) : |(l0_oh_q & ren_p);
+    wire [LBL_W-1:0] y0 = l0_hit ? lrun : ((do_merge && ren0) ? x_q : y0_raw);
+    // L1: this cycle's step (a run of the previous row only for the row's first event)
+    wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
+    wire [LBL_W-1:0] y1 = l1_hit ? lrun
+                        : ((do_merge && l1_y_q == l2_y_q) ? x_q : l1_y_q);
+    wire             l2_ld = l1_v_q && (!l2_v_q || step);
+    wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    assign           l0_free = !l0_v_q || l1_ld;
+
+    // next label vectors and live masks of this cycle's step
+    reg [COLS*LBL_W-1:0] p_nx, c_nx;
+    reg [NL:1]           livep_nx, livec_nx;
+    always @(*) begin : c_step
+        integer i;
+        p_nx = p_q;
+        c_nx = c_q;
+        for (i = 0; i < COLS; i = i + 1) begin
+            if (do_merge && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_merge && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = x_q;
+            if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
+        end
+        livep_nx = livep_q & ~(do_merge ? vbit : {NL{1'b0}});
+        livec_nx = (livec_q & ~(do_merge ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
+    end
+    // free labels: the lowest one is prefetched into n0_q
+    wire        n0_fill = !n0v_q || do_new;
+    wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
+    reg  [LBL_W-1:0] f_enc;
+    reg  [NL:1]      f_t;
+    always @(*) begin : c_fenc
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 1; i <= NL; i = i + 1)
+                f_t[i] = f_low[i] && (((i >> b) & 1) == 1);
+            f_enc[b] = |f_t;
+        end
+    end
+
+    // Records for the membership pass: the labels of every row at its end (after its
+    // merges), and, written at the end of row r+1 about the labels of row r, which of
+    // them continued into row r+1 (cont) and as which label of row r+1 (alias: renamed
+    // by the merges of row r+1).
+    reg [NL*LBL_W-1:0]  alias_q, alias_nx, alias_id;
+    always @(*) begin : c_alias
+        integer i;
+        for (i = 1; i <= NL; i = i + 1) begin
+            alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
+            alias_nx[(i-1)*LBL_W +: LBL_W] =
+                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == l2_y_q) ? x_q : alias_q[(i-1)*LBL_W +: LBL_W];
+        end
+    end
+    wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
+    (* ram_style = "block" *)                 // one write, one synchronous read
+    reg [COLS*(LBL_W+1)-1:0] lr_mem [0:ROWS-1];     // {on-cells, labels} of a row
+    (* ram_style = "block" *)
+    reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
+    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
+    always @(posedge clk) begin
+        if (row_done) lr_mem[l2_row] <= {on_l2, c_nx};
+        if (row_done && l2_row != {ROW_IDX_W{1'b0}})
+            fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
+    end
+
+    // ---- K: command register (the accumulator update of the step) -------------------------
+    localparam [1:0] OP_NONE = 2'd0, OP_NEW = 2'd1, OP_ADD = 2'd2, OP_MERGE = 2'd3;
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
+    reg                 x4_mrg_q;             // x4_op_q == OP_MERGE (a step was a merge)
     reg [LBL_W-1:0]     x4_a_q, x4_b_q;
-    reg [NL:1]          x4_k_q;
+    reg [NL:1]          x4_lp_q, x4_lc_q;     // P's and C's labels after the step
+    wire [NL:1]         x4_k = x4_last_q ? (x4_lp_q | x4_lc_q) : (x4_lp_q & ~x4_lc_q);
     reg [ROW_IDX_W-1:0] x4_row_q;
-    reg [E_W-1:0]       x4_e_q;               // the run as an entry
+    reg [E_W-1:0]       x4_e_q;                // the run as an entry
     reg [E_W-1:0]       run_e;
     // the second operand of an update: the run (ADD) or label B's entry (MERGE); one
     // combine() serves both
     wire [E_W-1:0]      acc_y;
     always @(*) begin
         run_e = {E_W{1'b0}};
-        run_e[O_AREA +: AREA_W]   = x3_cnt_q;
-        run_e[O_SZ +: SZ_W]       = x3_s_q;
-        run_e[O_SX +: SX_W]       = x3_sx_q;
-        run_e[O_SY +: SY_W]       = {{(SY_W-SZ_W){1'b0}}, x3_s_q} * x3_row_q;
-        run_e[O_RMIN +: ROW_IDX_W] = x3_row_q;
-        run_e[O_RMAX +: ROW_IDX_W] = x3_row_q;
-        run_e[O_CMIN +: COL_IDX_W] = x3_cmin_q;
-        run_e[O_CMAX +: COL_IDX_W] = x3_cmax_q;
-        run_e[O_PEAK +: HM_W]      = x3_pk_q;
-        run_e[O_PR +: ROW_IDX_W]   = x3_row_q;
-        run_e[O_PC +: COL_IDX_W]   = x3_pc_q;
-        run_e[O_FC +: COL_IDX_W]   = x3_cmin_q;
+        run_e[O_AREA +: AREA_W]    = l2_e_q[F_CNT +: AREA_W];
+        run_e[O_SZ +: SZ_W]        = l2_e_q[F_SZ +: SZ_W];
+        run_e[O_SX +: SX_W]        = l2_e_q[F_SX +: SX_W];
+        run_e[O_SY +: SY_W]        = l2_e_q[F_SY +: SY_W];
+        run_e[O_RMIN +: ROW_IDX_W] = l2_row;
+        run_e[O_RMAX +: ROW_IDX_W] = l2_row;
+        run_e[O_CMIN +: COL_IDX_W] = l2_cmin;
+        run_e[O_CMAX +: COL_IDX_W] = l2_e_q[F_CMX +: COL_IDX_W];
+        run_e[O_PEAK +: HM_W]      = l2_e_q[F_PK +: HM_W];
+        run_e[O_PR +: ROW_IDX_W]   = l2_row;
+        run_e[O_PC +: COL_IDX_W]   = l2_e_q[F_PC +: COL_IDX_W];
+        run_e[O_FC +: COL_IDX_W]   = l2_cmin;
     end
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
     // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
     // or else the close engine's label (a closed label waits while a MERGE is applied)
-    reg [E_W-1:0] acc_q [1:NL];
-    wire            b_merge = x4_v_q && (x4_op_q == OP_MERGE);
+    reg [E_W-1:0] acc_q [0:NL];             // (0: never written, keeps the reads in range)
+    wire            b_merge = x4_mrg_q;      // (x4_op_q == OP_MERGE)
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
-    assign acc_y = (x4_op_q == OP_MERGE) ? acc_b : x4_e_q;
-    reg [LBL_W-1:0] cpick;
-    reg [NL:1]      cpick_bit;
+    assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
+    // the close engine's next label (lowest pending), picked one cycle ahead
+    reg  [LBL_W-1:0] pk_q;
+    reg              pk_v_q;
+    wire             cl_go   = pk_v_q && !b_merge;
+    wire             pk_fill = !pk_v_q || cl_go;
+    wire [NL:1]      p_low   = pend_q & (~pend_q + 1'b1);
+    reg  [LBL_W-1:0] p_enc;
+    reg  [NL:1]      cpick_bit;               // the label the close engine frees
+    reg  [NL:1]      p_t;
     always @(*) begin : c_cpick
-        integer i;
-        cpick = {LBL_W{1'b0}};
-        for (i = NL; i >= 1; i = i - 1)
-            if (pend_q[i]) cpick = i[LBL_W-1:0];
+        integer i, b;
+        for (b = 0; b < LBL_W; b = b + 1) begin
+            for (i = 1; i <= NL; i = i + 1)
+                p_t[i] = p_low[i] && (((i >> b) & 1) == 1);
+            p_enc[b] = |p_t;
+        end
         for (i = 1; i <= NL; i = i + 1)
-            cpick_bit[i] = (cpick == i[LBL_W-1:0]) && pend_q[i] && !b_merge;
+            cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
     end
-    wire cl_go = (|pend_q) && !b_merge;
-    assign acc_b_lbl = b_merge ? x4_b_q : cpick;
+    assign acc_b_lbl = b_merge ? x4_b_q : pk_q;
     reg           cl_v_q;
     reg [E_W-1:0] cl_e_q;
-    reg [ROW_IDX_W-1:0] crow_q [1:NL];        // row at whose end the label was closed
+    reg [ROW_IDX_W-1:0] crow_q [0:NL];        // row at whose end the label was closed (0: unused)
     reg [ROW_IDX_W-1:0] cl_row_q;
     reg [LBL_W-1:0]     cl_lbl_q;
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
@@ -642,16 +856,21 @@ module fmt_blob #(
     // (per label, by row) holds whether it was a blob.
     reg                  bw_run_q;            // reading rows
     reg [ROW_IDX_W-1:0]  bw_r_q;              // next row to read
-    reg                  bw_v_q;              // fr_rd_q holds row bw_row_q
-    reg [ROW_IDX_W-1:0]  bw_row_q;
-    reg [NL*(LBL_W+1)-1:0] fr_rd_q;           // continuation record of row r
+    reg                  bw_v1_q, bw_v_q;     // block-RAM read of row bw_row1_q / bw_row_q
+    reg [ROW_IDX_W-1:0]  bw_row1_q, bw_row_q;
+    reg [NL*(LBL_W+1)-1:0] fr_rd1_q, fr_rd_q; // continuation record of row r
+    reg [COLS*(LBL_W+1)-1:0] lr_rd1_q, lr_rd_q;   // on-cells and labels of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg                  mask_ok_q;           // the mask holds a complete frame
-    reg                  qb_q;                // lr_mem bank of the mask's frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) fr_rd_q <= fr_mem[bw_r_q];
+        if (bw_run_q) begin
+            fr_rd1_q <= fr_mem[bw_r_q];
+            lr_rd1_q <= lr_mem[bw_r_q];
+        end
+        fr_rd_q <= fr_rd1_q;                  // the block RAMs' output registers
+        lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
     wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
@@ -691,78 +910,116 @@ module fmt_blob #(
                 bw_s[g] = cfr[g];
         end
     end
-    // the status words, one per row, indexed by label
-    (* ram_style = "block" *)
-    reg [NL:1]      st_mem [0:ROWS-1];
+    // the cells of row r: the status of their label (MK), a row of the mask
+    reg                  mk_v_q;
+    reg [ROW_IDX_W-1:0]  mk_row_q;
+    reg [NL:1]           mk_s_q;
+    reg [COLS*(LBL_W+1)-1:0] mk_lr_q;     // (C keeps older labels in off columns)
+    reg [NLP-1:0]        mk_s_pad;
+    reg [COLS-1:0]       mk_bits;
+    always @(*) begin : c_mk
+        integer c;
+        mk_s_pad = {NLP{1'b0}};
+        mk_s_pad[NL:1] = mk_s_q;
+        for (c = 0; c < COLS; c = c + 1)
+            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]] && mk_lr_q[COLS*LBL_W + c];
+    end
+    (* ram_style = "distributed" *)
+    reg [COLS-1:0]       mask_mem [0:ROWS-1];
     always @(posedge clk) begin
-        if (bw_v_q) st_mem[bw_row_q] <= bw_s;
+        if (mk_v_q) mask_mem[mk_row_q] <= mk_bits;
+        mk_s_q   <= bw_s;
+        mk_lr_q  <= lr_rd_q;
+        mk_row_q <= bw_row_q;
     end
 
-    // ---- Q: cell query: label of the cell, then its status in the cell's row ---------
-    reg [COLS*LBL_W-1:0] q_lr_q;              // labels of the queried row
-    reg [NL:1]           q_st_q;              // status word of the queried row
+    // ---- Q: cell query: the row's mask word, then the cell's bit -----------------------
+    localparam NCP = 1 << COL_IDX_W;
+    reg [COLS-1:0]       q_w_q;               // mask word of the queried row
     reg [COL_IDX_W-1:0]  q_col_q;
-    wire [ADDR_W-1:0] q_addr = (qb_q ? ROWS_A : {ADDR_W{1'b0}})
-                             + {{(ADDR_W-ROW_IDX_W){1'b0}}, mask_q_row_i};
+    reg [NCP-1:0]        q_w_pad;             // columns >= COLS read 0
     always @(posedge clk) begin
-        q_lr_q  <= lr_mem[q_addr];
-        q_st_q  <= st_mem[mask_q_row_i];
+        q_w_q   <= mask_mem[mask_q_row_i];
         q_col_q <= mask_q_col_i;
     end
-    // columns >= COLS and label 0 (background) read 0
-    localparam NCP = 1 << COL_IDX_W;
-    reg [NCP*LBL_W-1:0] q_lr_pad;
-    reg [NLP-1:0]       q_st_pad;
-    reg [LBL_W-1:0]     q_lbl;
     always @(*) begin
-        q_lr_pad = {(NCP*LBL_W){1'b0}};
-        q_lr_pad[COLS*LBL_W-1:0] = q_lr_q;
-        q_lbl = q_lr_pad[q_col_q*LBL_W +: LBL_W];
-        q_st_pad = {NLP{1'b0}};
-        q_st_pad[NL:1] = q_st_q;
+        q_w_pad = {NCP{1'b0}};
+        q_w_pad[COLS-1:0] = q_w_q;
     end
 
-    wire pipe_busy = nx_v_q || cur_v_q || x1_v_q || x2_v_q || x3_v_q || x4_v_q
-                   || cl_v_q || (|pend_q);
+    wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
+                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
+                   || cl_v_q || (|pend_q) || pk_v_q;
+    reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
-    wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && !pipe_busy;
-    wire fin_abort = (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
-                   && fr_in && !arr_p[fr_row];
+    wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
+    reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
+    wire fin_abort = (state_q == S_RUN) && abort_q;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
     always @(posedge clk) begin : s_main
         integer i;
         // ---- datapath registers (no reset needed) ----
-        if (take) begin
-            cur_z_q   <= nx_z_q;
-            cur_row_q <= nx_row_q;
+        if (f2_take) begin
+            e1_z_q   <= f2_z_q;
+            e1_c_q   <= f2_c_q;
+            e1_fa_q  <= f2_fa_q;
+            e1_row_q <= f2_row_q;
         end
-        if (fetch) nx_row_q <= fr_row;
-        x1_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
-        x1_a_q   <= do_merge ? la : lrun;
-        x1_b_q   <= lb;
-        x1_m_q   <= (do_run) ? run_m : {COLS{1'b0}};
-        x1_zm_q  <= zm;
-        x1_row_q <= cur_row_q;
-        x1_end_q <= row_done;
-        x1_last_q <= row_done && last_row;
-        x1_k_q   <= close_k;
-        x2_op_q <= x1_op_q;  x2_a_q <= x1_a_q;  x2_b_q <= x1_b_q;  x2_row_q <= x1_row_q;
-        x2_end_q <= x1_end_q;  x2_last_q <= x1_last_q;  x2_k_q <= x1_k_q;
-        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_gm_q <= gm;  x2_gc_q <= gc;
-        x2_cnt_q <= cnt;  x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
-        x3_op_q <= x2_op_q;  x3_a_q <= x2_a_q;  x3_b_q <= x2_b_q;  x3_row_q <= x2_row_q;
-        x3_end_q <= x2_end_q;  x3_last_q <= x2_last_q;  x3_k_q <= x2_k_q;
-        x3_cnt_q <= x2_cnt_q;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= tpk;  x3_pc_q <= tpc;
-        x4_op_q <= x3_op_q;  x4_a_q <= x3_a_q;  x4_b_q <= x3_b_q;
-        x4_end_q <= x3_end_q;  x4_last_q <= x3_last_q;  x4_k_q <= x3_k_q;
-        x4_e_q <= run_e;
-        x4_row_q <= x3_row_q;
+        if (f2_take) begin
+            e1_rem_q <= f2_es_q;
+            e1_b_q   <= f2_b_q;
+            e1_ge_q  <= f2_ge_q;
+            e1_last_q <= f2_one_q;
+            e1_first_q <= 1'b1;
+        end else if (ev_go) begin
+            e1_rem_q <= e1_remr;
+            e1_b_q   <= e1_remr & e1_neg;
+            e1_ge_q  <= e1_remr | e1_neg;
+            e1_last_q <= ((e1_remr & ~e1_neg) == {COLS{1'b0}});
+            e1_first_q <= 1'b0;
+        end
+        x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
+        x1_m_q   <= ev_m;
+        x1_lc_q  <= ev_lc;
+        x1_z_q   <= e1_z_q;
+        x1_row_q <= e1_row_q;
+        x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
+        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk2[PN2*PK_W-1:0];
+        x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
+        x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
+        x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
+        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= pk4[PN4*PK_W-1:0];
+        y4_e_q <= x3_ev;  y4_pk_q <= pk6[PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        y5_e_q <= y4_ev;
+        if (fpop) l0_e_q <= f_rd;
+        if (fpop) l0_oh_q <= lc_oh;
+        if (l1_ld) begin                      // (L1 holds only while L2 waits: no step)
+            l1_e_q  <= l0_e_q;
+            l1_oh_q <= l0_oh_q;
+            l1_m_q  <= l1_m;
+            l1_y_q  <= y0;
+        end
+        if (l2_ld) begin
+            l2_e_q <= l1_e_q;
+            l2_y_q <= y1;
+            l2_m_q <= l1_m_q;
+        end
+        if (do_run) x_q <= lrun;
+        x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
+        x4_mrg_q <= do_merge;
+        x4_a_q   <= do_merge ? x_q : lrun;
+        x4_b_q   <= l2_y_q;
+        x4_e_q   <= run_e;
+        x4_row_q <= l2_row;
+        x4_end_q <= row_done;
+        x4_last_q <= row_done && l2_lastrow;
+        x4_lp_q  <= livep_nx;
+        x4_lc_q  <= livec_nx;
         // accumulators
-        if (x4_v_q) begin
-            case (x4_op_q)
+        begin
+            case (x4_op_q)                    // (OP_NONE when no step)
                 OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
                 OP_ADD,
                 OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_y);
@@ -771,12 +1028,12 @@ module fmt_blob #(
         end
         if (cl_go) begin
             cl_e_q   <= acc_b;
-            cl_row_q <= crow_q[cpick];
-            cl_lbl_q <= cpick;
+            cl_row_q <= crow_q[pk_q];
+            cl_lbl_q <= pk_q;
         end
         if (x4_v_q && x4_end_q) begin
             for (i = 1; i <= NL; i = i + 1)
-                if (x4_k_q[i]) crow_q[i] <= x4_row_q;
+                if (x4_k[i]) crow_q[i] <= x4_row_q;
         end
         // emission side registers
         dl_i_q[0] <= em_i_q;
@@ -802,9 +1059,23 @@ module fmt_blob #(
             pb_q     <= 1'b0;
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
-            nx_v_q   <= 1'b0;
-            cur_v_q  <= 1'b0;
-            rem_q    <= {COLS{1'b0}};
+            lastc_q  <= {COLS{1'b0}};
+            f1_v_q   <= 1'b0;
+            f2_v_q   <= 1'b0;
+            e1_v_q   <= 1'b0;
+            y4_v_q   <= 1'b0;
+            y5_v_q   <= 1'b0;
+            fwp_q    <= {FP_W{1'b0}};
+            frp_q    <= {FP_W{1'b0}};
+            fcnt_q   <= {(FP_W+1){1'b0}};
+            res_q    <= {(FP_W+1){1'b0}};
+            l0_v_q   <= 1'b0;
+            l1_v_q   <= 1'b0;
+            l2_v_q   <= 1'b0;
+            n0v_q    <= 1'b0;
+            pk_v_q   <= 1'b0;
+            idle_q   <= 1'b0;
+            abort_q  <= 1'b0;
             p_q      <= {(COLS*LBL_W){1'b0}};
             c_q      <= {(COLS*LBL_W){1'b0}};
             livep_q  <= {NL{1'b0}};
@@ -831,11 +1102,12 @@ module fmt_blob #(
             dl_t_q   <= {DL{1'b0}};
             bw_run_q  <= 1'b0;
             bw_r_q    <= {ROW_IDX_W{1'b0}};
+            bw_v1_q   <= 1'b0;
             bw_v_q    <= 1'b0;
+            mk_v_q    <= 1'b0;
             bw_busy_q <= 1'b0;
             tok_q     <= 1'b0;
             mask_ok_q <= 1'b0;
-            qb_q      <= 1'b0;
             mask_q_data_o <= 1'b0;
             mask_ready_o <= 1'b0;
             mask_frame_o <= {FRAME_W{1'b0}};
@@ -857,26 +1129,37 @@ module fmt_blob #(
                 if (pb_q != wb_q && !releasing) overrun_o <= 1'b1;
             end
 
-            // ---- fetch / current row ----
+            // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
-            if (fetch) nx_v_q <= 1'b1;
-            else if (take) nx_v_q <= 1'b0;
-            if (take) begin
-                cur_v_q <= 1'b1;
-                rem_q   <= nx_on;
-            end else if (row_done) begin
-                cur_v_q <= 1'b0;
-                rem_q   <= {COLS{1'b0}};
-            end else if (do_run) begin
-                rem_q   <= rem_q & ~run_m;
-            end
+            if (fetch) lastc_q <= on_f;
+            if (fetch) f1_v_q <= 1'b1;
+            else if (f1_mv) f1_v_q <= 1'b0;
+            if (f1_mv) f2_v_q <= 1'b1;
+            else if (f2_take) f2_v_q <= 1'b0;
+            if (f2_take) e1_v_q <= 1'b1;
+            else if (ev_go && ev_last) e1_v_q <= 1'b0;
+            x1_v_q <= ev_go;
+            x2_v_q <= x1_v_q;
+            x3_v_q <= x2_v_q;
+            y4_v_q <= x3_v_q;
+            y5_v_q <= y4_v_q;
+            if (y5_v_q) fwp_q <= fwp_q + 1'b1;
+            if (fpop)   frp_q <= frp_q + 1'b1;
+            fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
+            res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
+            if (fpop) l0_v_q <= 1'b1;
+            else if (l1_ld) l0_v_q <= 1'b0;
+            if (l1_ld) l1_v_q <= 1'b1;
+            else if (l2_ld) l1_v_q <= 1'b0;
+            if (l2_ld) l2_v_q <= 1'b1;
+            else if (step) l2_v_q <= 1'b0;
 
             // ---- labelling state ----
             alias_q <= row_done ? alias_id : alias_nx;
             if (row_done) begin
-                p_q     <= last_row ? {(COLS*LBL_W){1'b0}} : c_nx;
-                c_q     <= {(COLS*LBL_W){1'b0}};
-                livep_q <= last_row ? {NL{1'b0}} : livec_nx;
+                p_q     <= l2_lastrow ? {(COLS*LBL_W){1'b0}} : c_nx;
+                c_q     <= c_nx;              // kept: the next row's first event reads it
+                livep_q <= l2_lastrow ? {NL{1'b0}} : livec_nx;
                 livec_q <= {NL{1'b0}};
             end else begin
                 p_q     <= p_nx;
@@ -884,14 +1167,23 @@ module fmt_blob #(
                 livep_q <= livep_nx;
                 livec_q <= livec_nx;
             end
-            free_q <= (free_q & ~(do_new ? lfree_bit : {NL{1'b0}}))
-                    | (do_merge ? lb_bit : {NL{1'b0}})
+            if (n0_fill) begin
+                n0_q  <= f_enc;
+                n0v_q <= |free_q;
+            end
+            free_q <= (free_q & ~(n0_fill ? f_low : {NL{1'b0}}))
+                    | (do_merge ? vbit : {NL{1'b0}})
                     | cpick_bit;
-            x1_v_q <= do_merge || do_run || row_done;
-            x2_v_q <= x1_v_q;
-            x3_v_q <= x2_v_q;
-            x4_v_q <= x3_v_q;
-            pend_q <= (pend_q & ~cpick_bit) | ((x4_v_q && x4_end_q) ? x4_k_q : {NL{1'b0}});
+            x4_v_q <= do_merge || do_run || row_done;
+            pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
+                    | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
+            if (pk_fill) begin
+                pk_q   <= p_enc;
+                pk_v_q <= |pend_q;
+            end
+            idle_q <= !pipe_busy && !fetch;
+            abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
+                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
@@ -917,23 +1209,25 @@ module fmt_blob #(
                 bw_r_q    <= LAST_ROW;
                 bw_busy_q <= 1'b1;
                 mask_ok_q <= 1'b0;
-                qb_q      <= pb_q;
             end
-            mask_q_data_o <= q_st_pad[q_lbl] && mask_ok_q;
+            mask_q_data_o <= q_w_pad[q_col_q] && mask_ok_q;
             if (fin_abort) begin
                 mask_ready_o <= 1'b1;
                 mask_frame_o <= frm_q[pb_q];
                 mask_ok_q    <= 1'b0;
             end
-            bw_v_q   <= bw_run_q;
-            bw_row_q <= bw_r_q;
+            bw_v1_q   <= bw_run_q;
+            bw_row1_q <= bw_r_q;
+            bw_v_q    <= bw_v1_q;
+            bw_row_q  <= bw_row1_q;
+            mk_v_q    <= bw_v_q;
             if (bw_run_q) begin
                 if (bw_r_q == {ROW_IDX_W{1'b0}}) bw_run_q <= 1'b0;
                 else                             bw_r_q   <= bw_r_q - 1'b1;
             end
-            if (bw_v_q) begin
-                sn_q  <= bw_s;
-                if (bw_row_q == {ROW_IDX_W{1'b0}}) begin
+            if (bw_v_q) sn_q <= bw_s;
+            if (mk_v_q) begin
+                if (mk_row_q == {ROW_IDX_W{1'b0}}) begin
                     bw_busy_q    <= 1'b0;
                     mask_ready_o <= 1'b1;
                     mask_frame_o <= em_frame_q;
@@ -969,6 +1263,7 @@ module fmt_blob #(
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};
+                lastc_q      <= {COLS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
                 pb_q         <= ~pb_q;
@@ -978,6 +1273,7 @@ module fmt_blob #(
                 livep_q <= {NL{1'b0}};
                 livec_q <= {NL{1'b0}};
                 free_q  <= {NL{1'b1}};
+                n0v_q   <= 1'b0;
                 alias_q <= alias_id;
             end
         end
