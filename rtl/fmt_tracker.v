@@ -1,63 +1,63 @@
 // fmt_tracker -- frame matching: stable contact IDs, new / move / lift events.
 //
-// Twin: sim/fmt/tracker.py (Tracker.step), bit-exact (same events, same order); the
-// cycle count of the match is modelled by tracking.lazy_greedy (see MATCH below).
+// Twin: sim/fmt/tracker.py (Tracker.step), bit-exact (same events, same order).  The
+// cycle counts are modelled by tb/fmt_tracker (match_cycles, tail_latency).
 //
 // Contact table: MAX_TOUCHES slots.  In flip-flops (read by all slots in parallel):
 // active flag, miss counter (frames since last seen), generation counter and the
-// rounded prediction pred = (p + 2^(VF-1)) >>> VF per axis, formed the cycle after p
-// is written and clamped to PR_W = 18 bits signed, [-2^17, 2^17) (exact for the gate test: a
-// prediction outside that range is, clamped or not, more than 65535 from any x in
-// [0, 65535], so never a candidate).  In a LUT RAM (one word per slot, one slot per
-// cycle; written by NEW before it is read, so not reset): predicted position p
-// (signed, Q.(8+VF): Q8.8 cells with VF extra fraction bits), velocity v (signed V_W
-// bits, 2^-(8+VF) cells/frame) and last measured position (for the lift event).
+// rounded prediction pred = (p + 2^(VF-1)) >>> VF per axis, clamped to PR_W = 18 bits
+// signed, [-2^17, 2^17) (exact for the gate test: a prediction outside that range is,
+// clamped or not, more than 65535 from any x in [0, 65535], so never a candidate).  In
+// LUT RAMs (one word per slot; written before read, so not reset): p (signed,
+// Q.(8+VF)), v (signed V_W bits, 2^-(8+VF) cells/frame), last measured x, y.
 //
-// Per frame:
-//   COLLECT  touches arrive (tp_valid, any cycles).  In the cycle a touch arrives its
-//            record goes to a LUT RAM and its L1 distance to the prediction of every
-//            slot is computed in parallel, D = |x - pred_x| + |y - pred_y|, and
-//            stored (one LUT-RAM row per touch, D kept to 16 bits) with
-//            a candidate bit = slot active and D <= gate (max_jump_i for a contact
-//            seen last frame, hold_jump_i for one in hold-off).  The next cycle the row
-//            is read back and one shared min tree over the slots (ties to the lower
-//            slot) caches the touch's best key (D, s) in a register.  Touches beyond
-//            MAX_TOUCHES are dropped (sticky drop_flag_o).
-//   MATCH    (after tp_eof) greedy nearest pairs, smallest (D, t, s) first -- ties to
-//            the smallest index t * 2^SB + s -- with lazily refreshed per-touch minima:
-//            a second min tree picks the smallest cached key (D_t, t) of the
-//            unassigned touches.  Cached keys only grow as slots are taken, so each is
-//            a lower bound of that touch's current key: if the picked touch's cached
-//            slot is still free the pair IS the global greedy choice and is assigned
-//            (1 cycle); otherwise the pick is stale: the touch's row is re-read and
-//            its minimum over the free slots recomputed (2 cycles in all), and the
-//            pick repeats.  The
-//            cycle after an assignment a move event is issued and the slot's
-//            velocity/prediction updated:
-//              e = (x << VF) - p;  v = clamp(v + (e >>> vel_shift_i), +-max_speed_i);
-//              p = (x << VF) + v.
-//            No candidate left -> LIFT.  Stale picks: none when every touch's nearest
-//            slot is its own; at most one per remaining touch per assignment, i.e.
-//            <= MT(MT-1)/2 = 120 at 16 slots (all touches ranking the slots alike).
-//   LIFT     one lift per cycle, lowest slot first, for each active unmatched slot
-//            with miss + 1 >= hold_off_i (the slot becomes free).
-//   NEW      one per cycle, unassigned touches in arrival order: the first free slot
-//            at or after the round-robin pointer; generation + 1; id = {gen, slot};
-//            no free slot -> the touch is dropped (sticky noslot_flag_o).  The cycle
-//            that finds no touch left marks the frame's last event.
-//   UPDATE   after the last event, one slot per cycle, lowest first: every active slot
-//            neither matched nor new (a contact in hold-off): miss + 1, p += v; then
-//            one cycle to clear the frame.  busy_o stays high until then.
-// Events leave through a one-event holding register (to mark ev_last_o).  With m
-// matches, k stale picks, l lifts, n news and d new touches without a free slot, the
-// frame's last event is on the output m + 2k + l + n + d + 4 cycles after the tp_eof
-// cycle (MATCH m + 2k + 1, LIFT l + 1, NEW n + d + 1, holding register 1); one more
-// when the last touch arrives in the tp_eof cycle.  (Before the lazy minima: 2m + l +
-// n + d + 6.)  Worst case 16 + 240 + 4 = 260 at 16 touches and slots, well inside a
-// frame of 768 clk at 3 x fs.  busy_o falls h + 1 cycles after the last event (h =
-// contacts in hold-off).  A frame with no events emits nothing.  Touches of the next
-// frame must not arrive before the tracker is idle again (overrun_flag_o; they are
-// dropped).  tp_frame_i is sampled with every touch and with tp_eof (event frame).
+// Per frame (a pipeline: every step below is one register stage unless said):
+//   COLLECT  touches arrive (tp_valid, any cycles; beyond MAX_TOUCHES dropped, sticky
+//            drop_flag_o).  A1: the L1 distance of the touch to every slot's
+//            prediction, D = |x - pred_x| + |y - pred_y|, saturated to 17 bits.  A2:
+//            candidate = slot active and D <= gate (max_jump_i for a contact seen
+//            last frame, hold_jump_i in hold-off), the row {cand, D} per slot written
+//            to a LUT RAM.  R1..R_SB: the row read back and its minimum over the free
+//            candidate slots, key (D, s), ties to the lower slot, one tree level per
+//            stage (SB stages).  Then the key is inserted into a sorted queue.
+//   MATCH    (after tp_eof; greedy nearest pairs, smallest (D, t, s) first) the queue
+//            holds each touch's cached key sorted by (D, t), MAX_TOUCHES entries, insert and
+//            pop in one cycle (compare with every entry, 4:1 select).  Cached keys
+//            only grow as slots are taken, so each is a lower bound: per cycle, if the
+//            head's slot is free and no key is in flight, the head IS the greedy pair:
+//            it is assigned (a move) and every entry naming that slot marked stale; a
+//            stale head is popped and its row minimum recomputed over the free slots
+//            (R1..R_SB again, reinserted SB + 1 cycles later; several in flight, no
+//            assignment meanwhile).  Empty queue, nothing in flight: MATCH ends.
+//            The loop is only the head's compare-and-select: no search in the loop.
+//   EV       in the cycle MATCH ends and after: one lift per cycle (lowest slot first,
+//            active, unmatched, miss + 1 >= hold_off_i), then one new per cycle
+//            (unmatched touches in arrival order; the first free slot after the
+//            round-robin pointer; generation + 1; no free slot: dropped, sticky
+//            noslot_flag_o).  Every mask keeps its lowest set bit (the next pick)
+//            and "not empty" in registers, computed the cycle before.
+//   UPD      then one slot per cycle in hold-off (active, neither matched nor new):
+//            miss + 1, p += v; busy_o falls when the update pipeline has drained.
+// Every move / lift / new / update is an operation: issued into a register, released
+// (stage E1: LUT-RAM reads, the event out, miss counter) when the next operation is
+// issued or the frame's events end (ev_last_o), then fmt_tracker_vel E2..E4
+// (velocity filter, e = (x << VF) - p; v = clamp(v + (e >>> vel_shift_i),
+// +-max_speed_i); p = (x << VF) + v; p, v written) and E5 (the prediction rounded into
+// its registers).  No multiplier, no block RAM.
+//
+// Latency (tp_eof in cycle c, the frame's last touch in cycle a <= c; SB = 4 at 16
+// slots): first MATCH decision in cycle d0 = max(c + 1, a + SB + 3); without stale
+// pops MATCH ends m cycles later (m moves); l lifts and n news take one cycle each;
+// the last event is on the output in cycle d0 + m + l + n + 1, i.e. m + l + n + 7
+// cycles after tp_eof when the last touch came the cycle before (was m + 2k + l + n +
+// d + 4 with k stale picks and d touches without a slot, which now cost nothing).
+// Stale pops: 1 cycle each, and the round waits for the last recomputed key (SB + 1
+// cycles).  Worst case (16 touches ranking 16 slots alike: 120 stale pops): MATCH 211,
+// last event 218 cycles after tp_eof (was 260), busy 4 cycles more; with the 16 touch
+// cycles, 238 of a frame's 768.  busy_o falls 4 cycles after the last event with no
+// contact in hold-off, h + 5 with h.  A frame with no events emits nothing.  Touches of
+// the next frame must not arrive before the tracker is idle again (overrun_flag_o;
+// they are dropped).  tp_frame_i is sampled with every touch and with tp_eof.
 //
 // Fixed-point formats: x, y, axes unsigned Q8.8 cells; gates Q8.8 (L1); p signed
 // P_W = 16 + VF + 8 bits; e >>> vel_shift is an arithmetic shift (floor); velocity
@@ -124,283 +124,40 @@ module fmt_tracker #(
     localparam PR_W  = 18;                   // saturated rounded prediction (signed)
     localparam DW    = 16;                   // stored distance (candidates are <= 16 bits)
     localparam KW    = DW + 1;               // tree key {invalid, D}
+    localparam NW    = KW + SB;              // tree node {invalid, D, slot}
     localparam RW    = MT * KW;              // distance-RAM row: {cand, D} per slot
+    localparam TN    = MTP - 1;              // row-minimum tree nodes (stage registers)
     localparam TD_W  = 16 + 16 + HM_W + 16 + 16 + 8 + 8;  // touch record width
-    localparam SD_W  = 2 * P_W + 2 * V_W + 32;            // slot record {px,py,vx,vy,lx,ly}
 
-    localparam [2:0] S_IDLE = 3'd0, S_MATCH = 3'd1, S_LIFT = 3'd2, S_NEW = 3'd3, S_UPD = 3'd4;
-    localparam [1:0] T_NEW = 2'd0, T_MOVE = 2'd1, T_LIFT = 2'd2;
+    localparam [3:0] S_IDLE = 4'b0001, S_MATCH = 4'b0010, S_EV = 4'b0100, S_UPD = 4'b1000;
+    localparam [1:0] T_NEW = 2'd0, T_MOVE = 2'd1, T_LIFT = 2'd2, T_UPD = 2'd3;
 
-    // ---- state ------------------------------------------------------------------------
-    reg [2:0]           state_q;
-    reg [FRAME_W-1:0]   frame_q;
-    reg [TCW-1:0]       tcnt_q;                   // touches stored this frame
-    reg                 st_v_q;                   // a row written last cycle: reduce it now
-    reg [SB-1:0]        st_t_q;                   // its touch index
-    reg [MT-1:0]        kv_q;                     // cached key: touch has a candidate
-    reg [MT*DW-1:0]     kd_q;                     // cached key: best D
-    reg [MT*SB-1:0]     ks_q;                     // cached key: its slot
-    reg                 rc_q;                     // recompute the row of rc_t_q this cycle
-    reg [SB-1:0]        rc_t_q;
-    reg [MT-1:0]        tused_q;                  // touch assigned (matched / new / dropped)
-    reg [MT-1:0]        sused_q;                  // slot matched, newly allocated or updated
-    reg [MT-1:0]        act_q;                    // slot active
-    reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
-    reg [MT*PR_W-1:0]   prx_q, pry_q;             // rounded, saturated predictions
-    reg [MT*GEN_W-1:0]  gen_q;                    // generation counters
-    reg [SB-1:0]        next_slot_q;              // round-robin allocation pointer
-    reg                 mv_q;                     // the pair assigned last cycle: move now
-    reg [SB-1:0]        mv_s_q, mv_t_q;
-    // event holding register
-    reg                 pend_q;
-    reg [ID_W-1:0]      pid_q;
-    reg [1:0]           ptype_q;
-    reg [TD_W-1:0]      pdata_q;
-
-    assign busy_o = (state_q != S_IDLE);
-
-    // ---- LUT RAMs (asynchronous read, no reset: a word is written before it is read) --
-    reg [RW-1:0]    dmem [0:MTP-1];      // distance rows, written on arrival
-    reg [TD_W-1:0]  tmem [0:MTP-1];      // touch records, written on arrival
-    reg [SD_W-1:0]  smem [0:MTP-1];      // slot records
-
-    wire            arrive = (state_q == S_IDLE) && tp_valid_i && (tcnt_q < MT);
-    wire [SB-1:0]   wa_t   = tcnt_q[SB-1:0];      // < MT when arrive
-
-    // ---- gates and distances of the arriving touch to every slot ------------------
-    reg [RW-1:0]       drow;           // {cand, D} per slot
-    reg [15:0]         gate;
-    reg signed [PR_W:0] ddx, ddy;
-    reg [PR_W:0]       dsum;
-    // (loop variables are declared in their always block: one driver each, no latch)
-    always @* begin : c_drow
-        integer s_i;
-        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-            gate = (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}}) ? max_jump_i : hold_jump_i;
-            ddx = $signed({{(PR_W-15){1'b0}}, tp_x_i}) -
-                  $signed({prx_q[s_i*PR_W+PR_W-1], prx_q[s_i*PR_W +: PR_W]});
-            ddy = $signed({{(PR_W-15){1'b0}}, tp_y_i}) -
-                  $signed({pry_q[s_i*PR_W+PR_W-1], pry_q[s_i*PR_W +: PR_W]});
-            // |ddx|, |ddy| < 2^PR_W: the sum fits PR_W + 1 bits
-            dsum = {1'b0, ddx[PR_W-1:0] ^ {PR_W{ddx[PR_W]}}} + {{PR_W{1'b0}}, ddx[PR_W]} +
-                   {1'b0, ddy[PR_W-1:0] ^ {PR_W{ddy[PR_W]}}} + {{PR_W{1'b0}}, ddy[PR_W]};
-            drow[s_i*KW +: KW] = {act_q[s_i] && (dsum <= {{(PR_W+1-16){1'b0}}, gate}),
-                                  dsum[DW-1:0]};
+    // ---- functions ------------------------------------------------------------------------
+    // smaller tree node, ties to a (the lower slot)
+    function [NW-1:0] nmin;
+        input [NW-1:0] a;
+        input [NW-1:0] b;
+        begin
+            nmin = (b[NW-1:SB] < a[NW-1:SB]) ? b : a;
         end
-    end
-
-    always @(posedge clk) begin
-        if (arrive) begin
-            dmem[wa_t] <= drow;
-            tmem[wa_t] <= {tp_x_i, tp_y_i, tp_strength_i, tp_axis_major_i, tp_axis_minor_i,
-                           tp_angle_i, tp_flags_i};
+    endfunction
+    // index of a one-hot vector
+    function [SB-1:0] enc;
+        input [MT-1:0] oh;
+        integer i;
+        begin
+            enc = {SB{1'b0}};
+            for (i = 0; i < MT; i = i + 1)
+                if (oh[i]) enc = enc | i[SB-1:0];
         end
-    end
-
-    // ---- row min tree: one touch's best free slot ---------------------------------
-    // Leaves s = {invalid, D}; node <- min(left, right), ties to the left (lower slot).
-    wire [SB-1:0]  rr_t   = st_v_q ? st_t_q : rc_t_q;   // row being reduced
-    wire [RW-1:0]  rrow   = dmem[rr_t];
-    reg [MTP*KW-1:0] rk;
-    reg [MTP*SB-1:0] ri;
-    reg              r_found;
-    reg [DW-1:0]     r_d;
-    reg [SB-1:0]     r_s;
-    always @* begin : c_rtree
-        integer s_i, l_i, n_i;
-        for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
-            if (s_i < MT)
-                rk[s_i*KW +: KW] = {~(rrow[s_i*KW+DW] & ~sused_q[s_i]), rrow[s_i*KW +: DW]};
-            else
-                rk[s_i*KW +: KW] = {KW{1'b1}};
-            ri[s_i*SB +: SB] = s_i[SB-1:0];
+    endfunction
+    // lowest set bit (one-hot, 0 if none)
+    function [MT-1:0] lowest;
+        input [MT-1:0] m;
+        begin
+            lowest = m & (~m + 1'b1);
         end
-        for (n_i = MTP / 2; n_i >= 1; n_i = n_i / 2) begin
-            for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
-                if (rk[(2*l_i+1)*KW +: KW] < rk[(2*l_i)*KW +: KW]) begin
-                    rk[l_i*KW +: KW] = rk[(2*l_i+1)*KW +: KW];
-                    ri[l_i*SB +: SB] = ri[(2*l_i+1)*SB +: SB];
-                end else begin
-                    rk[l_i*KW +: KW] = rk[(2*l_i)*KW +: KW];
-                    ri[l_i*SB +: SB] = ri[(2*l_i)*SB +: SB];
-                end
-            end
-        end
-        r_found = ~rk[KW-1];
-        r_d = rk[DW-1:0];
-        r_s = ri[SB-1:0];
-    end
-
-    // ---- touch min tree: smallest cached key (D_t, t) of the unassigned touches -------
-    reg [MTP*KW-1:0] bk;
-    reg [MTP*SB-1:0] bi;             // touch index
-    reg [MTP*SB-1:0] bs;             // its cached slot
-    reg              m_found;
-    reg [SB-1:0]     m_t, m_s;
-    always @* begin : c_ttree
-        integer l_i, n_i, t_i;
-        for (t_i = 0; t_i < MTP; t_i = t_i + 1) begin
-            if (t_i < MT) begin
-                bk[t_i*KW +: KW] = {~(kv_q[t_i] & ~tused_q[t_i]), kd_q[t_i*DW +: DW]};
-                bs[t_i*SB +: SB] = ks_q[t_i*SB +: SB];
-            end else begin
-                bk[t_i*KW +: KW] = {KW{1'b1}};
-                bs[t_i*SB +: SB] = {SB{1'b0}};
-            end
-            bi[t_i*SB +: SB] = t_i[SB-1:0];
-        end
-        for (n_i = MTP / 2; n_i >= 1; n_i = n_i / 2) begin
-            for (l_i = 0; l_i < n_i; l_i = l_i + 1) begin
-                if (bk[(2*l_i+1)*KW +: KW] < bk[(2*l_i)*KW +: KW]) begin
-                    bk[l_i*KW +: KW] = bk[(2*l_i+1)*KW +: KW];
-                    bi[l_i*SB +: SB] = bi[(2*l_i+1)*SB +: SB];
-                    bs[l_i*SB +: SB] = bs[(2*l_i+1)*SB +: SB];
-                end else begin
-                    bk[l_i*KW +: KW] = bk[(2*l_i)*KW +: KW];
-                    bi[l_i*SB +: SB] = bi[(2*l_i)*SB +: SB];
-                    bs[l_i*SB +: SB] = bs[(2*l_i)*SB +: SB];
-                end
-            end
-        end
-        m_found = ~bk[KW-1];
-        m_t = bi[SB-1:0];
-        m_s = bs[SB-1:0];
-    end
-    // the picked touch's cached slot is still free (one-hot select: no barrel shifter)
-    reg m_fresh;
-    always @* begin : c_fresh
-        integer s_i;
-        m_fresh = 1'b0;
-        for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            m_fresh = m_fresh | (~sused_q[s_i] & (m_s == s_i[SB-1:0]));
-    end
-
-    // ---- lifts: lowest active unmatched slot whose hold-off expires --------------
-    reg [MT-1:0] lift_mask;
-    reg          l_found;
-    reg [SB-1:0] l_s;
-    always @* begin : c_lift
-        integer s_i;
-        for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            lift_mask[s_i] = act_q[s_i] & ~sused_q[s_i] &
-                ({1'b0, miss_q[s_i*HOLD_W +: HOLD_W]} + 1'b1 >= {1'b0, hold_off_i});
-        l_found = |lift_mask;
-        l_s = {SB{1'b0}};
-        for (s_i = MT - 1; s_i >= 0; s_i = s_i - 1)
-            if (lift_mask[s_i]) l_s = s_i[SB-1:0];
-    end
-
-    // ---- news: lowest unassigned touch, first free slot from the pointer -----------
-    reg          n_found, f_found;
-    reg [SB-1:0] n_t, f_s;
-    reg [SB:0]   idx;
-    always @* begin : c_new
-        integer t_i, k_i;
-        n_found = 1'b0;
-        n_t = {SB{1'b0}};
-        for (t_i = MT - 1; t_i >= 0; t_i = t_i - 1)
-            if (t_i < tcnt_q && !tused_q[t_i]) begin
-                n_found = 1'b1;
-                n_t = t_i[SB-1:0];
-            end
-        f_found = 1'b0;
-        f_s = {SB{1'b0}};
-        for (k_i = MT - 1; k_i >= 0; k_i = k_i - 1) begin
-            idx = {1'b0, next_slot_q} + k_i[SB:0];
-            if (idx >= MT) idx = idx - MT;
-            if (!act_q[idx[SB-1:0]]) begin
-                f_found = 1'b1;
-                f_s = idx[SB-1:0];
-            end
-        end
-    end
-    wire [SB-1:0] f_next = ({1'b0, f_s} == MT - 1) ? {SB{1'b0}} : f_s + 1'b1;
-
-    // ---- update: lowest active slot neither matched, new nor updated yet -------------
-    reg          u_found;
-    reg [SB-1:0] u_s;
-    always @* begin : c_upd
-        integer s_i;
-        u_found = |(act_q & ~sused_q);
-        u_s = {SB{1'b0}};
-        for (s_i = MT - 1; s_i >= 0; s_i = s_i - 1)
-            if (act_q[s_i] && !sused_q[s_i]) u_s = s_i[SB-1:0];
-    end
-
-    // ---- slot RAM port (read and write at one address) and touch RAM read ------------
-    reg  [SB-1:0]    sa;             // slot of this cycle
-    always @* begin
-        case (state_q)
-            S_MATCH: sa = mv_s_q;
-            S_LIFT:  sa = l_s;
-            S_NEW:   sa = f_s;
-            S_UPD:   sa = u_s;
-            default: sa = mv_s_q;
-        endcase
-    end
-    wire [SD_W-1:0]  srec  = smem[sa];
-    wire [P_W-1:0]   s_px  = srec[SD_W-1 -: P_W];
-    wire [P_W-1:0]   s_py  = srec[SD_W-P_W-1 -: P_W];
-    wire [V_W-1:0]   s_vx  = srec[SD_W-2*P_W-1 -: V_W];
-    wire [V_W-1:0]   s_vy  = srec[SD_W-2*P_W-V_W-1 -: V_W];
-    wire [15:0]      s_lx  = srec[31:16];
-    wire [15:0]      s_ly  = srec[15:0];
-    reg  [GEN_W-1:0] s_gen;          // generation of slot sa (one-hot select)
-    always @* begin : c_sgen
-        integer s_i;
-        s_gen = {GEN_W{1'b0}};
-        for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            s_gen = s_gen | (gen_q[s_i*GEN_W +: GEN_W] & {GEN_W{sa == s_i[SB-1:0]}});
-    end
-    wire [GEN_W-1:0] f_gen = s_gen + 1'b1;
-
-    wire [SB-1:0]    ta    = (state_q == S_NEW) ? n_t : mv_t_q;
-    wire [TD_W-1:0]  trec  = tmem[ta];
-    wire [15:0]      t_x   = trec[TD_W-1 -: 16];
-    wire [15:0]      t_y   = trec[TD_W-17 -: 16];
-
-    // matched pair: velocity / prediction update
-    wire [V_W-1:0]   m_vx_new, m_vy_new;
-    wire [P_W-1:0]   m_px_new, m_py_new;
-    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_velx (
-        .meas_i(t_x), .p_i(s_px), .v_i(s_vx),
-        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vx_new), .p_o(m_px_new));
-    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_vely (
-        .meas_i(t_y), .p_i(s_py), .v_i(s_vy),
-        .shift_i(vel_shift_i), .vmax_i(max_speed_i), .v_o(m_vy_new), .p_o(m_py_new));
-    // unmatched slot in hold-off: p + v
-    wire [P_W-1:0]   u_px  = s_px + {{(P_W-V_W){s_vx[V_W-1]}}, s_vx};
-    wire [P_W-1:0]   u_py  = s_py + {{(P_W-V_W){s_vy[V_W-1]}}, s_vy};
-    wire             u_en  = (state_q == S_UPD) && u_found;
-    wire             n_en  = (state_q == S_NEW) && n_found && f_found;
-
-    // slot write: move (mv_q, in MATCH), new, update
-    reg              s_we;
-    reg [SD_W-1:0]   s_wd;
-    reg [P_W-1:0]    w_px, w_py;     // the written p: rounded into the prediction registers
-    always @* begin
-        s_we = 1'b0;
-        w_px = u_px;
-        w_py = u_py;
-        s_wd = {u_px, u_py, s_vx, s_vy, s_lx, s_ly};
-        if (state_q == S_MATCH) begin
-            s_we = mv_q;
-            w_px = m_px_new;
-            w_py = m_py_new;
-            s_wd = {m_px_new, m_py_new, m_vx_new, m_vy_new, t_x, t_y};
-        end else if (state_q == S_NEW) begin
-            s_we = n_en;
-            w_px = {{(P_W-16-VF){1'b0}}, t_x, {VF{1'b0}}};
-            w_py = {{(P_W-16-VF){1'b0}}, t_y, {VF{1'b0}}};
-            s_wd = {w_px, w_py, {(2*V_W){1'b0}}, t_x, t_y};
-        end else if (state_q == S_UPD) begin
-            s_we = u_en;
-        end
-    end
-    always @(posedge clk) begin
-        if (s_we) smem[sa] <= s_wd;
-    end
-
+    endfunction
     // round half up, (p + 2^(VF-1)) >>> VF, then saturate to PR_W bits
     function [PR_W-1:0] pred_of;
         input [P_W-1:0] p;
@@ -418,76 +175,372 @@ module fmt_tracker #(
                 pred_of = {1'b0, {(PR_W-1){1'b1}}};
         end
     endfunction
-    // the written p is registered and rounded into the prediction registers one cycle
-    // later (off the velocity update's path); the last write lands in the cycle that
-    // clears the frame, before the next frame's touches can arrive
-    reg              pw_q;
-    reg [SB-1:0]     pw_s_q;
-    reg [P_W-1:0]    pw_x_q, pw_y_q;
-    wire [PR_W-1:0]  w_prx = pred_of(pw_x_q);
-    wire [PR_W-1:0]  w_pry = pred_of(pw_y_q);
-    // the slot's miss counter: 0 on move / new, + 1 on update (shared incrementer)
-    reg [HOLD_W-1:0] u_miss;
-    always @* begin : c_umiss
+
+    // ---- state ------------------------------------------------------------------------
+    reg [3:0]           state_q;                  // one-hot: UPD, EV, MATCH, IDLE
+    reg [FRAME_W-1:0]   frame_q;
+    reg [TCW-1:0]       tcnt_q;                   // touches stored this frame
+    reg [MT-1:0]        tval_q;                   // touch stored
+    reg [MT-1:0]        tused_q;                  // touch matched
+    reg [MT-1:0]        sused_q;                  // slot matched or newly allocated
+    reg [MT-1:0]        act_q;                    // slot active
+    reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
+    reg [MT-1:0]        mz_q;                     // miss == 0 (gate select)
+    reg [MT-1:0]        lexp_q;                   // miss + 1 >= hold-off (lift if unmatched)
+    reg [HOLD_W-1:0]    hm1_q;                    // max(hold_off, 1) - 1
+    reg [MT*PR_W-1:0]   prx_q, pry_q;             // rounded, saturated predictions
+    reg [MT*GEN_W-1:0]  gen_q;                    // generation counters
+    reg [MT-1:0]        therm_q;                  // slots after the last allocated one
+    reg [MT-1:0]        lm_q;                     // lifts to issue
+    reg [MT-1:0]        um_q;                     // unmatched touches (news to issue)
+    reg [MT-1:0]        fm_q;                     // free slots
+    reg [MT-1:0]        src_q;                    // free slots after the pointer, else fm_q
+    reg [MT-1:0]        upm_q;                    // hold-off updates to issue
+    reg [MT-1:0]        l_pick_q, u_pick_q, f_pick_q, p_pick_q;   // lowest bits (one-hot)
+    reg                 l_any_q, u_any_q, f_any_q, p_any_q;       // masks not empty
+    // arrival: A1 distances, A2 gate test and row write
+    reg                 a1_v_q;
+    reg [SB-1:0]        a1_t_q;
+    reg [MT*KW-1:0]     dq_q;                     // {D >= 2^16, D mod 2^16} per slot
+    // row minimum: request, R1, R2, R3 (key)
+    // (request = stage 0; tree stage k = 1..SB holds MTP >> k nodes from node
+    // MTP - (MTP >> (k - 1)); the root, node TN - 1, is the touch's key)
+    reg [SB:0]          rv_q;                     // stage valid
+    reg [(SB+1)*SB-1:0] rt_q;                     // stage touch index
+    reg [TN*NW-1:0]     tr_q;                     // tree nodes {invalid, D, slot}
+    // sorted key queue (entry 0 = head)
+    reg [MT-1:0]        qv_q, qst_q;              // valid, stale (slot taken since)
+    reg [MT*DW-1:0]     qd_q;
+    reg [MT*SB-1:0]     qt_q, qs_q;
+    // operation register (stage E1 when released) and the update pipeline E2..E5
+    reg                 op_v_q;
+    reg [1:0]           op_typ_q;
+    reg [SB-1:0]        op_t_q, op_s_q;               // touch, slot
+    reg [MT-1:0]        op_so_q;                      // slot (one-hot)
+    reg                 e2_v_q, e3_v_q, e4_v_q;
+    reg [1:0]           e2_typ_q, e3_typ_q, e4_typ_q;
+    reg [SB-1:0]        e2_s_q, e3_s_q, e4_s_q;
+    reg                 pw_q;
+    reg [SB-1:0]        pw_s_q;
+    reg [P_W-1:0]       pw_x_q, pw_y_q;
+
+    assign busy_o = ~state_q[0];
+
+    // ---- LUT RAMs (asynchronous read, no reset: a word is written before it is read) --
+    reg [RW-1:0]     dmem [0:MTP-1];     // distance rows (A2 write, R1 read)
+    reg [TD_W-1:0]   tmem [0:MTP-1];     // touch records (arrival write, E1 read)
+    reg [2*P_W-1:0]  pmem [0:MTP-1];     // slot p {x, y} (E4 write, E1 read)
+    reg [2*V_W-1:0]  vmem [0:MTP-1];     // slot v {x, y} (E4 write, E1 read)
+    reg [31:0]       lmem [0:MTP-1];     // slot last measured {x, y} (E1 read / write)
+
+    wire            arrive = state_q[0] && tp_valid_i && (tcnt_q < MT);
+    wire [SB-1:0]   wa_t   = tcnt_q[SB-1:0];      // < MT when arrive
+
+    always @(posedge clk) begin
+        if (arrive)
+            tmem[wa_t] <= {tp_x_i, tp_y_i, tp_strength_i, tp_axis_major_i, tp_axis_minor_i,
+                           tp_angle_i, tp_flags_i};
+    end
+
+    // ---- A1: L1 distance of the arriving touch to every slot's prediction --------------
+    reg [MT*KW-1:0]     dsat;
+    reg signed [PR_W:0] ddx, ddy;
+    reg [PR_W:0]        dsum;
+    always @* begin : c_dist
         integer s_i;
-        u_miss = {HOLD_W{1'b0}};
-        for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            u_miss = u_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{u_s == s_i[SB-1:0]}});
+        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+            ddx = $signed({{(PR_W-15){1'b0}}, tp_x_i}) -
+                  $signed({prx_q[s_i*PR_W+PR_W-1], prx_q[s_i*PR_W +: PR_W]});
+            ddy = $signed({{(PR_W-15){1'b0}}, tp_y_i}) -
+                  $signed({pry_q[s_i*PR_W+PR_W-1], pry_q[s_i*PR_W +: PR_W]});
+            // |ddx|, |ddy| < 2^PR_W: the sum fits PR_W + 1 bits
+            dsum = {1'b0, ddx[PR_W-1:0] ^ {PR_W{ddx[PR_W]}}} + {{PR_W{1'b0}}, ddx[PR_W]} +
+                   {1'b0, ddy[PR_W-1:0] ^ {PR_W{ddy[PR_W]}}} + {{PR_W{1'b0}}, ddy[PR_W]};
+            dsat[s_i*KW +: KW] = {|dsum[PR_W:DW], dsum[DW-1:0]};
+        end
     end
-    wire [HOLD_W-1:0] w_miss = (state_q == S_UPD) ? u_miss + 1'b1 : {HOLD_W{1'b0}};
 
-    // ---- events ---------------------------------------------------------------------
-    reg              gen_ev;           // an event is formed this cycle
-    reg [1:0]        gen_type;
+    // ---- A2: candidate = slot active and D <= gate; row written to the distance RAM -----
+    // D > gate is the carry of D + ~gate (the gate select folds into the adder's LUTs)
+    reg [RW-1:0] drow;
+    reg [DW:0]   dgt;
+    always @* begin : c_drow
+        integer s_i;
+        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+            dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~(mz_q[s_i] ? max_jump_i : hold_jump_i)};
+            drow[s_i*KW +: KW] = {act_q[s_i] && !dq_q[s_i*KW+DW] && !dgt[DW],
+                                  dq_q[s_i*KW +: DW]};
+        end
+    end
+    always @(posedge clk) begin
+        if (a1_v_q) dmem[a1_t_q] <= drow;
+    end
+
+    // ---- row minimum over the free candidate slots, one tree level per stage -----------
+    // (ties to the lower slot; the leaves are the row read in stage 1)
+    wire [SB-1:0]    rq_t = rt_q[0 +: SB];
+    wire [RW-1:0]    rrow = dmem[rq_t];
+    reg  [MTP*NW-1:0] lf;
+    reg  [TN*NW-1:0]  tr_d;
+    always @* begin : c_tree
+        integer s_i, k, l;
+        for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
+            if (s_i < MT)
+                lf[s_i*NW +: NW] = {~(rrow[s_i*KW+DW] & ~sused_q[s_i]), rrow[s_i*KW +: DW],
+                                    s_i[SB-1:0]};
+            else
+                lf[s_i*NW +: NW] = {{KW{1'b1}}, s_i[SB-1:0]};
+        end
+        for (l = 0; l < MTP / 2; l = l + 1)
+            tr_d[l*NW +: NW] = nmin(lf[(2*l)*NW +: NW], lf[(2*l+1)*NW +: NW]);
+        // stage k - 1 starts at node MTP - (MTP >> (k - 2)), stage k at MTP - (MTP >> (k - 1))
+        for (k = 2; k <= SB; k = k + 1)
+            for (l = 0; l < (MTP >> k); l = l + 1)
+                tr_d[(MTP-(MTP>>(k-1))+l)*NW +: NW] =
+                    nmin(tr_q[(MTP-(MTP>>(k-2))+2*l)*NW +: NW],
+                         tr_q[(MTP-(MTP>>(k-2))+2*l+1)*NW +: NW]);
+    end
+    wire [NW-1:0] root    = tr_q[(TN-1)*NW +: NW];
+    wire [DW-1:0] key_d_q = root[NW-2 -: DW];
+    wire [SB-1:0] key_s_q = root[SB-1:0];
+    wire [SB-1:0] key_t_q = rt_q[SB*SB +: SB];
+
+    // ---- sorted queue of the touches' keys (D, t) ---------------------------------------
+    // inflight_q: a key is on its way (A2 or a tree stage valid this cycle)
+    reg  inflight_q;
+    wire in_match = state_q[1];
+    wire q_asg    = in_match & qv_q[0] & ~qst_q[0] & ~inflight_q; // head is the greedy pair
+    wire q_stale  = in_match & qv_q[0] & qst_q[0];                // head: recompute its key
+    wire q_pop    = q_asg | q_stale;
+    wire m_done   = in_match & ~qv_q[0] & ~inflight_q;            // no candidate pair left
+    wire key_ins  = rv_q[SB] & ~root[NW-1];
+    wire [SB-1:0] h_t = qt_q[0 +: SB];
+    wire [SB-1:0] h_s = qs_q[0 +: SB];
+
+    // xl[j]: the key sorts before entry j - 1 (or that entry is empty); xl[0] = 0
+    reg  [MT+1:0]       xl;
+    always @* begin : c_qlt
+        integer i;
+        xl[0] = 1'b0;
+        for (i = 0; i < MT; i = i + 1)
+            xl[i+1] = ~qv_q[i] | ({key_d_q, key_t_q} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]});
+        xl[MT+1] = 1'b1;
+    end
+    // next state of entry i, a 4:1 select per entry: 0 keep, 1 entry i + 1 (a pop),
+    // 2 entry i - 1 (shifted down by an insert), 3 the inserted key.  An insert goes
+    // before the first later-sorting entry; a pop and an insert may come together.
+    localparam QE = 2 + DW + 2 * SB;        // entry {valid, stale, D, t, s}
+    wire [(MT+2)*QE-1:0] xq;                // entries with an empty one at each end
+    genvar gq;
+    assign xq[0 +: QE]         = {QE{1'b0}};
+    assign xq[(MT+1)*QE +: QE] = {QE{1'b0}};
+    generate
+        for (gq = 0; gq < MT; gq = gq + 1) begin : g_xq
+            assign xq[(gq+1)*QE +: QE] = {qv_q[gq], qst_q[gq], qd_q[gq*DW +: DW],
+                                          qt_q[gq*SB +: SB], qs_q[gq*SB +: SB]};
+        end
+    endgenerate
+    wire [QE-1:0] kq = {1'b1, 1'b0, key_d_q, key_t_q, key_s_q};
+    reg  [MT*2-1:0]  qsel;
+    reg  [MT-1:0]    qeq;                   // entry i + 1 holds the slot assigned now
+    always @* begin : c_qsel
+        integer i;
+        reg l_s, l_m;
+        for (i = 0; i < MT; i = i + 1) begin
+            l_s = q_pop ? xl[i+2] : xl[i+1];
+            l_m = q_pop ? ((i == 0) ? 1'b0 : xl[i+1]) : xl[i];
+            if (key_ins && l_s && l_m)
+                qsel[2*i +: 2] = q_pop ? 2'd0 : 2'd2;
+            else if (key_ins && l_s)
+                qsel[2*i +: 2] = 2'd3;
+            else
+                qsel[2*i +: 2] = q_pop ? 2'd1 : 2'd0;
+            qeq[i] = xq[(i+2)*QE+QE-1] && (xq[(i+2)*QE +: SB] == h_s);
+        end
+    end
+    reg [MT-1:0]    qv_d, qst_d;
+    reg [MT*DW-1:0] qd_d;
+    reg [MT*SB-1:0] qt_d, qs_d;
+    always @* begin : c_qnext
+        integer i;
+        reg [QE-1:0] e;
+        for (i = 0; i < MT; i = i + 1) begin
+            case (qsel[2*i +: 2])
+                2'd0:    e = xq[(i+1)*QE +: QE];
+                2'd1:    e = xq[(i+2)*QE +: QE];
+                2'd2:    e = xq[i*QE +: QE];
+                default: e = kq;
+            endcase
+            {qv_d[i], qst_d[i], qd_d[i*DW +: DW], qt_d[i*SB +: SB], qs_d[i*SB +: SB]} = e;
+            qst_d[i] = e[QE-2] | (q_asg & qeq[i]);   // an assignment pops: e is entry i + 1
+        end
+    end
+
+    // ---- issue: moves (MATCH), lifts and news (EV), hold-off updates (UPD) ------------
+    // Each mask has its lowest set bit (the next pick, one-hot) and "not empty" in
+    // registers, computed the cycle before: the issue is a select of registers.
+    wire [MT-1:0] one     = {{(MT-1){1'b0}}, 1'b1};
+    wire [MT-1:0] asg_s   = q_asg ? (one << h_s) : {MT{1'b0}};
+    wire [MT-1:0] asg_t   = q_asg ? (one << h_t) : {MT{1'b0}};
+    wire [MT-1:0] sused_n = sused_q | asg_s;
+    wire [MT-1:0] tused_n = tused_q | asg_t;
+    wire [MT-1:0] tval_n  = tval_q | (arrive ? (one << wa_t) : {MT{1'b0}});
+
+    wire          ev_ph    = m_done | state_q[2];
+    wire          iss_lift = ev_ph & l_any_q;
+    wire          iss_new  = ev_ph & ~l_any_q & u_any_q & f_any_q;
+    wire          ev_done  = ev_ph & ~l_any_q & ~(u_any_q & f_any_q);
+    wire          iss_upd  = state_q[3] & p_any_q;
+    wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
+    wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
+
+    // next masks and their picks
+    reg  [MT-1:0] lm_d, um_d, fm_d, src_d, upm_d, hm_d;
     always @* begin
-        gen_ev = 1'b0;
-        gen_type = T_MOVE;
-        case (state_q)
-            S_MATCH: gen_ev = mv_q;
-            S_LIFT:  begin gen_ev = l_found;  gen_type = T_LIFT; end
-            S_NEW:   begin gen_ev = n_en;     gen_type = T_NEW;  end
-            default: ;
-        endcase
+        lm_d  = lm_q;
+        um_d  = um_q;
+        fm_d  = fm_q;
+        src_d = src_q;
+        upm_d = upm_q;
+        hm_d  = src_q;
+        if (state_q[0] || (state_q[1] && !m_done)) begin
+            // shadows of the pending lifts and news, exact when MATCH ends
+            lm_d  = act_q & ~sused_n & lexp_q;
+            um_d  = tval_n & ~tused_n;
+            fm_d  = ~act_q;
+            hm_d  = ~act_q & therm_q;
+            src_d = (|hm_d) ? hm_d : fm_d;
+        end else if (iss_lift) begin
+            // the lifted slot is free for the news
+            lm_d  = lm_q & ~l_pick_q;
+            fm_d  = fm_q | l_pick_q;
+            hm_d  = fm_d & therm_q;
+            src_d = (|hm_d) ? hm_d : fm_d;
+        end else if (iss_new) begin
+            // src: free slots after the last pick (from the pointer), else all free slots
+            um_d  = um_q & ~u_pick_q;
+            fm_d  = fm_q & ~f_pick_q;
+            hm_d  = src_q & ~f_pick_q;
+            src_d = (|hm_d) ? hm_d : fm_d;
+        end
+        if (ev_done)
+            upm_d = act_q & ~sused_q;
+        else if (iss_upd)
+            upm_d = upm_q & ~p_pick_q;
     end
-    wire [ID_W-1:0] gen_id   = {(state_q == S_NEW) ? f_gen : s_gen, sa};
-    wire [TD_W-1:0] gen_data = (state_q == S_LIFT) ? {s_lx, s_ly, {(TD_W-32){1'b0}}} : trec;
-    wire            frame_done = (state_q == S_NEW) && !n_found;
 
-    // the cached key written this cycle: the row read on arrival or recomputed
-    wire k_we = st_v_q | rc_q;
+    // the held operation goes on when the next one is issued or the frame's events end
+    // (in EV and UPD every cycle; in MATCH with an assignment or at the end)
+    wire op_go = op_v_q & (~state_q[1] | (~inflight_q & ~(qv_q[0] & qst_q[0])));
+
+    // ---- E1: the released operation reads its records; event out ------------------------
+    wire [SB-1:0]    op_t  = op_t_q;
+    wire [SB-1:0]    op_s  = op_s_q;
+    wire [TD_W-1:0]  trec  = tmem[op_t];
+    wire [15:0]      t_x   = trec[TD_W-1 -: 16];
+    wire [15:0]      t_y   = trec[TD_W-17 -: 16];
+    wire [2*P_W-1:0] prec  = pmem[op_s];
+    wire [2*V_W-1:0] vrec  = vmem[op_s];
+    wire [31:0]      lrec  = lmem[op_s];
+    reg  [GEN_W-1:0] e1_gen;          // one-hot selects
+    reg  [HOLD_W-1:0] e1_miss;
+    always @* begin : c_e1sel
+        integer s_i;
+        e1_gen  = {GEN_W{1'b0}};
+        e1_miss = {HOLD_W{1'b0}};
+        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+            e1_gen  = e1_gen  | (gen_q[s_i*GEN_W +: GEN_W]   & {GEN_W{op_so_q[s_i]}});
+            e1_miss = e1_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{op_so_q[s_i]}});
+        end
+    end
+    wire             e1_ev = op_go & (op_typ_q != T_UPD);
+    always @(posedge clk) begin
+        if (op_go && (op_typ_q == T_MOVE || op_typ_q == T_NEW))
+            lmem[op_s] <= {t_x, t_y};
+    end
+
+    // ---- E2..E4: velocity / prediction update (x and y) ----------------------------------
+    wire [P_W-1:0] np_x, np_y;
+    wire [V_W-1:0] nv_x, nv_y;
+    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_velx (
+        .clk(clk), .typ_i(op_typ_q), .meas_i(t_x), .p_i(prec[2*P_W-1 -: P_W]),
+        .v_i(vrec[2*V_W-1 -: V_W]), .shift_i(vel_shift_i), .vmax_i(max_speed_i),
+        .p_o(np_x), .v_o(nv_x));
+    fmt_tracker_vel #(.VF(VF), .V_W(V_W), .P_W(P_W)) u_vely (
+        .clk(clk), .typ_i(op_typ_q), .meas_i(t_y), .p_i(prec[P_W-1:0]),
+        .v_i(vrec[V_W-1:0]), .shift_i(vel_shift_i), .vmax_i(max_speed_i),
+        .p_o(np_y), .v_o(nv_y));
+    always @(posedge clk) begin
+        if (e4_v_q && e4_typ_q != T_LIFT)
+            pmem[e4_s_q] <= {np_x, np_y};
+        if (e4_v_q && (e4_typ_q == T_MOVE || e4_typ_q == T_NEW))
+            vmem[e4_s_q] <= {nv_x, nv_y};
+    end
+    // E5: the written p rounded into the prediction registers
+    wire [PR_W-1:0] w_prx = pred_of(pw_x_q);
+    wire [PR_W-1:0] w_pry = pred_of(pw_y_q);
 
     always @(posedge clk) begin : s_main
-        integer s_i, t_i;
+        integer s_i;
         if (rst) begin
             state_q        <= S_IDLE;
             frame_q        <= {FRAME_W{1'b0}};
             tcnt_q         <= {TCW{1'b0}};
-            st_v_q         <= 1'b0;
-            st_t_q         <= {SB{1'b0}};
-            kv_q           <= {MT{1'b0}};
-            kd_q           <= {(MT*DW){1'b0}};
-            ks_q           <= {(MT*SB){1'b0}};
-            rc_q           <= 1'b0;
-            rc_t_q         <= {SB{1'b0}};
+            tval_q         <= {MT{1'b0}};
             tused_q        <= {MT{1'b0}};
             sused_q        <= {MT{1'b0}};
             act_q          <= {MT{1'b0}};
             miss_q         <= {(MT*HOLD_W){1'b0}};
+            mz_q           <= {MT{1'b1}};
+            lexp_q         <= {MT{1'b0}};
+            hm1_q          <= {HOLD_W{1'b0}};
             prx_q          <= {(MT*PR_W){1'b0}};
             pry_q          <= {(MT*PR_W){1'b0}};
             gen_q          <= {(MT*GEN_W){1'b0}};
+            therm_q        <= {MT{1'b1}};
+            lm_q           <= {MT{1'b0}};
+            um_q           <= {MT{1'b0}};
+            fm_q           <= {MT{1'b0}};
+            src_q          <= {MT{1'b0}};
+            upm_q          <= {MT{1'b0}};
+            l_pick_q       <= {MT{1'b0}};
+            u_pick_q       <= {MT{1'b0}};
+            f_pick_q       <= {MT{1'b0}};
+            p_pick_q       <= {MT{1'b0}};
+            l_any_q        <= 1'b0;
+            u_any_q        <= 1'b0;
+            f_any_q        <= 1'b0;
+            p_any_q        <= 1'b0;
+            inflight_q     <= 1'b0;
+            a1_v_q         <= 1'b0;
+            a1_t_q         <= {SB{1'b0}};
+            dq_q           <= {(MT*KW){1'b0}};
+            rv_q           <= {(SB+1){1'b0}};
+            rt_q           <= {((SB+1)*SB){1'b0}};
+            tr_q           <= {(TN*NW){1'b0}};
+            qv_q           <= {MT{1'b0}};
+            qst_q          <= {MT{1'b0}};
+            qd_q           <= {(MT*DW){1'b0}};
+            qt_q           <= {(MT*SB){1'b0}};
+            qs_q           <= {(MT*SB){1'b0}};
+            op_v_q         <= 1'b0;
+            op_typ_q       <= T_NEW;
+            op_t_q         <= {SB{1'b0}};
+            op_s_q         <= {SB{1'b0}};
+            op_so_q        <= {MT{1'b0}};
+            e2_v_q         <= 1'b0;
+            e3_v_q         <= 1'b0;
+            e4_v_q         <= 1'b0;
+            e2_typ_q       <= T_NEW;
+            e3_typ_q       <= T_NEW;
+            e4_typ_q       <= T_NEW;
+            e2_s_q         <= {SB{1'b0}};
+            e3_s_q         <= {SB{1'b0}};
+            e4_s_q         <= {SB{1'b0}};
             pw_q           <= 1'b0;
             pw_s_q         <= {SB{1'b0}};
             pw_x_q         <= {P_W{1'b0}};
             pw_y_q         <= {P_W{1'b0}};
-            next_slot_q    <= {SB{1'b0}};
-            mv_q           <= 1'b0;
-            mv_s_q         <= {SB{1'b0}};
-            mv_t_q         <= {SB{1'b0}};
-            pend_q         <= 1'b0;
-            pid_q          <= {ID_W{1'b0}};
-            ptype_q        <= 2'd0;
-            pdata_q        <= {TD_W{1'b0}};
             ev_valid_o     <= 1'b0;
             ev_frame_o     <= {FRAME_W{1'b0}};
             ev_id_o        <= {ID_W{1'b0}};
@@ -505,9 +558,7 @@ module fmt_tracker #(
             overrun_flag_o <= 1'b0;
         end else begin
             // ---- input side --------------------------------------------------------
-            st_v_q <= arrive;
-            st_t_q <= wa_t;
-            if (state_q == S_IDLE) begin
+            if (state_q[0]) begin
                 if (tp_valid_i) begin
                     frame_q <= tp_frame_i;
                     if (tcnt_q < MT) tcnt_q <= tcnt_q + 1'b1;
@@ -520,103 +571,138 @@ module fmt_tracker #(
             end else if (tp_valid_i || tp_eof_i) begin
                 overrun_flag_o <= 1'b1;
             end
+            tval_q <= tval_n;
+            a1_v_q <= arrive;
+            a1_t_q <= wa_t;
+            dq_q   <= dsat;
 
-            // ---- cached per-touch minima -------------------------------------------
-            for (t_i = 0; t_i < MT; t_i = t_i + 1) begin
-                if (k_we && rr_t == t_i[SB-1:0]) begin
-                    kv_q[t_i] <= r_found;
-                    kd_q[t_i*DW +: DW] <= r_d;
-                    ks_q[t_i*SB +: SB] <= r_s;
-                end
+            // ---- per-slot flags (settle long before they are used) ---------------------
+            hm1_q <= (hold_off_i == {HOLD_W{1'b0}}) ? {HOLD_W{1'b0}} : hold_off_i - 1'b1;
+            for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+                mz_q[s_i]   <= (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}});
+                lexp_q[s_i] <= (miss_q[s_i*HOLD_W +: HOLD_W] >= hm1_q);
             end
 
-            // ---- slot registers written with the slot RAM ------------------------------
-            for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                if (s_we && sa == s_i[SB-1:0])
-                    miss_q[s_i*HOLD_W +: HOLD_W] <= w_miss;
+            // ---- row minimum pipeline ------------------------------------------------
+            rv_q <= {rv_q[SB-1:0], a1_v_q | q_stale};
+            rt_q <= {rt_q[SB*SB-1:0], q_stale ? h_t : a1_t_q};
+            tr_q <= tr_d;
+
+            // ---- queue ---------------------------------------------------------------
+            qv_q  <= qv_d;
+            qst_q <= qst_d;
+            qd_q  <= qd_d;
+            qt_q  <= qt_d;
+            qs_q  <= qs_d;
+
+            inflight_q <= arrive | a1_v_q | q_stale | (|rv_q[SB-1:0]);
+
+            // ---- match: the greedy pair -----------------------------------------------
+            if (q_asg) begin
+                sused_q <= sused_n;
+                tused_q <= tused_n;
+            end
+
+            // ---- masks and their next picks ------------------------------------------
+            lm_q     <= lm_d;
+            um_q     <= um_d;
+            fm_q     <= fm_d;
+            src_q    <= src_d;
+            upm_q    <= upm_d;
+            l_pick_q <= lowest(lm_d);
+            u_pick_q <= lowest(um_d);
+            f_pick_q <= lowest(src_d);
+            p_pick_q <= lowest(upm_d);
+            l_any_q  <= |lm_d;
+            u_any_q  <= |um_d;
+            f_any_q  <= |fm_d;
+            p_any_q  <= |upm_d;
+
+            // ---- lifts, then news (first free slot from the round-robin pointer) --------
+            if (iss_lift)
+                act_q <= act_q & ~l_pick_q;
+            if (iss_new) begin
+                act_q   <= act_q | f_pick_q;
+                sused_q <= sused_q | f_pick_q;
+                therm_q <= ~(f_pick_q | (f_pick_q - 1'b1));
+                for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                    if (f_pick_q[s_i])
+                        gen_q[s_i*GEN_W +: GEN_W] <= gen_q[s_i*GEN_W +: GEN_W] + 1'b1;
+            end
+            if (ev_ph) state_q <= S_EV;
+            if (ev_done) begin
+                if (u_any_q) noslot_flag_o <= 1'b1;
+                state_q <= S_UPD;
+            end
+            if (state_q[3] && !p_any_q && drained) begin
+                tcnt_q  <= {TCW{1'b0}};
+                tval_q  <= {MT{1'b0}};
+                tused_q <= {MT{1'b0}};
+                sused_q <= {MT{1'b0}};
+                state_q <= S_IDLE;
+            end
+
+            // ---- operation register ------------------------------------------------------
+            if (iss) begin
+                op_v_q <= 1'b1;
+                if (q_asg) begin
+                    op_typ_q <= T_MOVE;
+                    op_t_q   <= h_t;
+                    op_s_q   <= h_s;
+                    op_so_q  <= asg_s;
+                end else if (iss_lift) begin
+                    op_typ_q <= T_LIFT;
+                    op_s_q   <= enc(l_pick_q);
+                    op_so_q  <= l_pick_q;
+                end else if (iss_new) begin
+                    op_typ_q <= T_NEW;
+                    op_t_q   <= enc(u_pick_q);
+                    op_s_q   <= enc(f_pick_q);
+                    op_so_q  <= f_pick_q;
+                end else begin
+                    op_typ_q <= T_UPD;
+                    op_s_q   <= enc(p_pick_q);
+                    op_so_q  <= p_pick_q;
+                end
+            end else if (op_go) begin
+                op_v_q <= 1'b0;
+            end
+
+            // ---- E1: miss counter; event -----------------------------------------------
+            for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                if (op_go && op_typ_q != T_LIFT && op_so_q[s_i])
+                    miss_q[s_i*HOLD_W +: HOLD_W] <= (op_typ_q == T_UPD) ? e1_miss + 1'b1
+                                                                          : {HOLD_W{1'b0}};
+            ev_valid_o <= e1_ev;
+            if (e1_ev) begin
+                ev_frame_o <= frame_q;
+                ev_id_o    <= {e1_gen, op_s};
+                ev_type_o  <= op_typ_q;
+                {ev_x_o, ev_y_o, ev_strength_o, ev_axis_major_o, ev_axis_minor_o,
+                 ev_angle_o, ev_flags_o} <= (op_typ_q == T_LIFT) ?
+                                            {lrec, {(TD_W-32){1'b0}}} : trec;
+                ev_last_o  <= ev_done;
+            end
+
+            // ---- E2..E5 ------------------------------------------------------------------
+            e2_v_q   <= op_go;
+            e2_typ_q <= op_typ_q;
+            e2_s_q   <= op_s;
+            e3_v_q   <= e2_v_q;
+            e3_typ_q <= e2_typ_q;
+            e3_s_q   <= e2_s_q;
+            e4_v_q   <= e3_v_q;
+            e4_typ_q <= e3_typ_q;
+            e4_s_q   <= e3_s_q;
+            pw_q     <= e4_v_q & (e4_typ_q != T_LIFT);
+            pw_s_q   <= e4_s_q;
+            pw_x_q   <= np_x;
+            pw_y_q   <= np_y;
+            for (s_i = 0; s_i < MT; s_i = s_i + 1)
                 if (pw_q && pw_s_q == s_i[SB-1:0]) begin
                     prx_q[s_i*PR_W +: PR_W] <= w_prx;
                     pry_q[s_i*PR_W +: PR_W] <= w_pry;
                 end
-            end
-            pw_q   <= s_we;
-            pw_s_q <= sa;
-            pw_x_q <= w_px;
-            pw_y_q <= w_py;
-
-            // ---- matching / lifts / news / update -------------------------------------
-            mv_q <= 1'b0;
-            rc_q <= 1'b0;
-            case (state_q)
-                S_MATCH: begin
-                    if (st_v_q || rc_q) begin
-                        // a cached key is being written this cycle: pick next cycle
-                    end else if (!m_found) begin
-                        state_q <= S_LIFT;
-                    end else if (m_fresh) begin
-                        tused_q[m_t] <= 1'b1;
-                        sused_q[m_s] <= 1'b1;
-                        mv_q   <= 1'b1;
-                        mv_s_q <= m_s;
-                        mv_t_q <= m_t;
-                    end else begin
-                        rc_q   <= 1'b1;           // stale: recompute this touch's minimum
-                        rc_t_q <= m_t;
-                    end
-                end
-                S_LIFT: begin
-                    if (l_found) act_q[l_s] <= 1'b0;
-                    else         state_q <= S_NEW;
-                end
-                S_NEW: begin
-                    if (n_found) begin
-                        tused_q[n_t] <= 1'b1;
-                        if (f_found) begin
-                            act_q[f_s]   <= 1'b1;
-                            for (s_i = 0; s_i < MT; s_i = s_i + 1)
-                                if (f_s == s_i[SB-1:0]) gen_q[s_i*GEN_W +: GEN_W] <= f_gen;
-                            sused_q[f_s] <= 1'b1;
-                            next_slot_q  <= f_next;
-                        end else begin
-                            noslot_flag_o <= 1'b1;
-                        end
-                    end else begin
-                        state_q <= S_UPD;
-                    end
-                end
-                S_UPD: begin
-                    if (u_found) begin
-                        sused_q[u_s] <= 1'b1;     // updated
-                    end else begin
-                        tcnt_q  <= {TCW{1'b0}};
-                        tused_q <= {MT{1'b0}};
-                        sused_q <= {MT{1'b0}};
-                        kv_q    <= {MT{1'b0}};
-                        state_q <= S_IDLE;
-                    end
-                end
-                default: ;
-            endcase
-
-            // ---- event output through the holding register ----------------------------
-            ev_valid_o <= 1'b0;
-            if (pend_q && (gen_ev || frame_done)) begin
-                ev_valid_o      <= 1'b1;
-                ev_frame_o      <= frame_q;
-                ev_id_o         <= pid_q;
-                ev_type_o       <= ptype_q;
-                {ev_x_o, ev_y_o, ev_strength_o, ev_axis_major_o, ev_axis_minor_o,
-                 ev_angle_o, ev_flags_o} <= pdata_q;
-                ev_last_o       <= frame_done;
-            end
-            if (gen_ev) begin
-                pend_q  <= 1'b1;
-                pid_q   <= gen_id;
-                ptype_q <= gen_type;
-                pdata_q <= gen_data;
-            end else if (frame_done) begin
-                pend_q <= 1'b0;
-            end
         end
     end
 

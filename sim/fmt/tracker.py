@@ -287,7 +287,7 @@ class Tracker:
 
 
 def lazy_greedy(dm: np.ndarray) -> tuple[list[tuple[int, int]], int]:
-    """The match order of the RTL (rtl/fmt_tracker.v, MATCH) and its cost.
+    """The lazy greedy match (the principle of rtl/fmt_tracker.v, MATCH) and its cost.
 
     ``dm``: candidate distances (touch, slot), ``NO_CAND`` where not a candidate (from
     :meth:`Tracker.candidates`).  Each touch caches its best key (D, s) over the free
@@ -295,8 +295,10 @@ def lazy_greedy(dm: np.ndarray) -> tuple[list[tuple[int, int]], int]:
     is still free the pair is assigned, else the pick was stale and the touch's key is
     recomputed over the free slots.  Cached keys are lower bounds of the current keys,
     so the pairs are exactly the greedy order of :meth:`Tracker.step` (smallest
-    (D, t, s) first).  Returns (pairs in assignment order, number of stale picks);
-    the RTL spends 1 cycle per assignment and 2 per stale pick."""
+    (D, t, s) first).  Returns (pairs in assignment order, number of stale picks).
+    The RTL keeps the cached keys in a sorted queue and recomputes several stale keys
+    at once in its pipeline (its cycle model: ``match_cycles`` in
+    tb/fmt_tracker/test_fmt_tracker.py); the pairs are the same."""
     nt, ns = dm.shape
     free = np.ones(ns, dtype=bool)
     used = np.zeros(nt, dtype=bool)
@@ -326,14 +328,14 @@ def lazy_greedy(dm: np.ndarray) -> tuple[list[tuple[int, int]], int]:
 
 
 def tail_cycles(events, stale: int, no_slot: int) -> int:
-    """RTL timing: tp_eof high in cycle c -> the frame's last event valid in cycle c + lat
-    (a plain register would be lat = 1), for a frame with these events (m moves, l
-    lifts, n news), ``stale`` stale picks (:func:`lazy_greedy`) and ``no_slot`` new
-    touches without a free slot: MATCH m + 2 stale + 1, LIFT l + 1, NEW n + no_slot + 1,
-    holding register 1.  Touches end before the tp_eof cycle (one more cycle if the
-    last touch comes with tp_eof).  busy stays high h + 1 cycles longer (UPDATE of
-    the h contacts in hold-off).  Before the lazy minima the RTL took
-    2m + l + n + no_slot + 6."""
+    """Timing of the previous (unpipelined) RTL, kept for comparison: tp_eof high in
+    cycle c -> the frame's last event valid in cycle c + lat (a plain register would
+    be lat = 1), for a frame with these events (m moves, l lifts, n news), ``stale``
+    stale picks (:func:`lazy_greedy`) and ``no_slot`` new touches without a free
+    slot: MATCH m + 2 stale + 1, LIFT l + 1, NEW n + no_slot + 1, holding register 1.
+    The pipelined RTL (125 MHz) takes m + l + n + 7 without stale picks when the last
+    touch came the cycle before tp_eof; its exact cycle model is ``tail_latency`` in
+    tb/fmt_tracker/test_fmt_tracker.py."""
     return len(events) + 2 * stale + no_slot + 4
 
 

@@ -6,12 +6,13 @@ vanish and flicker, random order, more than MAX_TOUCHES touches, random settings
 scripted scenarios on a scaled timeline (drumroll, merge/split, fast crossing,
 flicker, hold-off expiry, 17 touches with 16 slots), plus a reset in the middle of a
 frame.  Also measures and checks the tail latency: the frame's last event is on the
-output exactly fmt.tracker.tail_cycles cycles after the tp_eof cycle,
-n_events + 2 n_stale + n_noslot + 4 (n_stale = stale picks of the lazy match, counted
-by fmt.tracker.lazy_greedy on the model's candidate matrix; n_noslot = new touches
-dropped for want of a slot, one cycle each), and that busy_o falls h + 1 cycles after
-that (h = contacts in hold-off, updated one per cycle).  The worst case of the match (all touches ranking the
-slots alike, 120 stale picks at 16) is a test of its own.
+output exactly tail_latency cycles after the tp_eof cycle (a cycle model of the RTL's
+pipeline: the last touch's key reaches the sorted queue SB + 3 cycles after it came,
+match_cycles replays the queue's assignments and stale pops on the model's candidate
+matrix, then one cycle per lift and new), and that busy_o falls 4 cycles after that
+(h + 5 with h contacts in hold-off, updated one per cycle).  The worst case of the
+match (all touches ranking the slots alike, 120 stale pops at 16) is a test of its
+own; the lazy model's stale picks (fmt.tracker.lazy_greedy) are logged beside.
 """
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 from common.runner import run_cocotb, sources
 from common.tb_util import ClockedTB, env_int
 from fmt import params
-from fmt.tracker import Touch, Tracker, TrackParams, lazy_greedy, tail_cycles
+from fmt.tracker import NO_CAND, Touch, Tracker, TrackParams, lazy_greedy
 
 
 class TB(ClockedTB):
@@ -39,6 +40,7 @@ class TB(ClockedTB):
         self.eof_cycles = []
         self.stale_total = 0      # stale picks of the lazy match (model count)
         self.idle_cycle = 0
+        self.last_touch = None    # edge that sampled the frame's last touch
         self.idle()
         cocotb.start_soon(self._count())
         cocotb.start_soon(self._monitor())
@@ -87,6 +89,7 @@ class TB(ClockedTB):
         the cycle of tp_eof."""
         d = self.dut
         await self.writable()
+        self.last_touch = None
         for i, t in enumerate(touches):
             if eof_with_last and i == len(touches) - 1:
                 d.tp_eof_i.value = 1
@@ -103,6 +106,8 @@ class TB(ClockedTB):
             if eof_with_last and i == len(touches) - 1:
                 break
             await self.writable()
+            if i < self.mt:
+                self.last_touch = self.cycle  # the edge that sampled this (kept) touch
             if rng and rng.random() < 0.3:
                 d.tp_valid_i.value = 0
                 for _ in range(rng.randrange(1, 3)):
@@ -115,6 +120,8 @@ class TB(ClockedTB):
             await RisingEdge(self.clk)
         await ReadOnly()
         eof = self.cycle               # the edge that samples tp_eof
+        if eof_with_last and 0 < len(touches) <= self.mt:
+            self.last_touch = eof
         await self.writable()
         d.tp_valid_i.value = 0
         d.tp_eof_i.value = 0
@@ -133,6 +140,74 @@ def ev_tuple(e):
             e.axis_minor_q, e.angle, e.flags)
 
 
+def tree_stages(mt: int) -> int:
+    """Stages of the RTL's row-minimum tree (one level each): SB = clog2(MAX_TOUCHES)."""
+    return max(1, math.ceil(math.log2(mt)))
+
+
+def match_cycles(dm, sb: int) -> tuple[int, int]:
+    """Cycle model of the RTL's MATCH (rtl/fmt_tracker.v): a queue of the touches' cached
+    keys (D, t, slot) sorted by (D, t); per cycle the head is assigned (fresh, nothing in
+    flight), or popped for a recompute of its row minimum over the free slots (stale:
+    its slot was taken; the new key is inserted at the end of the (sb + 1)-th cycle
+    after the pop: request, sb tree stages; no pair is assigned while a recompute is
+    in flight), or MATCH ends (queue
+    empty, nothing in flight).  ``dm``: the model's candidate matrix (touch, slot).
+    Returns (cycles from the first MATCH decision to the cycle that ends it, stale pops)."""
+    nt, ns = dm.shape
+    free = [True] * ns
+
+    def row_min(t):
+        best = None
+        for s in range(ns):
+            if free[s] and dm[t, s] != NO_CAND and (best is None or int(dm[t, s]) < best[0]):
+                best = (int(dm[t, s]), s)
+        return best
+
+    q = []
+    for t in range(nt):
+        k = row_min(t)
+        if k:
+            q.append([k[0], t, k[1], False])
+    q.sort(key=lambda e: (e[0], e[1]))
+    due, busy_until, c, pops = {}, -1, 0, 0
+    while True:
+        head = q[0] if q else None
+        if head is not None and head[3]:
+            q.pop(0)
+            pops += 1
+            k = row_min(head[1])
+            if k:
+                due.setdefault(c + sb + 1, []).append([k[0], head[1], k[1], False])
+            busy_until = max(busy_until, c + sb + 1)
+        elif head is not None and c > busy_until:
+            q.pop(0)
+            free[head[2]] = False
+            for e in q:
+                if e[2] == head[2]:
+                    e[3] = True
+        elif head is None and c > busy_until:
+            return c, pops
+        for e in due.pop(c, []):
+            q.append(e)
+            q.sort(key=lambda x: (x[0], x[1]))
+        c += 1
+
+
+def tail_latency(events, dm, eof: int, last_touch, sb: int) -> tuple[int, int]:
+    """RTL timing: tp_eof sampled by edge ``eof`` -> the frame's last event on the output
+    after edge eof + lat - 1 (a plain register would be lat = 1).  The last touch (edge
+    ``last_touch``) has its key in the queue sb + 3 cycles later (A1 distances, A2 row
+    write, sb tree stages, insert), MATCH starts the cycle after tp_eof: first decision
+    d0 = max(1, last_touch + sb + 3 - eof) cycles after it; then match_cycles; then one cycle
+    per lift and new (issued in the cycle MATCH ends), and the cycle that marks the
+    last event.  Returns (lat, stale pops)."""
+    mc, pops = match_cycles(dm, sb) if dm is not None else (0, 0)
+    d0 = max(1, last_touch + sb + 3 - eof) if last_touch is not None else 1
+    ln = sum(1 for e in events if e.type in ("lift", "new"))
+    return d0 + mc + ln + 1, pops
+
+
 async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=None,
                      eof_with_last=False):
     """Drive frames and compare every frame's events with the model's."""
@@ -143,10 +218,9 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
         n0 = len(tb.events)
         eof = await tb.send_frame(fr, touches, rng, eof_with_last)
         got = tb.events[n0:]
-        ns0 = model.stats.no_slot
-        _, stale = lazy_greedy(model.candidates(touches)) if touches else ([], 0)
+        dm = model.candidates(touches) if touches else None
+        _, stale = lazy_greedy(dm) if touches else ([], 0)
         exp = model.step(fr, touches)
-        noslot = model.stats.no_slot - ns0
         g = [x[1] for x in got]
         e = [ev_tuple(x) for x in exp]
         assert g == e, f"frame {fr}: RTL {g}\nmodel {e}"
@@ -155,13 +229,15 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
             # cycle c + lat (a plain register would be lat = 1)
             lat = got[-1][0] - eof + 1
-            assert lat == tail_cycles(exp, stale, noslot) + int(eof_with_last and bool(touches)), \
-                f"tail latency {lat} for {len(got)} events, {stale} stale picks"
-            # the update of the h contacts in hold-off (active, missed this frame):
-            # busy_o low h + 1 cycles after the last event
+            exp_lat, pops = tail_latency(exp, dm, eof, tb.last_touch, tree_stages(tb.mt))
+            assert lat == exp_lat, \
+                f"tail latency {lat} (model {exp_lat}) for {len(got)} events, {pops} stale pops"
+            # the update of the h contacts in hold-off (active, missed this frame), one
+            # issued per cycle, then the E2..E4 pipeline drains: busy_o low 4 cycles after
+            # the last event (h = 0), h + 5 (h > 0)
             h = sum(1 for st in model.slots if st.active and st.miss > 0)
-            assert tb.idle_cycle - got[-1][0] == h + 1, "busy after the last event"
-            tail.append((len(got), stale, lat))
+            assert tb.idle_cycle - got[-1][0] == (h + 5 if h else 4), "busy after the last event"
+            tail.append((len(got), stale, pops, lat, tb.idle_cycle - eof))
         tb.stale_total += stale
     return model, tail
 
@@ -211,7 +287,7 @@ async def random_streams(dut):
             frames.append(ts)
         _, tail = await run_frames(tb, p, frames, rng, start_frame=rng.randrange(1 << 16))
         dut._log.info(f"trial {trial}: tail latency (events, stale picks, cycles) max "
-                      f"{max(tail, key=lambda x: x[2]) if tail else None}")
+                      f"{max(tail, key=lambda x: x[3]) if tail else None}")
     dut._log.info(f"stale picks in all trials: {tb.stale_total}")
 
 
@@ -309,19 +385,19 @@ async def match_timing(dut):
         frames = [[Touch(q(10 + 12 * (i % 8)) + 40 * k, q(10 + 12 * (i // 8)) + 25 * k, 900 + i)
                    for i in range(n)] for k in range(4)]
         _, tail = await run_frames(tb, p, frames)
-        dut._log.info(f"{n} spread fingers: (events, stale picks, tail cycles) {tail}")
-        assert all(st == 0 for _, st, _ in tail[1:])
+        dut._log.info(f"{n} spread fingers: (events, stale picks, stale pops, tail cycles, tp_eof -> idle) {tail}")
+        assert all(st == 0 and sp == 0 for _, st, sp, _, _ in tail[1:])
     await tb.reset()
     slots = [Touch(1000 + 300 * s, 2000, 100 + s) for s in range(mt)]
     worst = [Touch(999 - t, 2000, 500 + t) for t in range(mt)]
     _, tail = await run_frames(tb, p, [slots, worst])
-    dut._log.info(f"worst case: (events, stale picks, tail cycles) {tail}")
-    assert tail[1][1] == mt * (mt - 1) // 2
+    dut._log.info(f"worst case: (events, stale picks, stale pops, tail cycles, tp_eof -> idle) {tail}")
+    assert tail[1][1] == mt * (mt - 1) // 2 and tail[1][2] == mt * (mt - 1) // 2
     # the last touch in the tp_eof cycle: its row minimum is cached one cycle later
     await tb.reset()
     _, tail = await run_frames(tb, p, [slots, worst, worst[::-1], [], slots[1:]],
                                eof_with_last=True)
-    dut._log.info(f"last touch with tp_eof: (events, stale picks, tail cycles) {tail}")
+    dut._log.info(f"last touch with tp_eof: (events, stale picks, stale pops, tail cycles, tp_eof -> idle) {tail}")
 
 
 @cocotb.test()
