@@ -30,7 +30,8 @@
 //   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
 //        a row with k maxima holds the window k cycles)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
-//        ceil((COLS+2)/3):1 selects and a rotation per row)
+//        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
+//        the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list); the 3x3 goes to
 //        a (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
@@ -41,18 +42,19 @@
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
-// candidate <= 12 + n + m for n candidates and m maxima in the rows completed by the
+// candidate <= 14 + n + m for n candidates and m maxima in the rows completed by the
 // last beat (its row and the rows next to it): the sweep starts over (up to 5 reads:
 // rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one cycle,
-// and the last one is captured and inserted before the emission starts.  30 x 40, FFT
-// row order: 11 + n without maxima in those rows (3..5 candidates: 14..16); 20 maxima
-// in the last row, 16 candidates: 48 (= 12 + n + m).  hm_eof -> last candidate is one
-// cycle less; cand_eof follows the last candidate.
+// the last one is captured (2 registers) and inserted, and the finish test is
+// registered, before the emission starts.  30 x 40, FFT row order: 12 + n without
+// maxima in those rows (3..5 candidates: 15..17); 20 maxima in the last row, 16
+// candidates: 50 (= 14 + n + m).  hm_eof -> last candidate is one cycle less; cand_eof
+// follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
 // per row in a run) plus the virtual step (121), one cycle per maximum (at most 600:
-// Von Neumann checkerboard; Moore at most 300), 8 of pipeline and finish, n + 3 of
-// emission (19): 748 < 768.
+// Von Neumann checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of
+// emission (19): 750 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
@@ -275,15 +277,19 @@ module fmt_localmax #(
     localparam QI_W = $clog2(NGR + 1);
     localparam NGA  = 1 << QI_W;
     reg [COL_IDX_W-1:0] lo_col;
-    reg [QI_W-1:0]      lo_q;
+    reg [QI_W-1:0]      lo_q, lo_g0, lo_g1;    // col / 3; the group 0 and 1 cells (below)
     reg [1:0]           lo_m;
     /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
     always @(*) begin : c_lo
-        integer i, qd, md;
+        integer i, qd, md, g0, g1;
         qd     = 0;
         md     = 0;
+        g0     = 0;
+        g1     = 0;
         lo_col = {COL_IDX_W{1'b0}};
         lo_q   = {QI_W{1'b0}};
+        lo_g0  = {QI_W{1'b0}};
+        lo_g1  = {QI_W{1'b0}};
         lo_m   = 2'd0;
         for (i = 0; i < COLS; i = i + 1)
             if (rem_low[i]) begin
@@ -292,6 +298,10 @@ module fmt_localmax #(
                 lo_col = lo_col | i[COL_IDX_W-1:0];
                 lo_q   = lo_q   | qd[QI_W-1:0];
                 lo_m   = lo_m   | md[1:0];
+                g0     = qd + ((md > 0) ? 1 : 0);
+                g1     = qd + ((md > 1) ? 1 : 0);
+                lo_g0  = lo_g0  | g0[QI_W-1:0];
+                lo_g1  = lo_g1  | g1[QI_W-1:0];
             end
     end
     /* verilator lint_on UNUSEDSIGNAL */
@@ -301,6 +311,8 @@ module fmt_localmax #(
     reg [COL_IDX_W-1:0] icol_q;
     (* fsm_encoding = "none" *)
     reg [QI_W-1:0]      iq_q;                  // icol_q / 3
+    (* fsm_encoding = "none" *)
+    reg [QI_W-1:0]      ig0_q, ig1_q;          // the cells of groups 0 and 1 (q or q + 1)
     (* fsm_encoding = "none" *)
     reg [1:0]           im_q;                  // icol_q mod 3
 
@@ -348,20 +360,28 @@ module fmt_localmax #(
             end
         end
     endgenerate
-    wire [QI_W-1:0] gi0 = iq_q + {{(QI_W-1){1'b0}}, (im_q > 2'd0)};   // group 0
-    wire [QI_W-1:0] gi1 = iq_q + {{(QI_W-1){1'b0}}, (im_q > 2'd1)};   // group 1
-    wire [HM_W-1:0] sa0 = ga0[gi0], sa1 = ga1[gi1], sa2 = ga2[iq_q];
-    wire [HM_W-1:0] sb0 = gb0[gi0], sb1 = gb1[gi1], sb2 = gb2[iq_q];
-    wire [HM_W-1:0] sc0 = gc0[gi0], sc1 = gc1[gi1], sc2 = gc2[iq_q];
+    // first capture register: the three cells of each row (group order), then the
+    // rotation by m and the rows outside the sensor
+    wire [HM_W-1:0] sa0 = ga0[ig0_q], sa1 = ga1[ig1_q], sa2 = ga2[iq_q];
+    wire [HM_W-1:0] sb0 = gb0[ig0_q], sb1 = gb1[ig1_q], sb2 = gb2[iq_q];
+    wire [HM_W-1:0] sc0 = gc0[ig0_q], sc1 = gc1[ig1_q], sc2 = gc2[iq_q];
+    reg             pv_q;                      // pre-capture valid
+    reg [Z9_W-1:0]  pz_q;                      // the nine cells, group order
+    reg [1:0]       pm_q;                      // their rotation (column mod 3)
+    reg             ptop_q, pbot_q;            // first / last row
+    reg [IDX_W-1:0] pidx_q;                    // raster index
+    wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
+    wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
+    wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
     reg [Z9_W-1:0] z9;
     always @(*) begin
-        case (im_q)
-            2'd1:    z9 = {sc0, sc2, sc1, sb0, sb2, sb1, sa0, sa2, sa1};
-            2'd2:    z9 = {sc1, sc0, sc2, sb1, sb0, sb2, sa1, sa0, sa2};
-            default: z9 = {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
+        case (pm_q)
+            2'd1:    z9 = {qc0, qc2, qc1, qb0, qb2, qb1, qa0, qa2, qa1};
+            2'd2:    z9 = {qc1, qc0, qc2, qb1, qb0, qb2, qa1, qa0, qa2};
+            default: z9 = {qc2, qc1, qc0, qb2, qb1, qb0, qa2, qa1, qa0};
         endcase
-        if (mtop_q) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
-        if (mbot_q) z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
+        if (ptop_q) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
+        if (pbot_q) z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
     end
     reg              cap_v_q;                  // one maximum captured
     reg [Z9_W-1:0]   cap_z_q;                  // its 3x3
@@ -417,8 +437,10 @@ module fmt_localmax #(
     wire             over     = (found_q > lim_ext);
     wire [LIM_W-1:0] n_emit   = over ? lim_eff : found_q[LIM_W-1:0];
     wire             complete = (arr_p == {ROWS{1'b1}});
-    wire             finish   = run && eofs_q[pb_q] && !(|ready)
-                              && !v0_q && !v1_q && !v2_q && adv && !iv_q && !cap_v_q;
+    // finish: the frame's eof seen, no row ready, nothing in flight -- registered (one
+    // cycle old: nothing can start in between, as no row was ready)
+    reg              fin_pre_q;
+    wire             finish   = run && fin_pre_q;
     wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
     wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
@@ -452,10 +474,17 @@ module fmt_localmax #(
         if (rem_q != {COLS{1'b0}}) begin
             icol_q <= lo_col;
             iq_q   <= lo_q;
+            ig0_q  <= lo_g0;
+            ig1_q  <= lo_g1;
             im_q   <= lo_m;
         end
+        pz_q      <= {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
+        pm_q      <= im_q;
+        ptop_q    <= mtop_q;
+        pbot_q    <= mbot_q;
+        pidx_q    <= {mrow_q, icol_q};
         cap_z_q   <= z9;
-        cap_idx_q <= {mrow_q, icol_q};
+        cap_idx_q <= pidx_q;
         cand_z_o       <= z9_rd_q;
         cand_missing_o <= miss9;
         cand_row_o     <= em_row_q;
@@ -480,6 +509,8 @@ module fmt_localmax #(
             rem_q    <= {COLS{1'b0}};
             iv_q     <= 1'b0;
             cap_v_q  <= 1'b0;
+            pv_q     <= 1'b0;
+            fin_pre_q <= 1'b0;
             found_q  <= {FOUND_W{1'b0}};
             left_q   <= {LIM_W{1'b0}};
             em_v_q   <= 1'b0;
@@ -537,10 +568,13 @@ module fmt_localmax #(
                 iv_q  <= 1'b0;
                 if (v2_q && f2_q) rem_q <= part_q & down_n;
             end
-            cap_v_q <= iv_q;
+            pv_q    <= iv_q;
+            cap_v_q <= pv_q;
             if (cap_v_q) found_q <= found_q + 1'b1;
 
             // ---- finish and emit ----
+            fin_pre_q <= run && eofs_q[pb_q] && !(|ready) && !v0_q && !v1_q && !v2_q && adv
+                      && !iv_q && !pv_q && !cap_v_q;
             if (finish) begin
                 state_q    <= S_EMIT;
                 em_frame_q <= pb_q ? frm1_q : frm0_q;

@@ -7,7 +7,7 @@ many ties, random row orders, beats on consecutive cycles and with gaps, back-to
 frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges and
 corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
 neighbourhoods, a reset in the middle of a frame.  The latency from the last row beat
-(and from hm_eof) to the last candidate is measured and bounded: 12 + n + m for n
+(and from hm_eof) to the last candidate is measured and bounded: 14 + n + m for n
 candidates and m maxima in the rows completed by the last beat (rtl/fmt_localmax.v).
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ from fmt.localmax import local_maxima_fixed, maxima_mask
 
 # latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m
 # for n candidates and m maxima in the rows completed by the last beat
-LAT_C = 12
+LAT_C = 14
 
 
 class TB(ClockedTB):
