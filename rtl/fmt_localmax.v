@@ -8,30 +8,55 @@
 // give exactly one maximum (the first in raster order).
 //
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most.
-// Storage: the rows are written into an inferred RAM of 2 x ROWS words of COLS*HM_W
-// bits (two frame buffers: the next frame's rows may arrive while the current frame is
-// still being finished) with 3 synchronous read ports (rows r-1, r, r+1): block RAM,
-// one copy per read port (27 RAMB36 at 30 x 40), no LUTs.  An arrival
-// bitmap per buffer marks the rows present; row r is "ready" as soon as it and its
-// existing neighbour rows are present, so evaluation runs while the frame arrives:
-//   E0: pick the lowest ready row, read rows r-1, r, r+1          (1 row per cycle)
-//   E1: compare every cell of row r with its neighbours -> maxima mask (COLS bits)
-//   E2: serialise the maxima, one per cycle (lowest column first)
-//   E3: insert (z, row, col) into a sorted list of MAX_TOUCHES entries (z descending,
-//       ties by raster index ascending; fmt_sorted_list); the weakest falls off the end.
-// After the frame's hm_eof, once every row is evaluated, the list is emitted, one
-// candidate per cycle: the same three read ports fetch the candidate's rows and a
-// column select forms its 3x3 neighbourhood (by column mod 3: three ceil((COLS+2)/3):1
-// selects and a rotation per row); then cand_eof.  Settings (threshold_i,
-// moore_i, limit_i) are used live: change them between frames.
+// Storage: the rows are written into an inferred RAM of 2 x 2^ROW_IDX_W words of
+// COLS*HM_W bits (two frame buffers, word {buffer, row}: the next frame's rows may
+// arrive while the current frame is still being finished) with ONE read port: block
+// RAM, 9 RAMB36 at 30 x 40 (the width, one row written per cycle, sets the count), read
+// through a second (output) register as XST packs it.  An arrival bitmap per buffer
+// marks the rows present; row r is "ready" when it and its existing neighbour rows are
+// present, so evaluation runs while the frame arrives.  Evaluation sweeps down the rows,
+// one row read per step (SW = sweep):
+//   SW0  choose the step: finish the current row r (read r + 1; after the last row a
+//        virtual step without a read), move on to a ready r + 1, or start at the lowest
+//        ready row s (read s - 1, then s, then s + 1: 3 reads, 1 per row after that);
+//        address register
+//   SW1  block-RAM read, SW2 its output register (N, the new row)
+//   SW3  one comparator bank against the previous step's row P = N's row - 1 (the
+//        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
+//        (5 x COLS comparators; each pair of cells is compared once: P's "below" tests
+//        are the negations of N's "above" tests) -> N's partial mask (earlier
+//        neighbours) and P's final mask (its partial AND its later neighbours in N).
+//        The window shifts (w2 <- w1 <- w0 <- N): w2, w1, w0 = rows P - 1, P, P + 1.
+//   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
+//        a row with k maxima holds the window k cycles)
+//   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
+//        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
+//        the rows outside the sensor, registered)
+//   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
+//        descending, ties by raster index ascending; fmt_sorted_list); the 3x3 goes to
+//        a (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
+// After the frame's hm_eof, once every ready row is finished, the list is emitted, one
+// candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
+// then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
+// between frames.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
-// hm_eof right after the last row): last row beat -> last candidate = 7 + n cycles
-// for n candidates (1 -> 8, 5 -> 12), plus one cycle per maximum that lies in the rows
-// completed by the last beat (16 maxima all in the last row: 42); hm_eof -> last
-// candidate is one cycle less; cand_eof follows the last candidate.  Throughput: one
-// row per cycle plus one cycle per maximum; a frame must be finished (cand_eof) before
-// the frame after the next one starts to arrive, else overrun_o is set (sticky).
+// hm_eof right after the last row, the earlier rows finished): last row beat -> last
+// candidate <= 14 + n + m for n candidates and m maxima in the rows completed by the
+// last beat (its row and the rows next to it): the sweep starts over (up to 5 reads:
+// rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one cycle,
+// the last one is captured (2 registers) and inserted, and the finish test is
+// registered, before the emission starts.  30 x 40, FFT row order: 12 + n without
+// maxima in those rows (3..5 candidates: 15..17); 20 maxima in the last row, 16
+// candidates: 50 (= 14 + n + m).  hm_eof -> last candidate is one cycle less; cand_eof
+// follows the last candidate.
+// Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
+// idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
+// per row in a run) plus the virtual step (121), one cycle per maximum (at most 600:
+// Von Neumann checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of
+// emission (19): 750 < 768.
+// A frame must be finished (cand_eof) before the frame after the next one starts to
+// arrive, else overrun_o is set (sticky).
 //
 // Candidate stream: cand_valid_o with cand_frame_o, cand_row_o, cand_col_o, cand_z_o
 // (the 3x3 neighbourhood, k = (dy+1)*3 + (dx+1) at [k*HM_W +: HM_W], 0 outside the
@@ -43,8 +68,8 @@
 `include "fmt_defaults.vh"
 
 module fmt_localmax #(
-    parameter ROWS        = `FMT_ROWS,          // heat-map rows
-    parameter COLS        = `FMT_COLS,          // heat-map columns
+    parameter ROWS        = `FMT_ROWS,          // heat-map rows (>= 2)
+    parameter COLS        = `FMT_COLS,          // heat-map columns (>= 2)
     parameter HM_W        = `FMT_HM_W,          // cell width, unsigned
     parameter MAX_TOUCHES = `FMT_MAX_TOUCHES,   // candidate list length (contact limit)
     parameter FRAME_W     = 16,                 // frame number width
@@ -85,215 +110,249 @@ module fmt_localmax #(
 );
 
     localparam K      = MAX_TOUCHES;
-    localparam ADDR_W = $clog2(2 * ROWS);
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;    // raster key {row, col}
     localparam Z9_W   = 9 * HM_W;
+    localparam AW     = ROW_IDX_W + 1;            // frame-store address {buffer, row}
+    localparam SLOT_W = $clog2(K + 1);            // 3x3 store slot (K + 1 slots)
     localparam integer LAST_ROW_I = ROWS - 1;
     localparam integer LAST_COL_I = COLS - 1;
-    localparam integer ROWS_I     = ROWS;
     localparam integer K_I        = MAX_TOUCHES;
     localparam [ROW_IDX_W-1:0] LAST_ROW = LAST_ROW_I[ROW_IDX_W-1:0];
     localparam [COL_IDX_W-1:0] LAST_COL = LAST_COL_I[COL_IDX_W-1:0];
-    localparam [ADDR_W-1:0]    ROWS_A   = ROWS_I[ADDR_W-1:0];
     localparam [LIM_W-1:0]     K_L      = K_I[LIM_W-1:0];
 
-    // ---- frame buffers and arrival bookkeeping ----------------------------------------
-    (* ram_style = "block" *)                 // one write, three reads: block RAM, one
-    reg [RW-1:0]         mem [0:2*ROWS-1];  // copy per read port (no LUTs)
-    reg [ROWS-1:0]       arr_q [0:1];       // rows present, per buffer
-    reg [1:0]            eofs_q;            // hm_eof seen, per buffer
-    reg [FRAME_W-1:0]    frm_q [0:1];       // frame number, per buffer
-    reg                  wb_q;              // buffer receiving rows
-    reg                  pb_q;              // buffer being processed
-    reg [ROWS-1:0]       done_q;            // rows of pb issued for evaluation
+    // synthesis translate_off
+    initial begin
+        if (ROWS < 2 || COLS < 2) begin
+            $display("fmt_localmax: ROWS %0d and COLS %0d must be >= 2", ROWS, COLS);
+            $finish;
+        end
+    end
+    // synthesis translate_on
 
-    wire [ADDR_W-1:0] wr_row  = {{(ADDR_W-ROW_IDX_W){1'b0}}, hm_row_i};
-    wire [ADDR_W-1:0] wr_addr = wb_q ? (ROWS_A + wr_row) : wr_row;
+    // ---- frame store and arrival bookkeeping ---------------------------------------------
+    (* ram_style = "block" *)                  // one write port, one read port: block RAM
+    reg [RW-1:0]      mem [0:(1 << AW)-1];     // word {buffer, row}
+    reg [ROWS-1:0]    arr0_q, arr1_q;          // rows present, per buffer
+    reg [1:0]         eofs_q;                  // hm_eof seen, per buffer
+    reg [FRAME_W-1:0] frm0_q, frm1_q;          // frame number, per buffer
+    reg               wb_q;                    // buffer receiving rows
+    reg               pb_q;                    // buffer being processed
+
     always @(posedge clk) begin
-        if (hm_valid_i) mem[wr_addr] <= hm_data_i;
+        if (hm_valid_i) mem[{wb_q, hm_row_i}] <= hm_data_i;
     end
 
-    // ready rows of the processing buffer
-    wire [ROWS-1:0] arr_p = arr_q[pb_q];
-    reg  [ROWS-1:0] ready;
-    // (loop variables are local to their always block: one driver each, no latch)
-    always @(*) begin : c_ready
-        integer i;
-        for (i = 0; i < ROWS; i = i + 1)
-            ready[i] = arr_p[i] & ~done_q[i]
-                     & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
-                     & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
-    end
-    reg [ROW_IDX_W-1:0] pick;
-    always @(*) begin : c_pick
-        integer i;
-        pick = {ROW_IDX_W{1'b0}};
-        for (i = ROWS - 1; i >= 0; i = i - 1)
-            if (ready[i]) pick = i[ROW_IDX_W-1:0];
-    end
-    // ---- state ------------------------------------------------------------------------
+    wire [ROWS-1:0] arr_p = pb_q ? arr1_q : arr0_q;
+
+    // ---- sweep scheduler ------------------------------------------------------------------
+    // A step reads one row x of the processing buffer into the window.  The comparators
+    // compare it (N) with the row of the previous step (P).  When P = x - 1 the step
+    // yields N's partial mask (threshold, left/right, the row above) and, with fin, P's
+    // final mask (P's partial and the row below).  A virtual step after the last row
+    // finishes it without a read.
     localparam S_RUN = 1'b0, S_EMIT = 1'b1;
     reg state_q;
+    reg [ROWS-1:0]      done_q;                // rows finished (mask issued)
+    (* fsm_encoding = "none" *)             // small registers below: no FSM extraction
+    reg [ROW_IDX_W-1:0] cur_q;                 // row of the latest step
+    reg                 cv_q;                  // cur_q valid (a step since the frame began)
+    reg                 cp_q;                  // the partial mask of cur_q is complete
+    (* fsm_encoding = "none" *)
+    reg [ROW_IDX_W-1:0] jx_q;                  // the row to read to start there
+    reg                 jv_q;                  // some row was ready
+    wire                adv;                   // the step pipeline advances
 
-    // pipeline valids
-    reg e1_v_q, e2_v_q, e3_v_q;
-    wire [COLS-1:0] mask_next;
-    reg  [COLS-1:0] mask_q;
-    wire e2_free = !e2_v_q || ((mask_q & (mask_q - 1'b1)) == {COLS{1'b0}});
-    wire e1_adv  = e1_v_q && e2_free;
-    wire issue   = (state_q == S_RUN) && (|ready) && (!e1_v_q || e1_adv);
-
-    // ---- the sorted list (z, raster index): fmt_sorted_list, below ------------------------
-    /* verilator lint_off UNUSEDSIGNAL */     // only entry 0's raster index is read
-    wire [K*IDX_W-1:0] l_idx;                 // raster index {row, col} of entry i
+    reg [ROWS-1:0] ready;                      // present with its neighbours, not finished
+    reg [ROWS-1:0] fin_ok;                     // not finished and the row below present
+    reg [ROWS-1:0] nxt_ok;                     // row i + 1 ready
+    always @(*) begin : c_ready
+        integer i;
+        for (i = 0; i < ROWS; i = i + 1) begin
+            ready[i]  = arr_p[i] & ~done_q[i]
+                      & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
+                      & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
+            fin_ok[i] = ~done_q[i] & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
+        end
+        for (i = 0; i < ROWS; i = i + 1)
+            nxt_ok[i] = (i == ROWS - 1) ? 1'b0 : ready[(i == ROWS - 1) ? i : i + 1];
+    end
+    // lowest ready row, as an OR of one-hot bits (no priority chain)
+    wire [ROWS-1:0] rdy_low = ready & ~(ready - 1'b1);
+    reg  [ROW_IDX_W-1:0] jx_d;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_j
+        integer i, t;
+        t    = 0;
+        jx_d = {ROW_IDX_W{1'b0}};
+        for (i = 0; i < ROWS; i = i + 1)
+            if (rdy_low[i]) begin
+                t    = (i == 0) ? 0 : i - 1;
+                jx_d = jx_d | t[ROW_IDX_W-1:0];
+            end
+    end
     /* verilator lint_on UNUSEDSIGNAL */
-    reg [FOUND_W-1:0] found_q;
-    reg [LIM_W-1:0]   left_q;                 // candidates still to emit
-    wire              em_issue = (state_q == S_EMIT) && (left_q != {LIM_W{1'b0}});
-    wire [ROW_IDX_W-1:0] l_row0 = l_idx[COL_IDX_W +: ROW_IDX_W];
 
-    // ---- E0 -> E1: three synchronous reads (evaluation, or a candidate's 3x3 at emission)
-    reg [RW-1:0]        ra_q, rb_q, rc_q;       // rows r-1, r, r+1
-    reg [ROW_IDX_W-1:0] r1_q;
-    wire [ROW_IDX_W-1:0] rd_row = (state_q == S_EMIT) ? l_row0 : pick;
-    wire [ADDR_W-1:0] base  = pb_q ? ROWS_A : {ADDR_W{1'b0}};
-    wire [ADDR_W-1:0] a_mid = base + {{(ADDR_W-ROW_IDX_W){1'b0}}, rd_row};
-    wire [ADDR_W-1:0] a_up  = (rd_row == {ROW_IDX_W{1'b0}}) ? a_mid : a_mid - 1'b1;
-    wire [ADDR_W-1:0] a_dn  = (rd_row == LAST_ROW) ? a_mid : a_mid + 1'b1;
+    // The rules read fin_ok, nxt_ok and the lowest ready row one cycle late (registered,
+    // indexed by one-hot rows: a few LUT levels).  Safe: rows only arrive in between, and
+    // the only row finished in the last cycle is the previous cur, never indexed now
+    // (rule c checks its row against done_q itself).
+    reg [ROWS-1:0] fin_ok_q, nxt_ok_q;         // fin_ok, nxt_ok one cycle old
+    reg [ROWS-1:0] cur1h_q;                    // cur_q one-hot
+    reg [ROWS-1:0] j1h_q, jx1h_q;              // lowest ready row j, jx_q: one-hot
+    reg            jx0_q;                      // jx_q = 0
+    wire run    = (state_q == S_RUN);
+    wire rule_a = cv_q && cp_q && |(cur1h_q & fin_ok_q);  // finish cur (read cur + 1)
+    wire rule_b = cv_q && |(cur1h_q & nxt_ok_q);          // move on to a ready cur + 1
+    wire rule_c = jv_q && !(|(j1h_q & done_q));           // start at the ready row j
+    wire issue  = run && adv && (rule_a || rule_b || rule_c);
+    wire last_c = cur1h_q[ROWS-1];
+    wire [ROW_IDX_W-1:0] cur_p1 = cur_q + 1'b1;
+    wire [ROW_IDX_W-1:0] x_row  = (rule_a || rule_b) ? cur_p1 : jx_q;
+    wire [ROWS-1:0] jx1h_d = (rdy_low >> 1) | {{(ROWS-1){1'b0}}, rdy_low[0]};
+
+    // step pipeline: s0 address register, s1 block-RAM read, s2 its output register
+    reg [AW-1:0]        a0_q;
+    reg                 v0_q, v1_q, v2_q;      // step valid
+    reg                 f0_q, f1_q, f2_q;      // finishes the previous row
+    reg                 t0_q, t1_q, t2_q;      // the read row is row 0
+    reg                 x0_q, x1_q, x2_q;      // virtual step (after the last row)
+    reg [ROW_IDX_W-1:0] r0_q, r1_q, r2_q;      // row finished by the step
+    reg [RW-1:0]        rd_q;                  // block-RAM read register
+    reg [RW-1:0]        do_q;                  // block-RAM output register (N)
+    reg [RW-1:0]        w0_q, w1_q, w2_q;      // window: rows x-1 (P), x-2, x-3 of the last step
+
     always @(posedge clk) begin
-        if (issue || em_issue) begin
-            ra_q <= mem[a_up];
-            rb_q <= mem[a_mid];
-            rc_q <= mem[a_dn];
-            r1_q <= rd_row;
+        if (adv) begin
+            rd_q <= mem[a0_q];
+            do_q <= rd_q;
         end
     end
-    wire top1 = (r1_q == {ROW_IDX_W{1'b0}});
-    wire bot1 = (r1_q == LAST_ROW);
 
-    // ---- E1: maxima mask of row r1 ----------------------------------------------------
-    // gt_l[c] = B[c] > B[c-1] (c beats its left neighbour); the left neighbour beats
-    // (>=) c exactly when !gt_l[c]: one comparator per horizontal pair.
-    wire [COLS:0] gt_l;
-    assign gt_l[0]    = 1'b1;
-    assign gt_l[COLS] = 1'b0;
+    // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
+    wire [COLS:0]   gtl;                       // N[c] > N[c-1]
+    wire [COLS-1:0] gtv;                       // N[c] > P[c]
+    wire [COLS:0]   gd1;                       // N[c] > P[c-1]
+    wire [COLS:0]   gd2;                       // N[c] > P[c+1] at [c+1]
+    wire [COLS-1:0] part_n, down_n;
+    assign gtl[0] = 1'b1;  assign gtl[COLS] = 1'b0;
+    assign gd1[0] = 1'b1;  assign gd1[COLS] = 1'b0;
+    assign gd2[0] = 1'b0;  assign gd2[COLS] = 1'b1;
     genvar c;
     generate
-        for (c = 1; c < COLS; c = c + 1) begin : g_h
-            assign gt_l[c] = (rb_q[c*HM_W +: HM_W] > rb_q[(c-1)*HM_W +: HM_W]);
-        end
         for (c = 0; c < COLS; c = c + 1) begin : g_cmp
-            wire [HM_W-1:0] p  = rb_q[c*HM_W +: HM_W];
-            wire [HM_W-1:0] u  = ra_q[c*HM_W +: HM_W];
-            wire [HM_W-1:0] d  = rc_q[c*HM_W +: HM_W];
-            wire ok_thr = (p >= threshold_i);
-            wire ok_u   = top1 || (p > u);
-            wire ok_d   = bot1 || (p >= d);
-            wire ok_l   = gt_l[c];
-            wire ok_r   = !gt_l[c + 1];
-            wire ok_ul, ok_ur, ok_dl, ok_dr;
+            wire [HM_W-1:0] n = do_q[c*HM_W +: HM_W];
+            wire [HM_W-1:0] p = w0_q[c*HM_W +: HM_W];
+            assign gtv[c] = (n > p);
             if (c > 0) begin : g_l
-                wire [HM_W-1:0] ul = ra_q[(c-1)*HM_W +: HM_W];
-                wire [HM_W-1:0] dl = rc_q[(c-1)*HM_W +: HM_W];
-                assign ok_ul = top1 || !moore_i || (p > ul);
-                assign ok_dl = bot1 || !moore_i || (p >= dl);
-            end else begin : g_nl
-                assign ok_ul = 1'b1;  assign ok_dl = 1'b1;
+                assign gtl[c] = (n > do_q[(c-1)*HM_W +: HM_W]);
+                assign gd1[c] = (n > w0_q[(c-1)*HM_W +: HM_W]);
             end
             if (c < COLS - 1) begin : g_r
-                wire [HM_W-1:0] ur = ra_q[(c+1)*HM_W +: HM_W];
-                wire [HM_W-1:0] dr = rc_q[(c+1)*HM_W +: HM_W];
-                assign ok_ur = top1 || !moore_i || (p > ur);
-                assign ok_dr = bot1 || !moore_i || (p >= dr);
-            end else begin : g_nr
-                assign ok_ur = 1'b1;  assign ok_dr = 1'b1;
+                assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
-            assign mask_next[c] = ok_thr & ok_u & ok_d & ok_l & ok_r & ok_ul & ok_ur & ok_dl & ok_dr;
+            wire thr_ok = (n >= threshold_i);
+            // N's earlier neighbours: left (strict), above, above-left, above-right (strict)
+            wire up_ok  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
+            assign part_n[c] = thr_ok && gtl[c] && !gtl[c+1] && (t2_q || up_ok);
+            // P's later neighbours in N: below, below-left, below-right (P >= them)
+            wire dn_ok  = !gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c]));
+            assign down_n[c] = x2_q || dn_ok;
         end
     endgenerate
 
-    // ---- E2: serialise the maxima of the row (lowest column first) -------------------
-    reg [RW-1:0]        wrow_q;                 // the evaluated row (values for sorting)
-    reg [ROW_IDX_W-1:0] r2_q;
-    reg [COL_IDX_W-1:0] sel;                    // lowest set bit of mask_q
-    always @(*) begin : c_sel
-        integer i;
-        sel = {COL_IDX_W{1'b0}};
-        for (i = COLS - 1; i >= 0; i = i - 1)
-            if (mask_q[i]) sel = i[COL_IDX_W-1:0];
-    end
-    wire [HM_W-1:0] sel_z = wrow_q[sel*HM_W +: HM_W];
+    // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
+    reg [COLS-1:0]      part_q;                // partial mask of w0_q
+    reg [COLS-1:0]      rem_q;                 // maxima of w1_q not yet taken
+    (* fsm_encoding = "none" *)
+    reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
+    reg                 mtop_q, mbot_q;        // w1_q is the first / last row
+    assign adv = (rem_q == {COLS{1'b0}});
+    wire [COLS-1:0] rem_low = rem_q & ~(rem_q - 1'b1);
 
-    // E3 candidate register
-    reg [HM_W-1:0]  n_z_q;
-    reg [IDX_W-1:0] n_idx_q;
-
-    // ---- E3: insertion into the list (z descending, raster index ascending); the
-    // emission pops entry 0, one per candidate; the frame's release clears the list
-    wire releasing;
-    /* verilator lint_off UNUSEDSIGNAL */     // the emission reads entry 0's index only
-    wire [K-1:0]      l_v;
-    wire [K*HM_W-1:0] l_z;
-    wire [K-1:0]      l_pay;                  // no payload (PAY_W = 0: constant 0)
-    wire              l_drop;
-    /* verilator lint_on UNUSEDSIGNAL */
-    fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(0), .PAY_RST_IDX(0),
-                      .HAS_POP(1)) u_list (
-        .clk(clk), .rst(rst), .clear_i(releasing),
-        .ins_i(e3_v_q), .ins_key_i(n_z_q), .ins_tie_i(n_idx_q), .ins_pay_i(1'b0),
-        .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_pay),
-        .drop_pay_o(l_drop));
-
-    // ---- emission: 3x3 of the candidate read back in E1, column select ---------------
-    reg                 em_v_q, em_eof_q;
-    reg [ROW_IDX_W-1:0] em_row_q;
-    reg [COL_IDX_W-1:0] em_col_q;
-    reg [FRAME_W-1:0]   em_frame_q;
-    reg [Z9_W-1:0] z9;
-    reg [8:0]      miss9;
-    // The three rows padded with a zero cell at each end (padded cell p = column p - 1);
-    // the candidate's window is padded cells p0 .. p0 + 2, p0 = em_col_q.  The padded
-    // cells are split by p mod 3 into three groups of NGR cells (cell j of group g is
-    // p = 3j + g, 0 beyond the row): the window holds exactly one cell of each group,
-    // cell q or q + 1 (q = p0 / 3, m = p0 mod 3: q + 1 for the groups g < m), and window
-    // position k takes group (m + k) mod 3.  Three NGR : 1 selects and a 3 : 1 rotation
-    // per row and bit instead of three (COLS + 2) : 1 selects.
+    // column index, its quotient and remainder by 3, as ORs of the one-hot lowest bit
     localparam NPC  = COLS + 2;
     localparam NGR  = (NPC + 2) / 3;
     localparam QI_W = $clog2(NGR + 1);
     localparam NGA  = 1 << QI_W;
-    reg [QI_W-1:0] em_q_q;                     // em_col_q / 3
-    reg [1:0]      em_m_q;                     // em_col_q mod 3
+    reg [COL_IDX_W-1:0] lo_col;
+    reg [QI_W-1:0]      lo_q, lo_g0, lo_g1;    // col / 3; the group 0 and 1 cells (below)
+    reg [1:0]           lo_m;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_lo
+        integer i, qd, md, g0, g1;
+        qd     = 0;
+        md     = 0;
+        g0     = 0;
+        g1     = 0;
+        lo_col = {COL_IDX_W{1'b0}};
+        lo_q   = {QI_W{1'b0}};
+        lo_g0  = {QI_W{1'b0}};
+        lo_g1  = {QI_W{1'b0}};
+        lo_m   = 2'd0;
+        for (i = 0; i < COLS; i = i + 1)
+            if (rem_low[i]) begin
+                qd     = i / 3;
+                md     = i % 3;
+                lo_col = lo_col | i[COL_IDX_W-1:0];
+                lo_q   = lo_q   | qd[QI_W-1:0];
+                lo_m   = lo_m   | md[1:0];
+                g0     = qd + ((md > 0) ? 1 : 0);
+                g1     = qd + ((md > 1) ? 1 : 0);
+                lo_g0  = lo_g0  | g0[QI_W-1:0];
+                lo_g1  = lo_g1  | g1[QI_W-1:0];
+            end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    reg                 iv_q;                  // a maximum to capture
+    (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
+    reg [COL_IDX_W-1:0] icol_q;
+    (* fsm_encoding = "none" *)
+    reg [QI_W-1:0]      iq_q;                  // icol_q / 3
+    (* fsm_encoding = "none" *)
+    reg [QI_W-1:0]      ig0_q, ig1_q;          // the cells of groups 0 and 1 (q or q + 1)
+    (* fsm_encoding = "none" *)
+    reg [1:0]           im_q;                  // icol_q mod 3
+
+    // ---- capture: the 3x3 of the maximum from the window ----------------------------------
+    // The three rows padded with a zero cell at each end (padded cell p = column p - 1);
+    // the maximum's window is padded cells p0 .. p0 + 2, p0 = icol_q.  The padded cells
+    // are split by p mod 3 into three groups of NGR cells (cell j of group g is p = 3j + g,
+    // 0 beyond the row): the window holds exactly one cell of each group, cell q or q + 1
+    // (q = p0 / 3, m = p0 mod 3: q + 1 for the groups g < m), and window position k takes
+    // group (m + k) mod 3.  Three NGR : 1 selects and a 3 : 1 rotation per row and bit
+    // instead of three (COLS + 2) : 1 selects.
     wire [HM_W-1:0] ga0 [0:NGA-1], ga1 [0:NGA-1], ga2 [0:NGA-1];
     wire [HM_W-1:0] gb0 [0:NGA-1], gb1 [0:NGA-1], gb2 [0:NGA-1];
     wire [HM_W-1:0] gc0 [0:NGA-1], gc1 [0:NGA-1], gc2 [0:NGA-1];
     genvar gj;
     generate
         for (gj = 0; gj < NGA; gj = gj + 1) begin : g_grp
-            // padded cell 3j + g is column 3j + g - 1
+            // padded cell 3j + g is column 3j + g - 1; a: row above, b: the row, c: below
             if (3 * gj >= 1 && 3 * gj <= COLS) begin : g_0
-                assign ga0[gj] = ra_q[(3*gj-1)*HM_W +: HM_W];
-                assign gb0[gj] = rb_q[(3*gj-1)*HM_W +: HM_W];
-                assign gc0[gj] = rc_q[(3*gj-1)*HM_W +: HM_W];
+                assign ga0[gj] = w2_q[(3*gj-1)*HM_W +: HM_W];
+                assign gb0[gj] = w1_q[(3*gj-1)*HM_W +: HM_W];
+                assign gc0[gj] = w0_q[(3*gj-1)*HM_W +: HM_W];
             end else begin : g_0z
                 assign ga0[gj] = {HM_W{1'b0}};
                 assign gb0[gj] = {HM_W{1'b0}};
                 assign gc0[gj] = {HM_W{1'b0}};
             end
             if (3 * gj + 1 <= COLS) begin : g_1
-                assign ga1[gj] = ra_q[(3*gj)*HM_W +: HM_W];
-                assign gb1[gj] = rb_q[(3*gj)*HM_W +: HM_W];
-                assign gc1[gj] = rc_q[(3*gj)*HM_W +: HM_W];
+                assign ga1[gj] = w2_q[(3*gj)*HM_W +: HM_W];
+                assign gb1[gj] = w1_q[(3*gj)*HM_W +: HM_W];
+                assign gc1[gj] = w0_q[(3*gj)*HM_W +: HM_W];
             end else begin : g_1z
                 assign ga1[gj] = {HM_W{1'b0}};
                 assign gb1[gj] = {HM_W{1'b0}};
                 assign gc1[gj] = {HM_W{1'b0}};
             end
             if (3 * gj + 2 <= COLS) begin : g_2
-                assign ga2[gj] = ra_q[(3*gj+1)*HM_W +: HM_W];
-                assign gb2[gj] = rb_q[(3*gj+1)*HM_W +: HM_W];
-                assign gc2[gj] = rc_q[(3*gj+1)*HM_W +: HM_W];
+                assign ga2[gj] = w2_q[(3*gj+1)*HM_W +: HM_W];
+                assign gb2[gj] = w1_q[(3*gj+1)*HM_W +: HM_W];
+                assign gc2[gj] = w0_q[(3*gj+1)*HM_W +: HM_W];
             end else begin : g_2z
                 assign ga2[gj] = {HM_W{1'b0}};
                 assign gb2[gj] = {HM_W{1'b0}};
@@ -301,38 +360,76 @@ module fmt_localmax #(
             end
         end
     endgenerate
-    wire [QI_W-1:0] gi0 = em_q_q + {{(QI_W-1){1'b0}}, (em_m_q > 2'd0)};   // group 0
-    wire [QI_W-1:0] gi1 = em_q_q + {{(QI_W-1){1'b0}}, (em_m_q > 2'd1)};   // group 1
-    wire [HM_W-1:0] sa0 = ga0[gi0], sa1 = ga1[gi1], sa2 = ga2[em_q_q];
-    wire [HM_W-1:0] sb0 = gb0[gi0], sb1 = gb1[gi1], sb2 = gb2[em_q_q];
-    wire [HM_W-1:0] sc0 = gc0[gi0], sc1 = gc1[gi1], sc2 = gc2[em_q_q];
-    // quotient and remainder by 3 of a column index (for em_q_q, em_m_q)
-    wire [COL_IDX_W-1:0] nx_col = l_idx[0 +: COL_IDX_W];
-    reg  [QI_W-1:0]      nx_q;
-    reg  [1:0]           nx_m;
-    integer k3, colv, qv;
+    // first capture register: the three cells of each row (group order), then the
+    // rotation by m and the rows outside the sensor
+    wire [HM_W-1:0] sa0 = ga0[ig0_q], sa1 = ga1[ig1_q], sa2 = ga2[iq_q];
+    wire [HM_W-1:0] sb0 = gb0[ig0_q], sb1 = gb1[ig1_q], sb2 = gb2[iq_q];
+    wire [HM_W-1:0] sc0 = gc0[ig0_q], sc1 = gc1[ig1_q], sc2 = gc2[iq_q];
+    reg             pv_q;                      // pre-capture valid
+    reg [Z9_W-1:0]  pz_q;                      // the nine cells, group order
+    reg [1:0]       pm_q;                      // their rotation (column mod 3)
+    reg             ptop_q, pbot_q;            // first / last row
+    reg [IDX_W-1:0] pidx_q;                    // raster index
+    wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
+    wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
+    wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
+    reg [Z9_W-1:0] z9;
     always @(*) begin
-        colv = {{(32-COL_IDX_W){1'b0}}, nx_col};
-        qv = 0;
-        for (k3 = 1; k3 < NGA; k3 = k3 + 1)
-            if (colv >= 3 * k3) qv = k3;
-        nx_q = qv[QI_W-1:0];
-        colv = colv - 3 * qv;
-        nx_m = colv[1:0];
-    end
-    always @(*) begin
-        case (em_m_q)
-            2'd1:    z9 = {sc0, sc2, sc1, sb0, sb2, sb1, sa0, sa2, sa1};
-            2'd2:    z9 = {sc1, sc0, sc2, sb1, sb0, sb2, sa1, sa0, sa2};
-            default: z9 = {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
+        case (pm_q)
+            2'd1:    z9 = {qc0, qc2, qc1, qb0, qb2, qb1, qa0, qa2, qa1};
+            2'd2:    z9 = {qc1, qc0, qc2, qb1, qb0, qb2, qa1, qa0, qa2};
+            default: z9 = {qc2, qc1, qc0, qb2, qb1, qb0, qa2, qa1, qa0};
         endcase
+        if (ptop_q) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
+        if (pbot_q) z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
+    end
+    reg              cap_v_q;                  // one maximum captured
+    reg [Z9_W-1:0]   cap_z_q;                  // its 3x3
+    reg [IDX_W-1:0]  cap_idx_q;                // its raster index {row, col}
+
+    // ---- the sorted list of (z, raster index), payload = slot of the 3x3 store --------------
+    wire releasing;
+    reg [FOUND_W-1:0] found_q;
+    reg [LIM_W-1:0]   left_q;                  // candidates still to emit
+    wire              em_issue = (state_q == S_EMIT) && (left_q != {LIM_W{1'b0}});
+    /* verilator lint_off UNUSEDSIGNAL */      // entry 0's index and slot only are read
+    wire [K-1:0]        l_v;
+    wire [K*HM_W-1:0]   l_z;
+    wire [K*IDX_W-1:0]  l_idx;                 // raster index {row, col} of entry i
+    wire [K*SLOT_W-1:0] l_slot;                // 3x3 store slot of entry i
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
+    fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
+                      .HAS_POP(1)) u_list (
+        .clk(clk), .rst(rst), .clear_i(releasing),
+        .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
+        .ins_pay_i(l_free),
+        .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
+        .drop_pay_o(l_free));
+
+    // 3x3 store: K + 1 slots, written with the insert at the free slot
+    (* ram_style = "block" *)
+    reg [Z9_W-1:0] z9_mem [0:K];
+    reg [Z9_W-1:0] z9_rd_q;                    // read register
+    always @(posedge clk) begin
+        if (cap_v_q) z9_mem[l_free] <= cap_z_q;
+        if (em_issue) z9_rd_q <= z9_mem[l_slot[0 +: SLOT_W]];
+    end
+
+    // ---- emission ---------------------------------------------------------------------------
+    wire [ROW_IDX_W-1:0] l_row0 = l_idx[COL_IDX_W +: ROW_IDX_W];
+    wire [COL_IDX_W-1:0] l_col0 = l_idx[0 +: COL_IDX_W];
+    reg                 em_v_q, em_eof_q;
+    reg [ROW_IDX_W-1:0] em_row_q;
+    reg [COL_IDX_W-1:0] em_col_q;
+    reg [FRAME_W-1:0]   em_frame_q;
+    reg [8:0]           miss9;
+    always @(*) begin
         miss9 = 9'd0;
         if (em_col_q == {COL_IDX_W{1'b0}})     miss9 = miss9 | 9'b001_001_001;
         if (em_col_q == LAST_COL)              miss9 = miss9 | 9'b100_100_100;
         if (em_row_q == {ROW_IDX_W{1'b0}})     miss9 = miss9 | 9'b000_000_111;
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
-        if (em_row_q == {ROW_IDX_W{1'b0}}) z9[0 +: 3*HM_W]      = {(3*HM_W){1'b0}};
-        if (em_row_q == LAST_ROW)          z9[6*HM_W +: 3*HM_W] = {(3*HM_W){1'b0}};
     end
 
     wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
@@ -340,46 +437,86 @@ module fmt_localmax #(
     wire             over     = (found_q > lim_ext);
     wire [LIM_W-1:0] n_emit   = over ? lim_eff : found_q[LIM_W-1:0];
     wire             complete = (arr_p == {ROWS{1'b1}});
-    wire             finish   = (state_q == S_RUN) && eofs_q[pb_q] && !(|ready)
-                              && !e1_v_q && !e2_v_q && !e3_v_q;
+    // finish: the frame's eof seen, no row ready, nothing in flight -- registered (one
+    // cycle old: nothing can start in between, as no row was ready)
+    reg              fin_pre_q;
+    wire             finish   = run && fin_pre_q;
     wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
     wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
 
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
-        if (e1_adv) begin
-            wrow_q <= rb_q;
-            r2_q   <= r1_q;
+        jx_q     <= jx_d;
+        j1h_q    <= rdy_low;
+        jx1h_q   <= jx1h_d;
+        jx0_q    <= rdy_low[0] | rdy_low[1];
+        fin_ok_q <= fin_ok;
+        nxt_ok_q <= nxt_ok;
+        if (adv) begin
+            a0_q <= {pb_q, x_row};
+            r0_q <= cur_q;
+            t0_q <= !(rule_a || rule_b) && jx0_q;
+            x0_q <= rule_a && last_c;
+            f0_q <= rule_a;
+            r1_q <= r0_q;  t1_q <= t0_q;  x1_q <= x0_q;  f1_q <= f0_q;
+            r2_q <= r1_q;  t2_q <= t1_q;  x2_q <= x1_q;  f2_q <= f1_q;
+            if (v2_q) begin
+                w0_q   <= do_q;
+                w1_q   <= w0_q;
+                w2_q   <= w1_q;
+                part_q <= part_n;
+                mrow_q <= r2_q;
+                mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
+                mbot_q <= x2_q;
+            end
         end
-        n_z_q   <= sel_z;
-        n_idx_q <= {r2_q, sel};
-        cand_z_o       <= z9;
+        if (rem_q != {COLS{1'b0}}) begin
+            icol_q <= lo_col;
+            iq_q   <= lo_q;
+            ig0_q  <= lo_g0;
+            ig1_q  <= lo_g1;
+            im_q   <= lo_m;
+        end
+        pz_q      <= {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
+        pm_q      <= im_q;
+        ptop_q    <= mtop_q;
+        pbot_q    <= mbot_q;
+        pidx_q    <= {mrow_q, icol_q};
+        cap_z_q   <= z9;
+        cap_idx_q <= pidx_q;
+        cand_z_o       <= z9_rd_q;
         cand_missing_o <= miss9;
         cand_row_o     <= em_row_q;
         cand_col_o     <= em_col_q;
         cand_frame_o   <= em_frame_q;
 
         if (rst) begin
-            arr_q[0] <= {ROWS{1'b0}};
-            arr_q[1] <= {ROWS{1'b0}};
+            arr0_q   <= {ROWS{1'b0}};
+            arr1_q   <= {ROWS{1'b0}};
             eofs_q   <= 2'b00;
             wb_q     <= 1'b0;
             pb_q     <= 1'b0;
             done_q   <= {ROWS{1'b0}};
+            cur_q    <= {ROW_IDX_W{1'b0}};
+            cv_q     <= 1'b0;
+            cp_q     <= 1'b0;
+            jv_q     <= 1'b0;
             state_q  <= S_RUN;
-            e1_v_q   <= 1'b0;
-            e2_v_q   <= 1'b0;
-            e3_v_q   <= 1'b0;
-            mask_q   <= {COLS{1'b0}};
+            v0_q     <= 1'b0;
+            v1_q     <= 1'b0;
+            v2_q     <= 1'b0;
+            rem_q    <= {COLS{1'b0}};
+            iv_q     <= 1'b0;
+            cap_v_q  <= 1'b0;
+            pv_q     <= 1'b0;
+            fin_pre_q <= 1'b0;
             found_q  <= {FOUND_W{1'b0}};
             left_q   <= {LIM_W{1'b0}};
             em_v_q   <= 1'b0;
             em_eof_q <= 1'b0;
             em_row_q <= {ROW_IDX_W{1'b0}};
             em_col_q <= {COL_IDX_W{1'b0}};
-            em_q_q   <= {QI_W{1'b0}};
-            em_m_q   <= 2'd0;
             cand_valid_o      <= 1'b0;
             cand_eof_o        <= 1'b0;
             cand_count_o      <= {LIM_W{1'b0}};
@@ -391,39 +528,56 @@ module fmt_localmax #(
             overrun_o         <= 1'b0;
         end else begin
             // ---- arrivals ----
-            if (hm_valid_i) arr_q[wb_q][hm_row_i] <= 1'b1;
+            if (hm_valid_i) begin
+                if (wb_q) arr1_q[hm_row_i] <= 1'b1;
+                else      arr0_q[hm_row_i] <= 1'b1;
+            end
             if (hm_eof_i) begin
                 eofs_q[wb_q] <= 1'b1;
-                frm_q[wb_q]  <= hm_frame_i;
+                if (wb_q) frm1_q <= hm_frame_i;
+                else      frm0_q <= hm_frame_i;
                 wb_q         <= ~wb_q;
                 // the other buffer still holds an unfinished frame: it will be overwritten
                 if (pb_q != wb_q && !releasing) overrun_o <= 1'b1;
             end
 
-            // ---- E0/E1 ----
+            // ---- sweep ----
+            jv_q <= |ready;
+            if (adv) begin
+                v0_q <= issue;
+                v1_q <= v0_q;
+                v2_q <= v1_q;
+            end
             if (issue) begin
-                done_q[pick] <= 1'b1;
-                e1_v_q <= 1'b1;
-            end else if (e1_adv) begin
-                e1_v_q <= 1'b0;
+                if (rule_a) done_q <= done_q | cur1h_q;
+                if (rule_a && last_c) begin
+                    cv_q <= 1'b0;                      // virtual step after the last row
+                end else begin
+                    cv_q    <= 1'b1;
+                    cur_q   <= x_row;
+                    cur1h_q <= (rule_a || rule_b) ? (cur1h_q << 1) : jx1h_q;
+                    cp_q    <= (rule_a || rule_b) || jx0_q;
+                end
             end
 
-            // ---- E2 ----
-            e3_v_q <= e2_v_q && (|mask_q);
-            if (e2_free) begin
-                e2_v_q <= e1_v_q;
-                mask_q <= e1_v_q ? mask_next : {COLS{1'b0}};
+            // ---- serialiser ----
+            if (rem_q != {COLS{1'b0}}) begin
+                rem_q <= rem_q & ~rem_low;
+                iv_q  <= 1'b1;
             end else begin
-                mask_q <= mask_q & (mask_q - 1'b1);      // clear the lowest set bit
+                iv_q  <= 1'b0;
+                if (v2_q && f2_q) rem_q <= part_q & down_n;
             end
-
-            // ---- E3: count (the list inserts) ----
-            if (e3_v_q) found_q <= found_q + 1'b1;
+            pv_q    <= iv_q;
+            cap_v_q <= pv_q;
+            if (cap_v_q) found_q <= found_q + 1'b1;
 
             // ---- finish and emit ----
+            fin_pre_q <= run && eofs_q[pb_q] && !(|ready) && !v0_q && !v1_q && !v2_q && adv
+                      && !iv_q && !pv_q && !cap_v_q;
             if (finish) begin
                 state_q    <= S_EMIT;
-                em_frame_q <= frm_q[pb_q];
+                em_frame_q <= pb_q ? frm1_q : frm0_q;
                 left_q     <= complete ? n_emit : {LIM_W{1'b0}};
                 cand_count_o      <= complete ? n_emit : {LIM_W{1'b0}};
                 cand_found_o      <= complete ? found_q : {FOUND_W{1'b0}};
@@ -434,24 +588,24 @@ module fmt_localmax #(
                     drop_count_o    <= drop_sum[CNT_W] ? {CNT_W{1'b1}} : drop_sum[CNT_W-1:0];
                 end
             end
-            // emission pipeline: em_issue reads the rows (E1 registers), then the column
-            // select registers the candidate; cand_eof follows the last one
+            // emission: em_issue pops entry 0 and reads its 3x3 (block RAM), then the
+            // output registers; cand_eof follows the last candidate
             em_v_q       <= em_issue;
             em_eof_q     <= releasing;
             cand_valid_o <= em_v_q;
             cand_eof_o   <= em_eof_q;
             if (em_issue) begin
                 em_row_q <= l_row0;
-                em_col_q <= nx_col;
-                em_q_q   <= nx_q;
-                em_m_q   <= nx_m;
+                em_col_q <= l_col0;
                 left_q   <= left_q - 1'b1;      // the list pops entry 0
             end
             if (releasing) begin
                 state_q      <= S_RUN;      // the list is cleared
                 found_q      <= {FOUND_W{1'b0}};
                 done_q       <= {ROWS{1'b0}};
-                arr_q[pb_q]  <= {ROWS{1'b0}};
+                cv_q         <= 1'b0;
+                if (pb_q) arr1_q <= {ROWS{1'b0}};
+                else      arr0_q <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
                 pb_q         <= ~pb_q;
             end
