@@ -162,7 +162,7 @@ module fmt_fft_r22sdf #(
             localparam LOG2_M = LOG2_N - s + 1;         // block of the twiddle after stage s
 
             wire              bf_valid;
-            wire [LOG2_N-1:0] bf_idx;
+            wire [LOG2_N-1:0] bf_idx, bf_nidx;
             wire signed [DW:0] bf_re, bf_im;
 
             fmt_fft_bf #(
@@ -174,7 +174,7 @@ module fmt_fft_r22sdf #(
                 .in_idx_i(bus_idx[s*LOG2_N +: LOG2_N]),
                 .in_re_i(bus_re[boff(s) +: DW]),
                 .in_im_i(bus_im[boff(s) +: DW]),
-                .out_valid_o(bf_valid), .out_idx_o(bf_idx),
+                .out_valid_o(bf_valid), .out_idx_o(bf_idx), .nxt_idx_o(bf_nidx),
                 .out_re_o(bf_re), .out_im_o(bf_im));
 
             if (HAS_TW) begin : g_tw
@@ -186,7 +186,7 @@ module fmt_fft_r22sdf #(
                     .TW_W(TW_W), .SH(SH), .GUARD(GUARD)
                 ) u_tw (
                     .clk(clk), .rst(rst), .ce(ce),
-                    .in_valid_i(bf_valid), .in_idx_i(bf_idx),
+                    .in_valid_i(bf_valid), .in_idx_i(bf_idx), .nxt_idx_i(bf_nidx),
                     .in_re_i(bf_re), .in_im_i(bf_im),
                     .out_valid_o(bus_valid[s+1]),
                     .out_idx_o(bus_idx[(s+1)*LOG2_N +: LOG2_N]),
@@ -194,6 +194,10 @@ module fmt_fft_r22sdf #(
                     .out_im_o(bus_im[boff(s+1) +: OW]),
                     .ovf_o(bus_ovf[s+1]));
             end else begin : g_notw
+                // no twiddle ROM to address ahead
+                /* verilator lint_off UNUSEDSIGNAL */
+                wire unused_nidx = &{1'b0, bf_nidx};
+                /* verilator lint_on UNUSEDSIGNAL */
                 assign bus_valid[s+1]                   = bf_valid;
                 assign bus_idx[(s+1)*LOG2_N +: LOG2_N]  = bf_idx;
                 assign bus_re[boff(s+1) +: DW + 1]      = bf_re;
