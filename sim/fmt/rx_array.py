@@ -311,10 +311,12 @@ def get_cfg(name: str):
 
 
 # ---- timing of fmt_rx_array's shared magnitude units (no arithmetic) -----------------
-RX_SHARE_BACK = MAG_ITER + 8   # steps from a row's last unit input to its beat, minus P:
-#                                P unit input steps + MAG_ITER + 3 magnitude stages +
-#                                accumulator read, sum, rounding add, reciprocal multiply,
-#                                shift + saturate, row register
+RX_SHARE_BACK = MAG_ITER + 12  # steps from a row's last unit input to its beat, minus P:
+#                                P unit input steps, the cell multiplexer register,
+#                                MAG_ITER + 3 magnitude stages +
+#                                accumulator read and its output register, sum, rounding
+#                                add, reciprocal partial products, their middle sum, the
+#                                full product, shift + saturate, row register
 
 
 def rx_share_schedule(cfg, units: int, step_per_slot: int):
