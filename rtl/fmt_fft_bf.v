@@ -19,8 +19,10 @@
 // channel in turn, all CH of a sample index carrying the same idx); the delay line is
 // D x CH steps long, so each element meets its own channel's partner (fmt_fft_r22sdf CH).
 // Latency: D x CH + 1 ce-steps (delay line + output register): the element leaves one
-// step after the input that pairs with it.  out_valid_o is 1 for the
-// elements that came from valid inputs (the first valid input has idx 0 after reset).
+// step after the input that pairs with it.  out_valid_o is 1 for the elements that came
+// from valid inputs (the first valid input has idx 0 after reset).  nxt_idx_o
+// (combinational) is the position the output takes on the next ce edge: the following
+// twiddle reads its ROM with it one step ahead.
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -42,6 +44,7 @@ module fmt_fft_bf #(
     input  wire signed [DW-1:0] in_im_i,   // imaginary part
     output reg               out_valid_o,  // the output element is valid
     output reg  [LOG2_N-1:0] out_idx_o,    // its position in the window (block order)
+    output wire [LOG2_N-1:0] nxt_idx_o,    // out_idx_o of the next ce step (in_idx_i - D; the twiddle ROM address)
     output reg  signed [DW:0] out_re_o,    // real part, DW + 1 bits
     output reg  signed [DW:0] out_im_o     // imaginary part, DW + 1 bits
 );
@@ -86,6 +89,8 @@ module fmt_fft_bf #(
     fmt_fft_delay #(.W(2 * OW), .DEPTH(D * CH), .RAM_MIN(RAM_MIN), .BRAM_MIN(BRAM_MIN)) u_delay (
         .clk(clk), .rst(rst), .ce(ce), .din_i(dl_in), .dout_o(dl_out));
 
+    assign nxt_idx_o = in_idx_i - D[LOG2_N-1:0];
+
     // validity: the output element idx - D is valid once D valid samples came in
     reg  primed_q;
     wire idx_ge_d = (in_idx_i >> LOG2_D) != {LOG2_N{1'b0}};
@@ -99,7 +104,7 @@ module fmt_fft_bf #(
         end else if (ce) begin
             primed_q    <= primed_q | valid_d;
             out_valid_o <= valid_d;
-            out_idx_o   <= in_idx_i - D[LOG2_N-1:0];
+            out_idx_o   <= nxt_idx_o;
         end
     end
 

@@ -14,7 +14,9 @@
 //   of two (the FFT's channel-interleaved lines are D x CH deep): the pointer then
 //   wraps at DEPTH - 1 (one comparator more).  From BRAM_MIN words on the ring asks for
 //   block RAM (ram_style attribute, Yosys and XST): Yosys maps a 96-deep line (N = 256,
-//   CH = 3) to 3 LUT RAM banks plus read multiplexers, ~130 LUT6, otherwise.
+//   CH = 3) to 3 LUT RAM banks plus read multiplexers, ~130 LUT6, otherwise.  A block-RAM
+//   ring is read two steps ahead into the read latch and the block-RAM output register
+//   (the same DEPTH steps in all); a shorter ring asks for LUT RAM.
 // Latency: exactly DEPTH ce-steps (no extra register).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -46,15 +48,32 @@ module fmt_fft_delay #(
                 assign rptr = (wptr_q == TOP) ? {AW{1'b0}} : wptr_q + 1'b1;
             end
             if (DEPTH >= BRAM_MIN) begin : g_bram
+                // block RAM: read latch + output register, so the read address runs two
+                // ahead of the write address (own pointer, no adder before the RAM)
+                localparam integer  TOP_I = DEPTH - 1;
+                localparam [AW-1:0] TOP   = TOP_I[AW-1:0];
+                localparam integer  TWO_I = 2 % DEPTH;
+                localparam [AW-1:0] TWO   = TWO_I[AW-1:0];
                 (* ram_style = "block" *) reg [W-1:0] mem [0:DEPTH-1];
+                reg [W-1:0]  lat_q;                // block-RAM read latch
+                reg [AW-1:0] bptr_q;               // read address: written DEPTH-2 steps ago
                 always @(posedge clk) begin
                     if (ce) begin
                         mem[wptr_q] <= din_i;
-                        rd_q        <= mem[rptr];
+                        lat_q       <= mem[bptr_q];
+                        rd_q        <= lat_q;      // block-RAM output register
                     end
                 end
+                always @(posedge clk) begin
+                    if (rst)
+                        bptr_q <= TWO;
+                    else if (ce)
+                        bptr_q <= (bptr_q == TOP) ? {AW{1'b0}} : bptr_q + 1'b1;
+                end
             end else begin : g_lutram
-                reg [W-1:0] mem [0:DEPTH-1];
+                // LUT RAM (asynchronous read into rd_q): a block RAM here would need
+                // its own output register (Yosys ECP5 picks block RAM for 64 deep)
+                (* ram_style = "distributed" *) reg [W-1:0] mem [0:DEPTH-1];
                 always @(posedge clk) begin
                     if (ce) begin
                         mem[wptr_q] <= din_i;

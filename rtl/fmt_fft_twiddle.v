@@ -7,7 +7,8 @@
 // fmt_fft_twMMMM.hex that sim/fmt/fft_r22sdf.py generates (folder: the macro FMT_ROM_DIR
 // when defined, e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\", else the name alone, as fmt_dds_rom2).
 //
-// Arithmetic: four DW x TW_W products (one DSP48E each, DW <= 25), each truncated
+// Arithmetic: four DW x TW_W products (one multiplier each when DW <= MUL_W, else two:
+// see g_split), each truncated
 // (floor, arithmetic shift) by T = SH - GUARD bits, then
 //   re = (p_ac>>>T - p_bs>>>T + 2^(GUARD-1)) >>> GUARD   (round half up)
 //   im = (p_as>>>T + p_bc>>>T + 2^(GUARD-1)) >>> GUARD
@@ -15,7 +16,12 @@
 // truncation (the two floors' biases cancel).  The result keeps its low OW bits; if the
 // value did not fit, ovf_o (sticky) is set: the FFT's growth plan makes that impossible,
 // so no saturation hardware is spent on it, but it is never silent.
-// Latency: 4 ce-steps (ROM/data register, products, difference/sum, rounded output).
+// Pipeline (ce-steps; element k is presented on step k): the ROM is read one step
+// ahead, with nxt_idx_i = the position of the element of the NEXT ce step (fmt_fft_bf
+// nxt_idx_o): step k-1 ROM read register (block-RAM read latch), step k ROM output
+// register (block-RAM output register) and data registers (the multiplier operands),
+// k+1 products (DSP48E M register), k+2 difference/sum, k+3 rounded output.
+// Latency: 4 ce-steps from in_* to out_* (nxt_idx_i one step earlier).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -26,13 +32,16 @@ module fmt_fft_twiddle #(
     parameter OW     = 19,           // output width (signed)
     parameter TW_W   = 18,           // twiddle width (signed), scale 2^(TW_W-2)
     parameter SH     = 13,           // right shift after the products (>= 1)
-    parameter GUARD  = 3             // product bits kept below the output LSB (>= 1)
+    parameter GUARD  = 3,            // product bits kept below the output LSB (>= 1)
+    parameter MUL_W  = 18            // widest data operand of one multiplier (ECP5
+                                     // MULT18X18D; DSP48E takes 25): wider data is split
 ) (
     input  wire              clk,
     input  wire              rst,          // synchronous, active high
     input  wire              ce,           // sample strobe
     input  wire              in_valid_i,   // input element valid
     input  wire [LOG2_N-1:0] in_idx_i,     // its position in the window
+    input  wire [LOG2_N-1:0] nxt_idx_i,    // position of the element of the next ce step (ROM address)
     input  wire signed [DW-1:0] in_re_i,   // real part
     input  wire signed [DW-1:0] in_im_i,   // imaginary part
     output reg               out_valid_o,  // output element valid (4 steps later)
@@ -66,50 +75,122 @@ module fmt_fft_twiddle #(
 `endif
     end
 
-    // step 1: twiddle and data registers
-    reg [2*TW_W-1:0]    tw_q;
+    // step 0: ROM read register (the next element's twiddle); step 1: ROM output
+    // register and data registers (the multiplier operands)
+    reg [2*TW_W-1:0]    tw_q, tw2_q;
     reg signed [DW-1:0] a_q, b_q;
-    // step 2: truncated products
-    reg signed [QW-1:0] p_ac_q, p_bs_q, p_as_q, p_bc_q;
-    // step 3: difference and sum
-    reg signed [SW-1:0] s_re_q, s_im_q;
     reg [LOG2_N-1:0]    idx1_q, idx2_q, idx3_q;
     reg                 v1_q, v2_q, v3_q;
 
-    wire signed [TW_W-1:0] tw_c = tw_q[2*TW_W-1:TW_W];
-    wire signed [TW_W-1:0] tw_s = tw_q[TW_W-1:0];
-
-    // the low T bits of each product are dropped (floor)
+    // only the low LOG2_M bits of nxt_idx_i address the ROM
     /* verilator lint_off UNUSEDSIGNAL */
-    wire signed [PW-1:0] m_ac = a_q * tw_c;
-    wire signed [PW-1:0] m_bs = b_q * tw_s;
-    wire signed [PW-1:0] m_as = a_q * tw_s;
-    wire signed [PW-1:0] m_bc = b_q * tw_c;
+    wire unused_nxt = &{1'b0, nxt_idx_i};
     /* verilator lint_on UNUSEDSIGNAL */
+
+    wire signed [TW_W-1:0] tw_c = tw2_q[2*TW_W-1:TW_W];
+    wire signed [TW_W-1:0] tw_s = tw2_q[TW_W-1:0];
 
     always @(posedge clk) begin
         if (ce) begin
-            tw_q   <= rom[in_idx_i[LOG2_M-1:0]];
-            a_q    <= in_re_i;
-            b_q    <= in_im_i;
-            p_ac_q <= m_ac[PW-1:T];
-            p_bs_q <= m_bs[PW-1:T];
-            p_as_q <= m_as[PW-1:T];
-            p_bc_q <= m_bc[PW-1:T];
-            s_re_q <= {p_ac_q[QW-1], p_ac_q} - {p_bs_q[QW-1], p_bs_q};
-            s_im_q <= {p_as_q[QW-1], p_as_q} + {p_bc_q[QW-1], p_bc_q};
+            tw_q  <= rom[nxt_idx_i[LOG2_M-1:0]];
+            tw2_q <= tw_q;
+            a_q   <= in_re_i;
+            b_q   <= in_im_i;
         end
     end
 
-    // step 4: round half up ((s + 2^(G-1)) >>> G), keep OW bits, flag if it did not fit
-    wire signed [SW-1:0] half = {{(SW-1){1'b0}}, 1'b1} <<< (G - 1);
-    // the low G bits only carry the rounding
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire signed [SW-1:0] rs_re = s_re_q + half;
-    wire signed [SW-1:0] rs_im = s_im_q + half;
-    /* verilator lint_on UNUSEDSIGNAL */
-    wire signed [RW-1:0] r_re = rs_re[SW-1:G];
-    wire signed [RW-1:0] r_im = rs_im[SW-1:G];
+    // steps 2 and 3: products (registered), difference and sum; step 4 rounds
+    // (s + 2^(G-1)) >>> G = (s >>> G) + s[G-1] (the half as the adder's carry in).
+    wire signed [RW-1:0] r_re, r_im;       // rounded, before the OW-bit range check
+
+    generate
+        if (DW <= MUL_W) begin : g_one
+            // one multiplier per product; the low T bits of each product are dropped (floor)
+            reg signed [QW-1:0] p_ac_q, p_bs_q, p_as_q, p_bc_q;
+            reg signed [SW-1:0] s_re_q, s_im_q;
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire signed [PW-1:0] m_ac = a_q * tw_c;
+            wire signed [PW-1:0] m_bs = b_q * tw_s;
+            wire signed [PW-1:0] m_as = a_q * tw_s;
+            wire signed [PW-1:0] m_bc = b_q * tw_c;
+            /* verilator lint_on UNUSEDSIGNAL */
+            always @(posedge clk) begin
+                if (ce) begin
+                    p_ac_q <= m_ac[PW-1:T];
+                    p_bs_q <= m_bs[PW-1:T];
+                    p_as_q <= m_as[PW-1:T];
+                    p_bc_q <= m_bc[PW-1:T];
+                    s_re_q <= {p_ac_q[QW-1], p_ac_q} - {p_bs_q[QW-1], p_bs_q};
+                    s_im_q <= {p_as_q[QW-1], p_as_q} + {p_bc_q[QW-1], p_bc_q};
+                end
+            end
+            // the low G-1 bits only carry the rounding
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire signed [SW-1:0] re_g = s_re_q >>> G;
+            wire signed [SW-1:0] im_g = s_im_q >>> G;
+            /* verilator lint_on UNUSEDSIGNAL */
+            assign r_re = re_g[RW-1:0] + {{(RW-1){1'b0}}, s_re_q[G-1]};
+            assign r_im = im_g[RW-1:0] + {{(RW-1){1'b0}}, s_im_q[G-1]};
+        end else begin : g_split
+            // data wider than one multiplier: a = ah 2^LW + al, al = the low LW bits
+            // (unsigned), ah = the high HW bits (signed); x tw = (ah tw) 2^LW + al tw, two
+            // multipliers per product, both registered.  T <= LW - G, so
+            //   floor(a tw / 2^T) = (ah tw) 2^(LW-T) + floor(al tw / 2^T)
+            // and the high part is a multiple of 2^G: only the low part is rounded,
+            //   r = (dh 2^(LW-T-G)) + (dl >>> G) + dl[G-1]
+            // with dh, dl the high and low differences (sums): one adder per step.
+            localparam LW  = MUL_W - 1;                   // low part bits (unsigned)
+            localparam HW  = DW - LW;                     // high part bits (signed)
+            localparam PLW = LW + 1 + TW_W;               // low product width
+            localparam PHW = HW + TW_W;                   // high product width
+            localparam QLW = PLW - T;                     // truncated low product width
+            localparam SH2 = LW - T - G;                  // shift of dh in the result
+            reg signed [QLW-1:0] pl_ac_q, pl_bs_q, pl_as_q, pl_bc_q;
+            reg signed [PHW-1:0] ph_ac_q, ph_bs_q, ph_as_q, ph_bc_q;
+            reg signed [QLW:0]   dl_re_q, dl_im_q;
+            reg signed [PHW:0]   dh_re_q, dh_im_q;
+            wire signed [LW:0]   al = {1'b0, a_q[LW-1:0]};
+            wire signed [LW:0]   bl = {1'b0, b_q[LW-1:0]};
+            wire signed [HW-1:0] ah = a_q[DW-1:LW];
+            wire signed [HW-1:0] bh = b_q[DW-1:LW];
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire signed [PLW-1:0] ml_ac = al * tw_c;
+            wire signed [PLW-1:0] ml_bs = bl * tw_s;
+            wire signed [PLW-1:0] ml_as = al * tw_s;
+            wire signed [PLW-1:0] ml_bc = bl * tw_c;
+            /* verilator lint_on UNUSEDSIGNAL */
+            always @(posedge clk) begin
+                if (ce) begin
+                    pl_ac_q <= ml_ac[PLW-1:T];
+                    pl_bs_q <= ml_bs[PLW-1:T];
+                    pl_as_q <= ml_as[PLW-1:T];
+                    pl_bc_q <= ml_bc[PLW-1:T];
+                    ph_ac_q <= ah * tw_c;
+                    ph_bs_q <= bh * tw_s;
+                    ph_as_q <= ah * tw_s;
+                    ph_bc_q <= bh * tw_c;
+                    dl_re_q <= {pl_ac_q[QLW-1], pl_ac_q} - {pl_bs_q[QLW-1], pl_bs_q};
+                    dl_im_q <= {pl_as_q[QLW-1], pl_as_q} + {pl_bc_q[QLW-1], pl_bc_q};
+                    dh_re_q <= {ph_ac_q[PHW-1], ph_ac_q} - {ph_bs_q[PHW-1], ph_bs_q};
+                    dh_im_q <= {ph_as_q[PHW-1], ph_as_q} + {ph_bc_q[PHW-1], ph_bc_q};
+                end
+            end
+            // RW-bit results (the same bits as the one-multiplier form, wrap included)
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire signed [RW+SH2+PHW:0] hi_re = {{(RW+SH2){dh_re_q[PHW]}}, dh_re_q} <<< SH2;
+            wire signed [RW+SH2+PHW:0] hi_im = {{(RW+SH2){dh_im_q[PHW]}}, dh_im_q} <<< SH2;
+            wire signed [RW+QLW:0]     lo_re = {{RW{dl_re_q[QLW]}}, dl_re_q} >>> G;
+            wire signed [RW+QLW:0]     lo_im = {{RW{dl_im_q[QLW]}}, dl_im_q} >>> G;
+            /* verilator lint_on UNUSEDSIGNAL */
+            assign r_re = hi_re[RW-1:0] + lo_re[RW-1:0] + {{(RW-1){1'b0}}, dl_re_q[G-1]};
+            assign r_im = hi_im[RW-1:0] + lo_im[RW-1:0] + {{(RW-1){1'b0}}, dl_im_q[G-1]};
+            // elaboration check: the split needs T <= LW - G
+            if (SH2 < 0) begin : g_bad
+                fmt_fft_twiddle_split_needs_T_le_LW_minus_G u_bad ();
+            end
+        end
+    endgenerate
+
     wire                 big;
 
     generate

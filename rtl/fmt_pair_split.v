@@ -8,10 +8,13 @@
 // into the heat-map scaling of fmt_accum (HM_SHIFT includes it).  Width: W + 1 signed.
 //
 // The bins arrive in any order (bit-reversed from fmt_fft_r22sdf), one per ce cycle.
-// The first of a pair to arrive is held in a ROWS-entry memory (distributed RAM, with
-// a bit saying whether it was k or N-k); when its partner arrives, (2A, 2B) of row r
-// leave one ce cycle later.  A per-row "held" bit makes this order independent; reset
-// clears it.  Twin: sim/fmt/rx_array.py pair_split_fixed.
+// Step 1 registers the bin's decode (comb bin k or mirror N-k, row); step 2 reads the
+// held memory: the first of a pair to arrive is held in a ROWS-entry memory
+// (distributed RAM, with a bit saying whether it was k or N-k); when its partner
+// arrives, (2A, 2B) of row r are registered: they leave two ce cycles after the
+// partner came in (latency 2 ce cycles; the memory and the held bits are read and
+// written in step 2 only, so consecutive bins never see a stale entry).  A per-row
+// "held" bit makes this order independent; reset clears it.  Twin: sim/fmt/rx_array.py pair_split_fixed.
 // Channels (CH > 1): the input interleaves CH FFT streams in lockstep (fmt_fft_r22sdf
 // CH, in_ch_i = its out_ch_o): every bin arrives for channel 0, 1, .., CH-1 in turn, all
 // channels in the same bin order.  The held memory is per {channel, row} (CH x 2^ROW_W
@@ -79,27 +82,50 @@ module fmt_pair_split #(
     wire signed [DW-1:0] r_k    = d_k / STEP_S;
     wire signed [DW-1:0] r_m    = d_m / STEP_S;
     /* verilator lint_on UNUSEDSIGNAL */
-    wire [ROW_W-1:0]     row    = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
-    wire                 hit    = in_valid_i && (hit_k || hit_m);
+    wire [ROW_W-1:0]     row_in = hit_m ? r_m[ROW_W-1:0] : r_k[ROW_W-1:0];
 
-    // ---- held first-of-pair memory, per {channel, row} ----
+    // ---- step 1: decode register ----
+    reg                 d_hit_q, d_m_q;     // a comb bin or its mirror; it is the mirror
+    reg [ROW_W-1:0]     d_row_q;
+    reg [CH_W-1:0]      d_ch_q;
+    reg signed [W-1:0]  d_re_q, d_im_q;
+    reg [TAG_W-1:0]     d_tag_q;
+
+    always @(posedge clk) begin
+        if (rst) begin
+            d_hit_q <= 1'b0;
+        end else if (ce) begin
+            d_hit_q <= in_valid_i && (hit_k || hit_m);
+        end
+    end
+
+    always @(posedge clk) begin
+        if (ce) begin
+            d_m_q   <= hit_m;
+            d_row_q <= row_in;
+            d_ch_q  <= in_ch_i;
+            d_re_q  <= in_re_i;
+            d_im_q  <= in_im_i;
+            d_tag_q <= in_tag_i;
+        end
+    end
+
+    // ---- step 2: held first-of-pair memory, per {channel, row}; sums ----
     localparam AW = (CH > 1) ? CH_W + ROW_W : ROW_W;
     localparam MD = (CH > 1) ? (1 << AW) : ROWS;
     localparam integer CHM1 = CH - 1;
     localparam [CH_W-1:0] CH_LAST = CHM1[CH_W-1:0];
+    wire [ROW_W-1:0] row = d_row_q;
+    wire          hit_q = d_m_q;           // the current bin is the mirror (q = Z[N-k])
     wire [AW-1:0] addr;                    // held memory address {channel, row}
     wire          upd;                     // the last channel of this bin: update held_q
     generate
         if (CH > 1) begin : g_ch
-            assign addr = {in_ch_i, row};
-            assign upd  = (in_ch_i == CH_LAST);
+            assign addr = {d_ch_q, row};
+            assign upd  = (d_ch_q == CH_LAST);
         end else begin : g_one
             assign addr = row;
             assign upd  = 1'b1;
-            // one channel: in_ch_i is not used
-            /* verilator lint_off UNUSEDSIGNAL */
-            wire unused_ch = &{1'b0, in_ch_i};
-            /* verilator lint_on UNUSEDSIGNAL */
         end
     endgenerate
 
@@ -110,18 +136,22 @@ module fmt_pair_split #(
     wire                held     = held_q[row];
     wire signed [W-1:0] h_re     = rd[2*W-1:W];
     wire signed [W-1:0] h_im     = rd[W-1:0];
+    wire signed [W:0]   hx_re    = {h_re[W-1], h_re};
+    wire signed [W:0]   hx_im    = {h_im[W-1], h_im};
+    wire signed [W:0]   cx_re    = {d_re_q[W-1], d_re_q};
+    wire signed [W:0]   cx_im    = {d_im_q[W-1], d_im_q};
     // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
-    wire signed [W:0]   p_re = hit_m ? {h_re[W-1], h_re}   : {in_re_i[W-1], in_re_i};
-    wire signed [W:0]   p_im = hit_m ? {h_im[W-1], h_im}   : {in_im_i[W-1], in_im_i};
-    wire signed [W:0]   q_re = hit_m ? {in_re_i[W-1], in_re_i} : {h_re[W-1], h_re};
-    wire signed [W:0]   q_im = hit_m ? {in_im_i[W-1], in_im_i} : {h_im[W-1], h_im};
+    wire signed [W:0]   p_re     = hit_q ? hx_re : cx_re;
+    wire signed [W:0]   p_im     = hit_q ? hx_im : cx_im;
+    wire signed [W:0]   q_re     = hit_q ? cx_re : hx_re;
+    wire signed [W:0]   q_im     = hit_q ? cx_im : hx_im;
 
     // the second arrival of a pair: the other member is held
-    wire                second   = held && (rd[2*W] != hit_m);
+    wire                second   = held && (rd[2*W] != hit_q);
 
     always @(posedge clk) begin
-        if (ce && hit && !second) begin
-            mem[addr] <= {hit_m, in_re_i, in_im_i};
+        if (ce && d_hit_q && !second) begin
+            mem[addr] <= {hit_q, d_re_q, d_im_q};
         end
     end
 
@@ -131,7 +161,7 @@ module fmt_pair_split #(
             out_valid_o <= 1'b0;
         end else if (ce) begin
             out_valid_o <= 1'b0;
-            if (hit) begin
+            if (d_hit_q) begin
                 // the second arrival must be the other member of the pair
                 if (second) begin
                     if (upd) held_q[row] <= 1'b0;
@@ -143,15 +173,17 @@ module fmt_pair_split #(
         end
     end
 
+    // the sums are symmetric in (held, current); the differences take their operands
+    // through the mirror flag's swap
     always @(posedge clk) begin
         if (ce) begin
             out_row_o <= row;
-            a_re_o    <= p_re + q_re;
+            a_re_o    <= hx_re + cx_re;        // p_re + q_re
+            b_re_o    <= hx_im + cx_im;        // p_im + q_im
             a_im_o    <= p_im - q_im;
-            b_re_o    <= p_im + q_im;
             b_im_o    <= q_re - p_re;
-            out_tag_o <= in_tag_i;
-            out_ch_o  <= in_ch_i;
+            out_tag_o <= d_tag_q;
+            out_ch_o  <= d_ch_q;
         end
     end
 

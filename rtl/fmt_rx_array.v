@@ -49,16 +49,21 @@
 // values above M_MAX as M_MAX; fmt_rx_pair_front); a reset in the middle of a window
 // drops it and the stream restarts with the first full frame.
 // Latency (M = 1), from the ce edge that takes a window's last ADC sample: row r's pair
-// split output (the last pair's, FFT_CH > 1) is registered at step a_r = LATENCY0 +
-// slot_r + 1 ce cycles later (FFT_CH = 1) or, FFT_CH = G with ce every G clk, at clk
-// G + LATENCY0 + G slot_r (the FFT's register stages step on clk cycles:
-// rx_fixed.rx_split_clk); the row is queued at a_r + 1, loaded at L_r >= a_r + 2, and its
-// beat is at step L_r + P + MAG_ITER + 8 (P unit input steps, MAG_ITER + 3 magnitude
-// stages, accumulator read, sum, rounding add, reciprocal multiply, shift + saturate,
-// row register); the same for every M (counted from the frame's last window).  N = 256,
-// 30 x 40: last row 300 ce cycles after the window's last sample at ce = 1 (K = 10); at
-// 3 x fs (K = 4) 810 clk = 270.0 fs cycles with FFT_CH = 3 (854 clk with FFT_CH = 1),
-// hm_eof_o 1 step later (tb/fmt_rx_array measures them, rx_fixed.rx_row_beats predicts).
+// split output (the last pair's, FFT_CH > 1) is registered at step a_r: FFT_CH = 1,
+// LATENCY0 + slot_r + 2 ce cycles later with POST_CLK = 0, 1 clk after LATENCY0 + slot_r
+// + 1 ce cycles with POST_CLK = 1 (the split's second stage runs on clk); FFT_CH = G with
+// ce every G clk, clk G + LATENCY0 + G slot_r + 1 (the FFT's register stages step on
+// clk cycles: rx_array.rx_split_clk); the row is queued at a_r + 1, loaded at L_r >= a_r + 2, and its
+// beat is at step L_r + P + MAG_ITER + 12 (P unit input steps, cell multiplexer register,
+// MAG_ITER + 3 magnitude stages, accumulator read and its output register, sum, rounding
+// add, reciprocal partial products, their middle sum, the full product, shift +
+// saturate, row register); the same for every M (counted from the frame's last window).
+// N = 256, 30 x 40: at 3 x fs (K = 4) 815 clk = 271.7 fs cycles with FFT_CH = 3 (859 clk
+// with FFT_CH = 1), hm_eof_o 1 step later (tb/fmt_rx_array measures them,
+// rx_array.rx_row_beats predicts).
+// Pipeline rule: every block-RAM read (accumulator, reciprocal ROM) has its output
+// register, every product its operand and product registers (the 2T+1-bit t R as four
+// 17 x 17-bit partial products, then one adder per step).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
 // heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
 // before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
@@ -335,24 +340,40 @@ module fmt_rx_array #(
     // synthesis translate_on
 
     // ---- shared magnitude units: unit u takes cell g*K + u ----
+    // the cell multiplexer (result memories' read data, group g_q) is registered in
+    // front of the units, with the valid bit and the tag
     wire [K*MW-1:0] mags;
     wire            mg_valid;
     wire [TAGW-1:0] mg_tag;
+    reg             sel_v_q;
+    reg [TAGW-1:0]  sel_tag_q;
+    always @(posedge clk) begin
+        if (rst)
+            sel_v_q <= 1'b0;
+        else if (post_ce)
+            sel_v_q <= busy_q;
+    end
+    always @(posedge clk) begin
+        if (post_ce) sel_tag_q <= {row_q, g_q, etag_q};
+    end
     genvar u;
     generate
         for (u = 0; u < K; u = u + 1) begin : g_unit
-            reg [CW-1:0] sel;
-            integer g;
-            always @* begin
-                sel = cells[u*CW +: CW];
-                for (g = 1; g < P; g = g + 1)
-                    if (g_q == g[G_W-1:0]) sel = cells[(g*K+u)*CW +: CW];
+            // the P cells of unit u side by side, group g at [g*CW +: CW]
+            wire [P*CW-1:0] lane;
+            genvar gl;
+            for (gl = 0; gl < P; gl = gl + 1) begin : g_lane
+                assign lane[gl*CW +: CW] = cells[(gl*K+u)*CW +: CW];
+            end
+            reg [CW-1:0] sel_q;
+            always @(posedge clk) begin
+                if (post_ce) sel_q <= lane[g_q*CW +: CW];
             end
             if (u == 0) begin : g_lead
                 fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag (
-                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(busy_q),
-                    .in_re_i(sel[MW-1:0]), .in_im_i(sel[CW-1:MW]),
-                    .in_tag_i({row_q, g_q, etag_q}),
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(sel_v_q),
+                    .in_re_i(sel_q[MW-1:0]), .in_im_i(sel_q[CW-1:MW]),
+                    .in_tag_i(sel_tag_q),
                     .out_valid_o(mg_valid), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(mg_tag));
             end else begin : g_follow
                 // runs in lockstep with unit 0: its valid and tag are unit 0's
@@ -360,57 +381,28 @@ module fmt_rx_array #(
                 wire unused_v, unused_t;
                 /* verilator lint_on UNUSEDSIGNAL */
                 fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag (
-                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(busy_q),
-                    .in_re_i(sel[MW-1:0]), .in_im_i(sel[CW-1:MW]), .in_tag_i(1'b0),
+                    .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(sel_v_q),
+                    .in_re_i(sel_q[MW-1:0]), .in_im_i(sel_q[CW-1:MW]), .in_tag_i(1'b0),
                     .out_valid_o(unused_v), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(unused_t));
             end
         end
     endgenerate
 
     // ---- accumulator: one memory for all cells, address {row, g} ----
-    // stage A: read the running sums (block RAM, synchronous read), hold the magnitudes
+    // stage A: read the running sums (block RAM, synchronous read), hold the magnitudes;
+    // stage A2: the block-RAM output register, the reciprocal ROM read at the row's M
+    // (from the stage-A tag); stage B: the ROM's output register.
+    // An address is read and written once per window (no read-after-write hazard).
     reg [K*SUM_W-1:0] acc_mem [0:(1<<AW)-1];
-    reg [K*SUM_W-1:0] acc_rd_q;
-    reg [K*MW-1:0]    a_mag_q;
-    reg [TAGW-1:0]    a_tag_q;
-    reg               a_valid_q;
+    reg [K*SUM_W-1:0] acc_rd_q, acc_rd2_q;
+    reg [K*MW-1:0]    a_mag_q, a2_mag_q;
+    reg [TAGW-1:0]    a_tag_q, a2_tag_q;
+    reg               a_valid_q, a2_valid_q;
     wire [AW-1:0]     mg_addr = mg_tag[TAGW-1 -: AW];
-
-    always @(posedge clk) begin
-        if (post_ce) begin
-            acc_rd_q <= acc_mem[mg_addr];
-            a_mag_q  <= mags;
-            a_tag_q  <= mg_tag;
-        end
-    end
-
-    // stage B: sum = first ? mag : sum + mag (exact), written back; only the last
-    // window's sums go on
-    wire [AW-1:0]   a_addr  = a_tag_q[TAGW-1 -: AW];
-    wire            a_first = a_tag_q[1];
-    wire            a_last  = a_tag_q[0];
-    reg [K*SUM_W-1:0] sum_d;
-    integer l;
-    always @* begin
-        for (l = 0; l < K; l = l + 1)
-            sum_d[l*SUM_W +: SUM_W] = (a_first ? {SUM_W{1'b0}} : acc_rd_q[l*SUM_W +: SUM_W])
-                                    + {{MC_W{1'b0}}, a_mag_q[l*MW +: MW]};
-    end
-
-    always @(posedge clk) begin
-        if (post_ce && a_valid_q) acc_mem[a_addr] <= sum_d;
-    end
-
-    reg [K*SUM_W-1:0] b_sum_q;
-    // {first, last} are spent at stage B (b_valid_q carries "last")
-    /* verilator lint_off UNUSEDSIGNAL */
-    reg [TAGW-1:0]    b_tag_q;
-    /* verilator lint_on UNUSEDSIGNAL */
-    reg               b_valid_q;
     // the reciprocal ROM (rx_fixed.recip_rom; 256 words whatever M_MAX, MC_W <= 8), read
-    // with the row's M beside the sum
+    // with the row's M beside the sums
     reg [RW-1:0]      recip_rom [0:255];
-    reg [RW-1:0]      b_rom_q;
+    reg [RW-1:0]      rom_q, rom2_q;
     reg  [7:0]        a_m8;              // the row's M as an 8-bit ROM address
     always @* begin
         a_m8 = 8'd0;
@@ -423,22 +415,59 @@ module fmt_rx_array #(
         $readmemh("fmt_recip.hex", recip_rom);
 `endif
     end
+
+    always @(posedge clk) begin
+        if (post_ce) begin
+            acc_rd_q  <= acc_mem[mg_addr];
+            rom_q     <= recip_rom[a_m8];    // one step later: from the registered tag
+            a_mag_q   <= mags;
+            a_tag_q   <= mg_tag;
+            acc_rd2_q <= acc_rd_q;
+            a2_mag_q  <= a_mag_q;
+            a2_tag_q  <= a_tag_q;
+        end
+    end
+
+    // stage B: sum = first ? mag : sum + mag (exact), written back; only the last
+    // window's sums go on.
+    wire [AW-1:0]   a_addr  = a2_tag_q[TAGW-1 -: AW];
+    wire            a_first = a2_tag_q[1];
+    wire            a_last  = a2_tag_q[0];
+    reg [K*SUM_W-1:0] sum_d;
+    integer l;
+    always @* begin
+        for (l = 0; l < K; l = l + 1)
+            sum_d[l*SUM_W +: SUM_W] = (a_first ? {SUM_W{1'b0}} : acc_rd2_q[l*SUM_W +: SUM_W])
+                                    + {{MC_W{1'b0}}, a2_mag_q[l*MW +: MW]};
+    end
+
+    always @(posedge clk) begin
+        if (post_ce && a2_valid_q) acc_mem[a_addr] <= sum_d;
+    end
+
+    localparam [RW:0] RADD = (42'd1 << (TR - T)) - 42'd1;
+    // only bits TR-T .. TR of the rounded entry are R (R <= 2^T)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [RW:0]     r_round = {1'b0, rom2_q} + RADD;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    reg [K*SUM_W-1:0] b_sum_q;
+    // {first, last} are spent at stage B (b_valid_q carries "last")
+    /* verilator lint_off UNUSEDSIGNAL */
+    reg [TAGW-1:0]    b_tag_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg               b_valid_q;
     always @(posedge clk) begin
         if (post_ce) begin
             b_sum_q <= sum_d;
-            b_tag_q <= a_tag_q;
-            b_rom_q <= recip_rom[a_m8];
+            b_tag_q <= a2_tag_q;
+            rom2_q  <= rom_q;
         end
     end
 
     // stage C1: t = sum + M (the rounding half of 2M), R = ceil(entry / 2^(TR-T)) =
     // ceil(2^(T+l) / M), l = ceil(log2 M)
-    localparam [RW:0] RADD = (42'd1 << (TR - T)) - 42'd1;
     wire [MC_W-1:0] b_m     = b_tag_q[MC_W+1:2];
-    // only bits TR-T .. TR of the rounded entry are R (R <= 2^T)
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire [RW:0]     r_round = {1'b0, b_rom_q} + RADD;
-    /* verilator lint_on UNUSEDSIGNAL */
     reg  [LW-1:0]   l_d;
     reg  [8:0]      m_ext;
     integer i;
@@ -463,19 +492,52 @@ module fmt_rx_array #(
         end
     end
 
-    // stage C2: the products t R (exact, 2T + 1 bits)
-    reg [K*PW-1:0]        c2_p_q;
-    reg [LW-1:0]          c2_l_q;
-    reg [ROW_W+G_W-1:0]   c2_rg_q;
-    reg                   c2_valid_q;
+    // stage C2: the products t R (exact, 2T + 1 bits) as four 17 x 17-bit partial
+    // products (one multiplier each, operands and products registered): t = th 2^17 +
+    // tl, R = Rh 2^17 + Rl; C2A the products, C2B {hh, ll} (no overlap) and the middle
+    // sum hl + lh, C2C t R = {hh, ll} + (hl + lh) 2^17
+    localparam HS = 17;                                      // partial operand width
+    wire [2*HS-1:0] r34 = {{(2*HS-T-1){1'b0}}, c1_r_q};
+    reg  [K*PW-1:0]       c2_p_q;
+    reg  [LW-1:0]         c2a_l_q, c2b_l_q, c2_l_q;
+    reg  [ROW_W+G_W-1:0]  c2a_rg_q, c2b_rg_q, c2_rg_q;
+    reg                   c2a_valid_q, c2b_valid_q, c2_valid_q;
+    genvar ln;
+    generate
+        for (ln = 0; ln < K; ln = ln + 1) begin : g_recip
+            wire [2*HS-1:0] t34 = {{(2*HS-T){1'b0}}, c1_t_q[ln*T +: T]};
+            reg  [2*HS-1:0] ll_q, lh_q, hl_q, hh_q;
+            reg  [4*HS-1:0] hhll_q;
+            reg  [2*HS:0]   mid_q;
+            // t R < 2^PW: the top bits of the 4 HS + 2-bit sum are zero
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [4*HS+1:0] psum = {2'b00, hhll_q} + ({{(2*HS+1){1'b0}}, mid_q} << HS);
+            /* verilator lint_on UNUSEDSIGNAL */
+            always @(posedge clk) begin
+                if (post_ce) begin
+                    ll_q   <= t34[HS-1:0]    * r34[HS-1:0];
+                    lh_q   <= t34[HS-1:0]    * r34[2*HS-1:HS];
+                    hl_q   <= t34[2*HS-1:HS] * r34[HS-1:0];
+                    hh_q   <= t34[2*HS-1:HS] * r34[2*HS-1:HS];
+                    hhll_q <= {hh_q, ll_q};
+                    mid_q  <= {1'b0, lh_q} + {1'b0, hl_q};
+                    c2_p_q[ln*PW +: PW] <= psum[PW-1:0];
+                end
+            end
+        end
+    endgenerate
     always @(posedge clk) begin
         if (post_ce) begin
-            for (l = 0; l < K; l = l + 1)
-                c2_p_q[l*PW +: PW] <= {{(T+1){1'b0}}, c1_t_q[l*T +: T]} * {{T{1'b0}}, c1_r_q};
-            c2_l_q  <= c1_l_q;
-            c2_rg_q <= c1_rg_q;
+            c2a_l_q  <= c1_l_q;   c2b_l_q  <= c2a_l_q;   c2_l_q  <= c2b_l_q;
+            c2a_rg_q <= c1_rg_q;  c2b_rg_q <= c2a_rg_q;  c2_rg_q <= c2b_rg_q;
         end
     end
+    generate
+        if (T + 1 > 2 * HS) begin : g_check_t
+            // t R needs operands of at most 2 x 17 bits
+            fmt_rx_array_T_too_wide u_bad_t ();
+        end
+    endgenerate
 
     // stage C3: cell = (t R) >> (T + 1 + l) = floor((sum + M) / 2M), saturated
     reg [K*HM_W-1:0] cell_d;
@@ -510,16 +572,22 @@ module fmt_rx_array #(
     always @(posedge clk) begin
         if (rst) begin
             a_valid_q  <= 1'b0;
+            a2_valid_q <= 1'b0;
             b_valid_q  <= 1'b0;
+            c2a_valid_q <= 1'b0;
+            c2b_valid_q <= 1'b0;
             c1_valid_q <= 1'b0;
             c2_valid_q <= 1'b0;
             c_valid_q  <= 1'b0;
             sat_q      <= 1'b0;
         end else if (post_ce) begin
             a_valid_q  <= mg_valid;
-            b_valid_q  <= a_valid_q && a_last;
+            a2_valid_q <= a_valid_q;
+            b_valid_q  <= a2_valid_q && a_last;
             c1_valid_q <= b_valid_q;
-            c2_valid_q <= c1_valid_q;
+            c2a_valid_q <= c1_valid_q;
+            c2b_valid_q <= c2a_valid_q;
+            c2_valid_q <= c2b_valid_q;
             c_valid_q  <= c2_valid_q;
             if (c2_valid_q && clip_d) sat_q <= 1'b1;
         end

@@ -7,7 +7,9 @@
 // frame.  Outputs, valid in the cycle of win_i and held until the next one: m_cur_o = M of
 // the current frame, w_first_o / w_last_o = this window is the frame's first / last.
 // The state advances on clk edges with en_i && win_i (en_i = the sample strobe where the
-// FFT output is taken only on ce, or 1).
+// FFT output is taken only on ce, or 1).  The first / last flags are registered with the
+// state (the outputs are multiplexers after registers); the flag of the following
+// window is recomputed on every clk, so two windows must start at least 2 clk apart.
 `default_nettype none
 
 module fmt_rx_frame_win #(
@@ -26,10 +28,13 @@ module fmt_rx_frame_win #(
 
     localparam [MC_W-1:0] MMAX = M_MAX[MC_W-1:0];
     localparam [MC_W-1:0] MONE = 1;
+    localparam [MC_W:0]   TWO  = 2;
 
     reg             started_q;
     reg [MC_W-1:0]  wcnt_q;                 // window index inside the frame, 0 .. M-1
     reg [MC_W-1:0]  m_q;                    // M of the current frame
+    reg             first_q, last_q;        // the current window is the frame's first / last
+    reg             nlast_q;                // the window after it would be the last (no wrap)
     wire [MC_W-1:0] m_lim;                  // m_i clamped to M_MAX
     generate
         if (M_MAX < (1 << MC_W) - 1) begin : g_clamp
@@ -39,26 +44,35 @@ module fmt_rx_frame_win #(
         end
     endgenerate
     wire [MC_W-1:0] m_in     = (m_lim == {MC_W{1'b0}}) ? MONE : m_lim;
-    wire [MC_W-1:0] last_q   = m_q - 1'b1;
-    wire            wrap     = !started_q || (wcnt_q == last_q);
+    wire            m_in_one = (m_in == MONE);
+    // the flags are registered with the state, so the outputs are a few multiplexers
+    // after registers (nlast_q is recomputed every clk; windows are far apart)
+    wire            wrap     = !started_q || last_q;
     wire [MC_W-1:0] w_cur    = win_i ? (wrap ? {MC_W{1'b0}} : wcnt_q + 1'b1) : wcnt_q;
     wire [MC_W-1:0] m_cur    = (win_i && wrap) ? m_in : m_q;
-    wire [MC_W-1:0] last_cur = m_cur - 1'b1;
 
     assign m_cur_o   = m_cur;
-    assign w_first_o = (w_cur == {MC_W{1'b0}});
-    assign w_last_o  = (w_cur == last_cur);
+    assign w_first_o = win_i ? wrap : first_q;
+    assign w_last_o  = win_i ? (wrap ? m_in_one : nlast_q) : last_q;
 
     always @(posedge clk) begin
         if (rst) begin
             started_q <= 1'b0;
             wcnt_q    <= {MC_W{1'b0}};
             m_q       <= MONE;
+            first_q   <= 1'b1;
+            last_q    <= 1'b1;
         end else if (en_i && win_i) begin
             started_q <= 1'b1;
             wcnt_q    <= w_cur;
             m_q       <= m_cur;
+            first_q   <= w_first_o;
+            last_q    <= w_last_o;
         end
+    end
+
+    always @(posedge clk) begin
+        nlast_q <= ({1'b0, wcnt_q} + TWO == {1'b0, m_q});
     end
 
 endmodule

@@ -18,7 +18,8 @@
 // clamped to M_MAX); ps_tag = {M, first window, last window}.
 // Timing: channel c of ADC sample j enters the FFT input register on the edge c + 1
 // clk after sample j's ce edge (step j G + c); its window's slot s leaves the FFT on step
-// t_c + LATENCY0 + s G (fmt_fft_r22sdf) and the split registers it on that step's edge;
+// t_c + LATENCY0 + s G (fmt_fft_r22sdf), the split decodes it on that step's edge and
+// registers the pair's output one clk later (fmt_pair_split, 2 stages on every clk);
 // ps_* show it from the next clk (ps_ch_o = c); the result memory of pair c is written
 // on the next edge (rd_data_o shows it from then on, asynchronous read: LUT RAM).  With
 // ce every G clk (the 3 x fs build) the steps are consecutive clk cycles, so pair c's

@@ -15,7 +15,8 @@
 // Timing: the pair split takes slot s of a window on the ce edge LATENCY0 + s + 1 ce
 // cycles after the ce edge that takes the window's last ADC sample (LATENCY0 of
 // fmt_fft_r22sdf, counted from its input register which the despread register feeds);
-// ps_* are registered by the split (on post_ce); the result memory is written on the
+// ps_* are registered by the split one post_ce edge later (its second stage); the
+// result memory is written on the
 // next post_ce edge (rd_data_o shows it from then on, asynchronous read: LUT RAM).
 // Formats: FFT output W = FFT_OUT_W bits = X * 2^-FFT_SHIFT (see fmt_col_pair_rx);
 // split outputs 2A, 2B exact, W + 1 bits signed.  Flag: fft_ovf_o sticky.

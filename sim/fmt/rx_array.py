@@ -311,10 +311,12 @@ def get_cfg(name: str):
 
 
 # ---- timing of fmt_rx_array's shared magnitude units (no arithmetic) -----------------
-RX_SHARE_BACK = MAG_ITER + 8   # steps from a row's last unit input to its beat, minus P:
-#                                P unit input steps + MAG_ITER + 3 magnitude stages +
-#                                accumulator read, sum, rounding add, reciprocal multiply,
-#                                shift + saturate, row register
+RX_SHARE_BACK = MAG_ITER + 12  # steps from a row's last unit input to its beat, minus P:
+#                                P unit input steps, the cell multiplexer register,
+#                                MAG_ITER + 3 magnitude stages +
+#                                accumulator read and its output register, sum, rounding
+#                                add, reciprocal partial products, their middle sum, the
+#                                full product, shift + saturate, row register
 
 
 def rx_share_schedule(cfg, units: int, step_per_slot: int):
@@ -369,20 +371,29 @@ def rx_fft_ch_default(post_clk: int = 1, cps=None) -> int:
     return cps if post_clk else 1
 
 
-def rx_split_clk(latency0: int, slot: int, every: int, fft_ch: int, ch: int) -> int:
+SPLIT_LAT = 2   # fmt_pair_split: steps from a pair's second bin to its output register
+#                 (decode register, held memory + sums); its steps are clk cycles when the
+#                 split runs on every clk (POST_CLK = 1, FFT_CH > 1), else ce cycles
+
+
+def rx_split_clk(latency0: int, slot: int, every: int, fft_ch: int, ch: int,
+                 post_clk: int = 1) -> int:
     """clk cycle (from the ce edge that takes a window's last ADC sample, that edge = 0)
-    at whose end the pair split registers slot ``slot`` of pair ``ch`` of an engine.
+    at whose end the pair split registers its output for slot ``slot`` of pair ``ch`` of
+    an engine.  The split takes the FFT output slot (its decode register) on the clk
+    edge below, then SPLIT_LAT - 1 split steps later its output register.
     fft_ch = 1 (fmt_rx_pair_front): the despread register, then LATENCY0 + slot ce
     cycles: (latency0 + 1 + slot) * every.  fft_ch = G > 1 (fmt_rx_group_front): channel
     c enters on the clk c + 1 after the ce edge (step j G + c for sample j); slot s leaves
     the FFT on step t_c + latency0 + s G; step j G + q runs on clk j every + 1 + q (the
     engine steps on the G clk cycles after each ce, ce every ``every`` >= G clk)."""
+    extra = (SPLIT_LAT - 1) * (1 if post_clk else every)
     if fft_ch <= 1:
-        return (latency0 + 1 + slot) * every
+        return (latency0 + 1 + slot) * every + extra
     if every < fft_ch:
         raise ValueError(f"ce every {every} clk is too fast for {fft_ch} pairs per FFT engine")
     d = ch + latency0 + slot * fft_ch          # steps after the last sample's channel-0 step
-    return (d // fft_ch) * every + 1 + d % fft_ch
+    return (d // fft_ch) * every + 1 + d % fft_ch + extra
 
 
 def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None,
@@ -406,7 +417,7 @@ def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None
     if not keeps:
         raise ValueError(f"{units} magnitude units do not keep up at {steps_run} steps per slot")
     # split of slot 0 (the queue push), clk; the schedule counts from there
-    base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1)
+    base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1, post_clk)
     return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}
 
 

@@ -314,15 +314,17 @@ def test_split_clk_step_map(fft_ch, every):
     after each ce) against an enumeration of the engine's step cycles: channel c of the
     window's last sample K is step K G + c, slot s leaves latency0 + s G steps later."""
     lat0, kk = 22, 300
+    ex = R.SPLIT_LAT - 1                     # the split's own steps (clk here)
     if fft_ch == 1:
         for s in (0, 5, 251):
-            assert R.rx_split_clk(lat0, s, every, 1, 0) == (lat0 + 1 + s) * every
+            assert R.rx_split_clk(lat0, s, every, 1, 0) == (lat0 + 1 + s) * every + ex
+            assert R.rx_split_clk(lat0, s, every, 1, 0, post_clk=0) == (lat0 + 1 + s + ex) * every
         return
     step_clk = [k * every + 1 + q for k in range(kk + 400) for q in range(fft_ch)]
     for c in range(fft_ch):
         for s in (0, 1, 7, 63, 251):
             got = R.rx_split_clk(lat0, s, every, fft_ch, c)
-            assert got == step_clk[kk * fft_ch + c + lat0 + s * fft_ch] - kk * every
+            assert got == step_clk[kk * fft_ch + c + lat0 + s * fft_ch] - kk * every + ex
     # consecutive slots are one ce period apart (the shared units' schedule assumes it)
     assert R.rx_split_clk(lat0, 9, every, fft_ch, 1) - R.rx_split_clk(lat0, 8, every, fft_ch, 1) == every
     with pytest.raises(ValueError):
@@ -331,11 +333,11 @@ def test_split_clk_step_map(fft_ch, every):
 
 def test_row_beats_shared_engine_default():
     """30 x 40 at 3 x fs: the shared FFT engines (FFT_CH = 3, the default) move the last
-    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (854 clk)."""
+    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (859 clk)."""
     from fmt import fft_r22sdf as F
     cfg = params.DEFAULT
     lat0 = F.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
     one = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1, fft_ch=1).values())
     shared = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1).values())
     assert R.rx_fft_ch_default(1, 3) == 3 and R.rx_fft_ch_default(0, 1) == 1
-    assert one == 854 and shared == one - lat0 * 2
+    assert one == 859 and shared == one - lat0 * 2

@@ -3,7 +3,7 @@
 Inside fmt_fft_r22sdf the growth plan makes an overflow impossible, so the overflow
 detection and the sticky ovf_o are tested here with an output narrower than the data
 needs: bit-exact rotated values (ROM contents, truncated products, round half up, the
-kept low bits) against ``fft_fixed._twiddle_mul`` with random ce, the 4-step latency,
+kept low bits) against ``fft_fixed._twiddle_mul`` with random ce, the 4-step latency (the ROM address nxt_idx_i one step ahead),
 ovf_o staying 0 while every element fits and rising together with the first element
 that does not, and reset clearing it.
 """
@@ -32,6 +32,7 @@ class TB(ClockedTB):
         dut.ce.value = 0
         dut.in_valid_i.value = 0
         dut.in_idx_i.value = 0
+        dut.nxt_idx_i.value = 0
         dut.in_re_i.value = 0
         dut.in_im_i.value = 0
 
@@ -45,6 +46,11 @@ class TB(ClockedTB):
         dut = self.dut
         n = len(re)
         got, k, cyc = [], 0, 0
+        # one invalid step first: it reads element 0's twiddle (the ROM reads one step ahead)
+        await self.writable()
+        dut.ce.value = 1
+        dut.in_valid_i.value = 0
+        dut.nxt_idx_i.value = 0
         while len(got) < n:
             await self.writable()
             ce = 1 if rng.random() < 0.7 else 0
@@ -52,6 +58,7 @@ class TB(ClockedTB):
             if ce:
                 dut.in_valid_i.value = 1 if k < n else 0
                 dut.in_idx_i.value = k % (1 << self.log2_n)
+                dut.nxt_idx_i.value = (k + 1) % (1 << self.log2_n)   # the ROM reads one step ahead
                 dut.in_re_i.value = int(re[k]) if k < n else 0
                 dut.in_im_i.value = int(im[k]) if k < n else 0
             await ReadOnly()
@@ -102,9 +109,10 @@ async def overflow_and_sticky_flag(dut):
     assert int(dut.ovf_o.value) == 0
 
 
-@pytest.mark.parametrize("log2_m", [6])
-def test_fmt_fft_twiddle(sim, log2_m):
-    prm = {"LOG2_N": 6, "LOG2_M": log2_m, "DW": 15, "OW": 12, "SH": 13, "TW_W": 18}
+@pytest.mark.parametrize("dw", [15, 21])
+def test_fmt_fft_twiddle(sim, dw):
+    """DW = 15: one multiplier per product; DW = 21 > MUL_W: split products (g_split)."""
+    prm = {"LOG2_N": 6, "LOG2_M": 6, "DW": dw, "OW": 12, "SH": 13, "TW_W": 18}
     run_cocotb(sim=sim, toplevel="fmt_fft_twiddle", sources=sources("fmt_fft_twiddle"),
                test_module="test_fmt_fft_twiddle", test_dir=Path(__file__).parent,
                parameters=prm, extra_env=prm, build_args=[rom_define()])

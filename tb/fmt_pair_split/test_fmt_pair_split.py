@@ -2,7 +2,7 @@
 
 Random FFT outputs (full W-bit range, extremes included) stream in bit-reversed bin order
 as fmt_fft_r22sdf emits them, one bin per ce: every row's (2A, 2B) is bit-exact, comes
-exactly once per window, at the completion slot of its pair (+1 ce cycle), rows in the
+exactly once per window, at the completion slot of its pair (+LAT = 2 ce cycles), rows in the
 order of rx_fixed.row_order; natural order input works too (the block is order
 independent); random ce; a reset in the middle of a window drops the half-held pairs.
 """
@@ -21,6 +21,8 @@ from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt import rx_array as R
 
+LAT = 2     # ce cycles from the second bin of a pair to its (2A, 2B) (decode, memory + sums)
+
 
 class TB(ClockedTB):
     def __init__(self, dut):
@@ -36,7 +38,7 @@ class TB(ClockedTB):
         dut, n = self.dut, self.cfg.n_fft
         rng = rng or random.Random(2)
         items = [(w, s) for w in range(z_re.shape[0]) for s in range(n)]
-        outs, i, tail = [], 0, 0
+        outs, i, tail, fed = [], 0, 0, []
         while i < len(items) or tail < 4:
             await self.writable()
             ce = 1 if rng.random() < ce_prob else 0
@@ -54,9 +56,10 @@ class TB(ClockedTB):
             await RisingEdge(self.clk)
             await ReadOnly()
             if ce:
+                fed.append(items[i] if i < len(items) else None)
                 if int(dut.out_valid_o.value):
-                    assert i < len(items), "output without a bin in"
-                    ow, os_ = items[i]
+                    assert len(fed) >= LAT and fed[-LAT] is not None, "output without a bin in"
+                    ow, os_ = fed[-LAT]
                     outs.append((int(dut.out_tag_o.value), int(dut.out_row_o.value),
                                  dut.a_re_o.value.to_signed(), dut.a_im_o.value.to_signed(),
                                  dut.b_re_o.value.to_signed(), dut.b_im_o.value.to_signed(), os_))
@@ -143,7 +146,7 @@ async def run_ch(tb, order, zs_re, zs_im, ch, ce_prob=1.0, rng=None):
     dut, n = tb.dut, tb.cfg.n_fft
     rng = rng or random.Random(3)
     items = [(w, s, c) for w in range(zs_re.shape[1]) for s in range(n) for c in range(ch)]
-    outs, i, tail = [], 0, 0
+    outs, i, tail, fed = [], 0, 0, []
     while i < len(items) or tail < 4:
         await tb.writable()
         ce = 1 if rng.random() < ce_prob else 0
@@ -162,9 +165,10 @@ async def run_ch(tb, order, zs_re, zs_im, ch, ce_prob=1.0, rng=None):
         await RisingEdge(tb.clk)
         await ReadOnly()
         if ce:
+            fed.append(items[i] if i < len(items) else None)
             if int(dut.out_valid_o.value):
-                assert i < len(items), "output without a bin in"
-                _, os_, oc = items[i]
+                assert len(fed) >= LAT and fed[-LAT] is not None, "output without a bin in"
+                _, os_, oc = fed[-LAT]
                 assert int(dut.out_ch_o.value) == oc, f"out_ch_o {int(dut.out_ch_o.value)}, input channel {oc}"
                 outs.append((oc, int(dut.out_tag_o.value), int(dut.out_row_o.value),
                              dut.a_re_o.value.to_signed(), dut.a_im_o.value.to_signed(),
