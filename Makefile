@@ -52,10 +52,11 @@ ccache:
 	  else (sudo DEBIAN_FRONTEND=noninteractive apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq ccache) >/dev/null 2>&1; fi \
 	  || echo "ccache could not be installed: continuing without it"; }
 
-$(STAMP): requirements.txt
-	@echo "creating $(VENV) with pinned packages (requirements.txt)"
+$(STAMP): requirements.txt pyproject.toml
+	@echo "creating $(VENV) with pinned packages (requirements.txt) and the fmt package (pip install -e .)"
 	@test -x $(VPY) || $(PYTHON) -m venv $(VENV)
 	@$(VPY) -m pip install -q --disable-pip-version-check -r requirements.txt
+	@$(VPY) -m pip install -q --disable-pip-version-check --no-deps -e .
 	@touch $@
 
 setup: iverilog ccache $(STAMP)

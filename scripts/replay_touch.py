@@ -5,9 +5,12 @@ from Python through cocotb) and write the touch events as JSON lines.
     source scripts/env.sh
     python scripts/replay_touch.py --in heatmaps.npy --out events.jsonl
                                    [--config default|small|medium] [--settings s.json] [--check]
+    python scripts/replay_touch.py --in recording.npz --out events.jsonl [--check]
 
 heatmaps.npy: (frames, ROWS, COLS) unsigned heat-map counts (e.g. the output of
-scripts/replay_rx.py).  Rows are fed in the receive chain's order, one frame per window
+scripts/replay_rx.py).  recording.npz: a recording of ``fmtctl record`` (docs/host.md):
+its heat-map snapshots in order, its sensor config, its settings (TouchSettings from the
+registers; --config / --settings override them) and its frame period (M windows).  Rows are fed in the receive chain's order, one frame per window
 (3 N clocks at 3 x fs), identity calibration, blobs off.  --settings: a JSON object of
 fmt.settings.TouchSettings fields.  Each line of events.jsonl is one event: frame, id,
 type (new/move/lift/blob), x_q, y_q (Q8.8 cells), strength, axis_major_q, axis_minor_q,
@@ -33,9 +36,11 @@ import numpy as np  # noqa: E402
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--in", dest="inp", required=True, help="heat maps .npy (frames x rows x cols)")
+    ap.add_argument("--in", dest="inp", required=True,
+                    help="heat maps .npy (frames x rows x cols) or a recording .npz (fmtctl record)")
     ap.add_argument("--out", required=True, help="events .jsonl")
-    ap.add_argument("--config", default="default", choices=["default", "small", "medium"])
+    ap.add_argument("--config", default=None, choices=["default", "small", "medium"],
+                    help="sensor config (default: the recording's, else default)")
     ap.add_argument("--settings", default="", help="TouchSettings fields as a JSON file")
     ap.add_argument("--check", action="store_true", help="compare with process_frames (bit-exact)")
     a = ap.parse_args(argv)
@@ -44,13 +49,52 @@ def main(argv=None) -> int:
     from fmt import params
     from fmt_touch.touch_driver import build_args
 
-    cfg = params.get(a.config)
     inp, out = Path(a.inp).resolve(), Path(a.out).resolve()
     if not inp.exists():
         print(f"replay_touch: no such file: {inp}", file=sys.stderr)
         return 2
+    settings_path = Path(a.settings).resolve() if a.settings else None
+    period = None
+    if inp.suffix == ".npz":                   # a recording of fmtctl record
+        from fmt.host import recording as R
+        try:
+            rec = R.load(inp)
+        except ValueError as e:
+            print(f"replay_touch: {e}", file=sys.stderr)
+            return 2
+        cfg_rec = rec.config()
+        if a.config is None:
+            if cfg_rec is None:
+                print(f"replay_touch: no sensor config of {rec.rows} x {rec.cols}: give --config",
+                      file=sys.stderr)
+                return 2
+            a.config = cfg_rec.name
+        out.parent.mkdir(parents=True, exist_ok=True)
+        npy = out.with_suffix(".heatmaps.npy")
+        np.save(npy, rec.heatmaps)
+        if settings_path is None:
+            st = dict(rec.meta["settings"])
+            if st.get("blobs"):
+                print("replay_touch: the recording has blob detection on; the replay runs it off",
+                      file=sys.stderr)
+                st["blobs"] = False
+            if not rec.meta.get("settings_exact", True):
+                print("replay_touch: the recording's tracking registers differ from its settings' "
+                      "conversion: the replay uses the settings", file=sys.stderr)
+            settings_path = out.with_suffix(".settings.json")
+            settings_path.write_text(json.dumps(st))
+        m = max(1, int(rec.meta.get("registers", {}).get("WINDOWS_M", 1)))
+        period = params.get(a.config).window_s * m
+        print(f"replay_touch: recording {inp.name}: {len(rec.heatmaps)} heat maps, "
+              f"{len(rec.events)} recorded events, config {a.config}, M = {m}")
+        inp = npy
+    a.config = a.config or "default"
+    cfg = params.get(a.config)
+    a.settings = str(settings_path) if settings_path else ""
     env = {"CFG": a.config, "REPLAY_IN": inp, "REPLAY_OUT": out,
-           "REPLAY_SETTINGS": Path(a.settings).resolve() if a.settings else ""}
+           "REPLAY_SETTINGS": settings_path or ""}
+    if period is not None:
+        env["REPLAY_FRAME_PERIOD_S"] = repr(period)
     run_cocotb(
         sim="verilator", toplevel="fmt_touch", sources=sources("fmt_touch"),
         test_module="replay_cocotb", test_dir=ROOT / "tb" / "fmt_touch",
@@ -63,7 +107,7 @@ def main(argv=None) -> int:
         from fmt.settings import TouchSettings
         from fmt.touch import process_frames
         st = TouchSettings(**json.loads(Path(a.settings).read_text())) if a.settings else TouchSettings()
-        exp = process_frames(np.load(inp), cfg, st, fixed=True, frame_period_s=cfg.window_s)
+        exp = process_frames(np.load(inp), cfg, st, fixed=True, frame_period_s=period or cfg.window_s)
         want = [(e.frame, e.id, e.type, e.x_q, e.y_q, e.strength, e.axis_major_q, e.axis_minor_q,
                  e.angle, e.flags) for fr in exp for e in fr]
         got = [(e["frame"], e["id"], e["type"], e["x_q"], e["y_q"], e["strength"], e["axis_major_q"],

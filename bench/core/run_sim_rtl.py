@@ -495,6 +495,10 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
                 rep["png"] = str(od / "heatmap.png")
                 latency_histogram(first_lat, last_lat, onset_lat, od / "latency_hist.png")
                 rep["latency_png"] = str(od / "latency_hist.png")
+                if os.environ.get("FMT_GIF"):        # the animated view, on request (imageio)
+                    step = max(1, int(os.environ.get("FMT_GIF_STEP", "1")))
+                    _plots.animation_gif(flat, frame_events, cfg, od / "heatmap.gif", step=step)
+                    rep["gif"] = str(od / "heatmap.gif")
             except Exception as exc:          # plots are a convenience, never fatal
                 rep["plot_error"] = repr(exc)
         (od / "report.json").write_text(json.dumps(rep, indent=1) + "\n")
@@ -503,23 +507,9 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
 
 
 def latency_histogram(first, last, onset, path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    allv = list(first) + list(last) + list(onset) + [8.0]
-    bins = np.linspace(min(allv) - 0.1, max(allv) + 0.1, 80)     # shared bins
-    for v, lab in ((first, "window end -> first event"), (last, "window end -> last event"),
-                   (onset, "onset -> new-contact event")):
-        if v:
-            ax.hist(v, bins=bins, alpha=0.6, label=lab)
-    ax.axvline(8.0, color="k", ls="--", lw=1, label="8 us")
-    ax.set_xlabel("latency (us)")
-    ax.set_ylabel("count")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    """The latency plot: one panel per population, each on its own range (fmt.plots)."""
+    from fmt import plots as _plots
+    _plots.latency_panels(first, last, onset, path)
 
 
 # ---- the run ---------------------------------------------------------------------------

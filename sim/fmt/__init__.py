@@ -11,7 +11,8 @@ Naming convention of the model twins:
   A block that is integer-exact by nature has only the ``_fixed`` function
   (``local_maxima_fixed``, ``blob_stream_fixed``, ``track_fixed``).
 * Modules that twin no single RTL block are named for what they do (params, regmap,
-  generate, sensor, scene, chain, report, run_sim, settings, plots).
+  generate, sensor, scene, chain, report, run_sim, settings, plots; the subpackage host:
+  the fmtctl host tool and its outputs).
 
 Module -> RTL modules it twins:
 
