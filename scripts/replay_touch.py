@@ -110,9 +110,11 @@ def run(a) -> int:
         # 0 .. 2^HM_W - 1 (no wrap)
         maps = inputs.load_int_array(inp, "heat maps", (None, cfg.rows, cfg.cols), 0,
                                      (1 << cfg.hm_width) - 1)
+    settings_path = Path(a.settings).resolve() if a.settings else ""
+    if st is not None and not a.settings:             # the recording's (checked) settings
+        settings_path = out.with_suffix(".settings.json")
+        settings_path.write_text(json.dumps(st.as_dict()))
     st = st or TouchSettings()
-    settings_path = out.with_suffix(".settings.json")
-    settings_path.write_text(json.dumps(st.as_dict()))
     tmp = inputs.temp_output(out)
     inputs.remove_quietly(tmp)
     env = {"CFG": a.config, "REPLAY_IN": inp, "REPLAY_OUT": tmp,
