@@ -315,7 +315,7 @@ def check_dict(d, where: str = "scene") -> None:
     I.check_fields(d, {
         "name": I.is_str(), "description": I.is_str(), "sensor": I.is_str(tuple(_params.CONFIGS)),
         "frames": I.is_int(1, 10**8), "m": I.is_int(1, 255), "seed": I.is_int(0, 2**63 - 1),
-        "duration_s": I.is_num(0, lo_open=True, none_ok=True),
+        "duration_s": I.is_num(0, 3600, lo_open=True, none_ok=True),
         "effects": I.is_type(dict, name="an object"), "contacts": I.is_type(list, name="a list")}, where)
     unknown = set(d.get("effects", {})) - EFFECT_KEYS
     if unknown:
@@ -332,6 +332,7 @@ def check_dict(d, where: str = "scene") -> None:
             "active": lambda v: None if v is None or isinstance(v, (list, dict)) else
             "must be null, [[on, off], ...] or {\"repeat\": {...}}",
             "active_units": I.is_str(("s", "samples"))}, cw)
+        _check_active(c.get("active"), cw, I)
         if "path" not in c:
             raise I.InputError(f"{cw}: key 'path' missing")
         for j, w in enumerate(c["path"]):
@@ -339,6 +340,28 @@ def check_dict(d, where: str = "scene") -> None:
                     or any(I.is_num()(x) for x in w)):
                 raise I.InputError(f"{cw}: key 'path': waypoint {j} must be [t_s, x_mm, y_mm] "
                                    f"numbers, got {w!r}")
+
+
+def _check_active(a, where: str, I) -> None:
+    """``active``: null, [[on, off or null], ...] or {"repeat": {count, first_s, period_s,
+    on_s[, step_samples]}}."""
+    if a is None:
+        return
+    if isinstance(a, dict):
+        if set(a) != {"repeat"}:
+            raise I.InputError(f"{where}: key 'active': an object must be {{\"repeat\": {{...}}}}, got {a!r}")
+        I.check_fields(a["repeat"], {"count": I.is_int(0, 10**6), "first_s": I.is_num(),
+                                     "period_s": I.is_num(0), "on_s": I.is_num(0),
+                                     "step_samples": I.is_int()}, f"{where}: key 'active.repeat'")
+        missing = {"count", "first_s", "period_s", "on_s"} - set(a["repeat"])
+        if missing:
+            raise I.InputError(f"{where}: key 'active.repeat': missing {sorted(missing)}")
+        return
+    for j, iv in enumerate(a):
+        if (not isinstance(iv, list) or len(iv) != 2 or I.is_num()(iv[0])
+                or I.is_num(none_ok=True)(iv[1])):
+            raise I.InputError(f"{where}: key 'active': interval {j} must be [on, off or null] "
+                               f"numbers, got {iv!r}")
 
 
 def load(path) -> Scene:

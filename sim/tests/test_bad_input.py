@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -26,6 +27,8 @@ from fmt.inputs import InputError
 
 ROOT = Path(__file__).resolve().parents[2]
 SMALL = params.SMALL
+# examples per property test (FMT_HYPOTHESIS_EXAMPLES=2000 for a longer search by hand)
+N_EX = int(os.environ.get("FMT_HYPOTHESIS_EXAMPLES", "0")) or None
 
 
 def _script(name):
@@ -366,7 +369,7 @@ def bad_heatmaps(draw):
     return a
 
 
-@settings(max_examples=60, deadline=None, database=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=N_EX or 60, deadline=None, database=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(arr=bad_heatmaps())
 def test_property_replay_touch_refuses(tmp_path, capsys, no_sim, arr):
     code = _touch(tmp_path, arr)
@@ -393,8 +396,57 @@ def bad_captures(draw):
     return a
 
 
-@settings(max_examples=60, deadline=None, database=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=N_EX or 60, deadline=None, database=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(arr=bad_captures())
 def test_property_replay_rx_refuses(tmp_path, capsys, no_sim, arr):
     assert _rx(tmp_path, arr) == 2
     one_line(capsys)
+
+
+# ---- property-based: random scene and settings objects load or give one InputError ----------
+_JSON = st.recursive(st.none() | st.booleans() | st.integers(-2**40, 2**40)
+                     | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=6),
+                     lambda ch: st.lists(ch, max_size=3) | st.dictionaries(st.text(max_size=6), ch, max_size=3),
+                     max_leaves=6)
+_SCENE_KEYS = ["name", "sensor", "frames", "m", "seed", "duration_s", "effects", "contacts", "bogus"]
+_CONTACT_KEYS = ["path", "name", "diameter_mm", "strength", "profile", "minor_diameter_mm",
+                 "angle_deg", "active", "active_units", "bogus"]
+
+
+@settings(max_examples=N_EX or 150, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(key=st.sampled_from(_SCENE_KEYS), ckey=st.sampled_from(_CONTACT_KEYS), value=_JSON,
+       where=st.sampled_from(["scene", "contact"]))
+def test_property_scene_loads_or_one_input_error(tmp_path, key, ckey, value, where):
+    d = _scene_dict(frames=2)
+    if where == "scene":
+        d[key] = value
+    else:
+        d["contacts"][0][ckey] = value
+    p = tmp_path / "s.json"
+    try:
+        p.write_text(json.dumps(d))
+    except ValueError:
+        return
+    try:
+        sc = S.load(p)
+    except InputError as e:
+        assert "\n" not in str(e) and str(p) in str(e)
+        return
+    for t in sc.frame_centre_s(range(min(sc.frames, 2))):   # a loaded scene is usable
+        sc.truth(t)
+    sc.onset_samples()
+
+
+@settings(max_examples=N_EX or 150, deadline=None, database=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(key=st.sampled_from(list(_settings.TouchSettings().as_dict()) + ["bogus"]), value=_JSON)
+def test_property_settings_load_or_one_input_error(tmp_path, key, value):
+    p = tmp_path / "st.json"
+    p.write_text(json.dumps({key: value}))
+    try:
+        st_ = _settings.load(p)
+    except InputError as e:
+        assert "\n" not in str(e) and key in str(e)
+        return
+    st_.converted(SMALL, SMALL.window_s)                  # a loaded setting is usable
