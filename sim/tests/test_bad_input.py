@@ -306,6 +306,14 @@ def test_run_sim_bad_scene(tmp_path, capsys, mod):
     one_line(capsys)
 
 
+def test_bench_model_bad_scene(tmp_path, capsys):
+    bm = _script("bench_model")
+    assert bm.main(["--scene", str(tmp_path / "none.json")]) == 2
+    one_line(capsys)
+    assert bm.main(["--frames", "0"]) == 2
+    one_line(capsys)
+
+
 def test_run_sim_rtl_bad_cps_and_serve(capsys):
     from bench.core import run_sim_rtl as rsr
     with pytest.raises(SystemExit) as e:
