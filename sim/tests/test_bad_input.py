@@ -458,3 +458,24 @@ def test_property_settings_load_or_one_input_error(tmp_path, key, value):
         assert "\n" not in str(e) and key in str(e)
         return
     st_.converted(SMALL, SMALL.window_s)                  # a loaded setting is usable
+
+
+def test_touch_check_passes_when_the_sim_equals_the_model(tmp_path, capsys, monkeypatch):
+    """The good path through the checks: scene heat maps, a stand-in simulation that
+    writes the model's events, --check passes, the output is renamed into place."""
+    import common.runner as R
+    from fmt.settings import TouchSettings
+    from fmt.touch import process_frames
+    from fmt_touch.touch_driver import scene_maps
+    maps = scene_maps(SMALL, 8, (1 << SMALL.hm_width) - 1, np.random.default_rng(5)).astype(np.uint16)
+    exp = process_frames(maps.astype(np.int64), SMALL, TouchSettings(), fixed=True,
+                         frame_period_s=SMALL.window_s)
+    evs = [{"frame": e.frame, "id": e.id, "type": e.type, "x_q": e.x_q, "y_q": e.y_q,
+            "strength": e.strength, "axis_major_q": e.axis_major_q, "axis_minor_q": e.axis_minor_q,
+            "angle": e.angle, "flags": e.flags, "cycle": 0} for fr in exp for e in fr]
+    assert evs
+    monkeypatch.setattr(R, "run_cocotb", _fake_touch_sim(evs))
+    assert _touch(tmp_path, maps, "--check") == 0
+    out = capsys.readouterr().out
+    assert "bit-exact" in out and f"{len(evs)} events from 8 heat maps" in out
+    assert len((tmp_path / "ev.jsonl").read_text().splitlines()) == len(evs)
