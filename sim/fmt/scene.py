@@ -350,18 +350,19 @@ def _check_active(a, where: str, I) -> None:
     if isinstance(a, dict):
         if set(a) != {"repeat"}:
             raise I.InputError(f"{where}: key 'active': an object must be {{\"repeat\": {{...}}}}, got {a!r}")
-        I.check_fields(a["repeat"], {"count": I.is_int(0, 10**6), "first_s": I.is_num(),
-                                     "period_s": I.is_num(0), "on_s": I.is_num(0),
-                                     "step_samples": I.is_int()}, f"{where}: key 'active.repeat'")
+        I.check_fields(a["repeat"], {"count": I.is_int(0, 10**6), "first_s": I.is_num(-1e6, 1e6),
+                                     "period_s": I.is_num(0, 1e6), "on_s": I.is_num(0, 1e6),
+                                     "step_samples": I.is_int(-10**9, 10**9)}, f"{where}: key 'active.repeat'")
         missing = {"count", "first_s", "period_s", "on_s"} - set(a["repeat"])
         if missing:
             raise I.InputError(f"{where}: key 'active.repeat': missing {sorted(missing)}")
         return
     for j, iv in enumerate(a):
-        if (not isinstance(iv, list) or len(iv) != 2 or I.is_num()(iv[0])
-                or I.is_num(none_ok=True)(iv[1])):
+        # bounded so that the sample indices fit int64 (seconds or samples)
+        if (not isinstance(iv, list) or len(iv) != 2 or I.is_num(-1e9, 1e9)(iv[0])
+                or I.is_num(-1e9, 1e9, none_ok=True)(iv[1])):
             raise I.InputError(f"{where}: key 'active': interval {j} must be [on, off or null] "
-                               f"numbers, got {iv!r}")
+                               f"numbers within +-1e9, got {iv!r}")
 
 
 def load(path) -> Scene:
