@@ -45,7 +45,14 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--json", action="store_true", help="print the result as JSON")
     a = ap.parse_args(argv)
-    sc = _scene.load(a.scene).replace(frames=a.frames)
+    if a.frames < 1 or a.repeat < 1:
+        print("bench_model: --frames and --repeat must be >= 1", file=sys.stderr)
+        return 2
+    try:
+        sc = _scene.load(a.scene).replace(frames=a.frames)
+    except ValueError as e:                       # fmt.inputs.InputError: one line
+        print(f"bench_model: {e}", file=sys.stderr)
+        return 2
     chain.heatmaps_float(sc, frames=8)            # warm up (imports, caches)
     res = {"scene": sc.name, "sensor": sc.cfg.name, "frames": a.frames, "m": sc.m}
     for label, fn in (("adc_chain", lambda: chain.heatmaps_float(sc)),

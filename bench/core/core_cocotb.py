@@ -29,6 +29,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, FallingEdge, First, ReadOnly, RisingEdge
 
 from fmt import params, protocol, regmap
+from fmt.progress import Progress
 
 UART_DIV = 4
 
@@ -177,6 +178,7 @@ async def run_scene(dut):
     total = job["run_cycles"]
     step = max(1000, total // 50)
     done = len(job["regs"])
+    bar = Progress(total)
     while done < total:
         n = min(step, total - done)
         await ClockCycles(dut.clk, n)
@@ -184,10 +186,9 @@ async def run_scene(dut):
         if not quiet and total > 200000:
             fr = int(dut.frames_o.value)
             rate = fr / max(time.perf_counter() - t0, 1e-9)
-            print(f"\r  fmt_core: frame {fr}/{job['frames']}  ({rate:.0f} frames/s)",
-                  end="", file=sys.stderr, flush=True)
+            bar.update(done, f"  fmt_core: frame {fr}/{job['frames']}  ({rate:.0f} frames/s)")
     if not quiet and total > 200000:
-        print(file=sys.stderr)
+        bar.close()
     wall = time.perf_counter() - t0
     res = {"wall_s": wall, "frames": int(dut.frames_o.value), "events": int(dut.events_o.value),
            "upd_late": int(dut.upd_late_o.value), "upd_done": int(dut.upd_done_o.value),

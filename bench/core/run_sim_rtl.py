@@ -613,7 +613,7 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
     return exe, time.perf_counter() - t0
 
 
-def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
+def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: int,
                   verilog_channel: bool = False, serve: dict | None = None) -> None:
     """The job of the C++ harness: the same phases as the cocotb run_scene; serve:
     {"port", "seconds", "cycles", "once", "log_clk"} for serve mode (see the module doc;
@@ -621,7 +621,7 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: bool,
     from fmt import regmap as _regmap
     addr = lambda n: _regmap.lookup(n).addr
     lines = [f"rows {cfg.rows}", f"cols {cfg.cols}", f"cps {cps}", f"frames {job['frames']}",
-             f"progress {int(progress)}",
+             f"progress {int(progress)}",        # 0 off, 1 terminal (\\r), 2 whole lines
              f"ext_channel {0 if verilog_channel else 1}",
              f"chan_file {d / 'chan.hex'}", f"gauss_file {d / 'gauss.hex'}",
              f"sine_file {d / 'sine.hex'}", f"upd_file {d / 'upd.hex'}",
@@ -654,7 +654,9 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
     exe, build_s = harness_build(scene.cfg, cps, d, tag=tag, cflags=cflags, quiet=quiet,
                                  verilog_channel=verilog_channel)
     job = json.loads((d / "job.json").read_text())
-    write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d, progress=not quiet,
+    from fmt.progress import is_tty
+    write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d,
+                  progress=0 if quiet else (1 if is_tty(sys.stderr) else 2),
                   verilog_channel=verilog_channel, serve=serve)
     (d / "serve.log").unlink(missing_ok=True)
     t0 = time.perf_counter()
@@ -778,12 +780,37 @@ def _summary(rep: dict) -> str:
                if "sim_frames_per_cpu_s" in rep else ""))
 
 
+def verdict(rep: dict) -> tuple[int, str]:
+    """(exit status, one line) of a run: 1 when no frame arrived, frames were dropped or
+    the golden model disagrees, else 0."""
+    want = rep.get("frames_requested", rep["frames"])
+    if rep["frames"] == 0:
+        return 1, f"run_sim_rtl: FAIL: no frame arrived (0 of {want} requested)"
+    if rep["frames_dropped"]:
+        return 1, (f"run_sim_rtl: FAIL: {rep['frames_dropped']} frames dropped "
+                   f"({rep['frames']} of {want} arrived, event FIFO drops {rep.get('ev_drop_count', 0)})")
+    if rep["golden_mismatches"]:
+        first = " ".join(str((rep.get("golden_detail") or {}).get("first") or "").split())[:200]
+        return 1, (f"run_sim_rtl: FAIL: {rep['golden_mismatches']} golden mismatches"
+                   + (f", first: {first}" if first else ""))
+    return 0, ""
+
+
+def positive_int(text: str) -> int:
+    v = int(text)
+    if v < 1:
+        raise ValueError(text)
+    return v
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Run a scene through the RTL (fmt_core) under Verilator.")
+    from fmt.inputs import InputError, OneLineParser
+    ap = OneLineParser(description="Run a scene through the RTL (fmt_core) under Verilator.")
     ap.add_argument("--scene", default=str(ROOT / "sim" / "scenes" / "default.json"))
     ap.add_argument("--out", default=str(ROOT / "build" / "sim"))
-    ap.add_argument("--frames", type=int, default=None)
-    ap.add_argument("--cps", type=int, default=3, help="clk cycles per sample (CLK_PER_SAMPLE)")
+    ap.add_argument("--frames", type=positive_int, default=None)
+    ap.add_argument("--cps", type=positive_int, default=3,
+                    help="clk cycles per sample (CLK_PER_SAMPLE)")
     ap.add_argument("--sim", default="verilator", choices=("verilator", "icarus"))
     ap.add_argument("--engine", default="cpp", choices=("cpp", "cocotb"),
                     help="cpp: the standalone C++ Verilator harness (default, Verilator only); "
@@ -804,7 +831,14 @@ def main(argv=None) -> int:
     ap.add_argument("--cflags", default=HARNESS_CFLAGS,
                     help=f"C++ flags of the harness build (default '{HARNESS_CFLAGS}'; tests: -O0)")
     a = ap.parse_args(argv)
-    sc = _scene.load(a.scene)
+    try:
+        sc = _scene.load(a.scene)
+    except InputError as exc:
+        print(f"run_sim_rtl: {exc}", file=sys.stderr)
+        return 2
+    if a.serve is not None and not (a.engine == "cpp" and a.sim == "verilator"):
+        print("run_sim_rtl: --serve needs the C++ harness (--engine cpp, --sim verilator)", file=sys.stderr)
+        return 2
     try:
         check_scene(sc)
     except _channel.UnsupportedEffect as exc:
@@ -827,7 +861,11 @@ def main(argv=None) -> int:
         print(f"served the UART for {s['clk']} clk ({s['wall_s']:.1f} s, {s['clients']} clients, "
               f"{s['bytes_in']} bytes in, {s['bytes_out']} out), end: {s['end']}")
     print(f"report: {rep['report']}")
-    return 0 if rep["golden_mismatches"] == 0 else 1
+    code, line = verdict(rep)
+    if code:
+        sys.stdout.flush()
+        print(line, file=sys.stderr)
+    return code
 
 
 if __name__ == "__main__":

@@ -440,22 +440,33 @@ int main(int argc, char** argv) {
     const long long step = std::max<long long>(1000, total / 100);
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = cpu_seconds();
+    int line_step = 0;                                       // progress 2: last 10 % step printed
+    double line_t = 0.0;                                     // progress 2: time of the last line
     while (done < total) {
         const long long n = std::min(step, total - done);
         ticks(n);
         done += n;
         if (job.progress) {
+            // progress 1: a terminal, the line is rewritten in place; progress 2: a log, whole
+            // lines, one per 10 % or 10 s (and the last)
             const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            const unsigned fr = top->frames_o;
-            std::fprintf(stderr, "\r  fmt_core (Verilator, C++ harness): frame %u/%d  %3d%%  %.0f frames/s, %.0f clk/s   ",
-                         fr, job.frames, static_cast<int>(100.0 * done / total), fr / std::max(dt, 1e-9),
-                         (done - static_cast<long long>(job.regs.size())) / std::max(dt, 1e-9));
-            std::fflush(stderr);
+            const int pct = static_cast<int>(100.0 * done / total);
+            if (job.progress == 1 || pct / 10 > line_step || dt - line_t >= 10.0 || done >= total) {
+                const unsigned fr = top->frames_o;
+                std::fprintf(stderr, job.progress == 1
+                                 ? "\r  fmt_core (Verilator, C++ harness): frame %u/%d  %3d%%  %.0f frames/s, %.0f clk/s   "
+                                 : "  fmt_core (Verilator, C++ harness): frame %u/%d  %3d%%  %.0f frames/s, %.0f clk/s\n",
+                             fr, job.frames, pct, fr / std::max(dt, 1e-9),
+                             (done - static_cast<long long>(job.regs.size())) / std::max(dt, 1e-9));
+                std::fflush(stderr);
+                line_step = pct / 10;
+                line_t = dt;
+            }
         }
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double cpu = cpu_seconds() - c0;
-    if (job.progress) std::fprintf(stderr, "\n");
+    if (job.progress == 1) std::fprintf(stderr, "\n");
     const unsigned frames = top->frames_o, events = top->events_o;
     const long long run_clk = total - static_cast<long long>(job.regs.size());
     // stop the event consumer so that the counters hold still while they are read

@@ -81,6 +81,7 @@ from . import run_sim as _run_sim
 from . import rx_array as _rx
 from . import scene as _scene
 from . import touch as _touch
+from .progress import Progress
 from .settings import TouchSettings
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -244,6 +245,7 @@ def run_sweep(spec: SweepSpec, touch_clk: int = TOUCH_CLK_DEFAULT, progress=True
     # relative cost of one scene: rendering ~ M windows, touch processing ~ settings
     cost = lambda m: 0.3 * m + len(combos)
     work = sum(cost(m) for m, _ in groups) * spec.scenes
+    bar = Progress(work)
     done = 0.0
     for gi, (m, snr) in enumerate(groups):
         for si, cts in enumerate(layouts):
@@ -263,11 +265,10 @@ def run_sweep(spec: SweepSpec, touch_clk: int = TOUCH_CLK_DEFAULT, progress=True
             if progress:
                 el = time.perf_counter() - t_start
                 eta = el / done * (work - done)
-                print(f"\r  report: group {gi + 1}/{len(groups)} (M={m}, {snr:g} dB) scene "
-                      f"{si + 1}/{spec.scenes}, {el:5.0f} s elapsed, ~{eta:4.0f} s left  ",
-                      end="", file=sys.stderr, flush=True)
+                bar.update(done, f"  report: group {gi + 1}/{len(groups)} (M={m}, {snr:g} dB) scene "
+                                 f"{si + 1}/{spec.scenes}, {el:5.0f} s elapsed, ~{eta:4.0f} s left  ")
     if progress:
-        print(file=sys.stderr)
+        bar.close()
     points = []
     for (m, snr, w, neigh, bias), evl in acc.items():
         pe = [e["position_error_mm"] for e in evl]

@@ -42,6 +42,7 @@ import numpy as np
 
 from . import chain as _chain
 from . import scene as _scene
+from .progress import Progress
 from .settings import TouchSettings
 
 MATCH_MM = 10.0          # a detection farther than this from every true contact is false
@@ -210,9 +211,12 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
         scene = scene.replace(frames=frames)
     t0, c0 = time.perf_counter(), time.process_time()
 
+    bar = Progress(scene.frames)
+
     def progress(done, total):
         if not quiet and total >= 1000:
-            print(f"\r  {scene.name}: {done}/{total} frames", end="", file=sys.stderr, flush=True)
+            bar.total = total
+            bar.update(done, f"  {scene.name}: {done}/{total} frames")
 
     if render:
         hm = _chain.render_heatmaps(scene)
@@ -220,7 +224,7 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
     else:
         res = _chain.heatmaps_float(scene, progress=progress)
         if not quiet and scene.frames >= 1000:
-            print(file=sys.stderr)
+            bar.close()
     t1, c1 = time.perf_counter(), time.process_time()
     cal = calibration(scene)
     evs = processor(res.heatmaps, scene, settings, cal)
@@ -269,16 +273,28 @@ def _summary(rep: dict) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description="Run a scene through the FMT model (make sim).")
+    from .inputs import InputError, OneLineParser
+
+    def positive(text):
+        v = int(text)
+        if v < 1:
+            raise ValueError(text)
+        return v
+
+    ap = OneLineParser(description="Run a scene through the FMT model (make sim).")
     ap.add_argument("--scene", default=str(ROOT / "sim" / "scenes" / "default.json"))
     ap.add_argument("--out", default=str(ROOT / "build" / "sim"))
-    ap.add_argument("--frames", type=int, default=None, help="override the scene's length")
+    ap.add_argument("--frames", type=positive, default=None, help="override the scene's length")
     ap.add_argument("--render", action="store_true",
                     help="heat maps by render_heatmaps (no ADC synthesis)")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
-    sc = _scene.load(a.scene)
+    try:
+        sc = _scene.load(a.scene)
+    except InputError as e:
+        print(f"run_sim: {e}", file=sys.stderr)
+        return 2
     rep = run(sc, a.out, render=a.render, plot=not a.no_plot, quiet=a.quiet, frames=a.frames)
     print(_summary(rep))
     print(f"report: {rep['report']}" + (f", plot: {rep['png']}" if "png" in rep else ""))

@@ -308,16 +308,90 @@ def edge_distance_mm(cfg: SensorConfig, x, y):
                               (cfg.rows - 0.5) * p - y])
 
 
+def check_dict(d, where: str = "scene") -> None:
+    """Check a scene object before building it: unknown keys, wrong types and values out of
+    range raise fmt.inputs.InputError with one line naming the key (contacts by index)."""
+    from . import inputs as I
+    I.check_fields(d, {
+        "name": I.is_str(), "description": I.is_str(), "sensor": I.is_str(tuple(_params.CONFIGS)),
+        "frames": I.is_int(1, 10**8), "m": I.is_int(1, 255), "seed": I.is_int(0, 2**63 - 1),
+        "duration_s": I.is_num(0, 3600, lo_open=True, none_ok=True),
+        "effects": I.is_type(dict, name="an object"), "contacts": I.is_type(list, name="a list")}, where)
+    unknown = set(d.get("effects", {})) - EFFECT_KEYS
+    if unknown:
+        raise I.InputError(f"{where}: key 'effects': unknown effects {sorted(unknown)} "
+                           f"(known: {', '.join(sorted(EFFECT_KEYS))})")
+    for i, c in enumerate(d.get("contacts", [])):
+        cw = f"{where}: contacts[{i}]"
+        I.check_fields(c, {
+            "path": I.is_type(list, name="[[t_s, x_mm, y_mm], ...]"), "name": I.is_str(),
+            "diameter_mm": I.is_num(0, 1e4, lo_open=True), "strength": I.is_num(0, 100),
+            "profile": I.is_str(("disk", "gaussian")),
+            "minor_diameter_mm": I.is_num(0, 1e4, lo_open=True, none_ok=True),
+            "angle_deg": I.is_num(-360, 360),
+            "active": lambda v: None if v is None or isinstance(v, (list, dict)) else
+            "must be null, [[on, off], ...] or {\"repeat\": {...}}",
+            "active_units": I.is_str(("s", "samples"))}, cw)
+        _check_active(c.get("active"), cw, I)
+        if "path" not in c:
+            raise I.InputError(f"{cw}: key 'path' missing")
+        for j, w in enumerate(c["path"]):
+            if (not isinstance(w, list) or len(w) != 3
+                    or any(I.is_num()(x) for x in w)):
+                raise I.InputError(f"{cw}: key 'path': waypoint {j} must be [t_s, x_mm, y_mm] "
+                                   f"numbers, got {w!r}")
+
+
+def _check_active(a, where: str, I) -> None:
+    """``active``: null, [[on, off or null], ...] or {"repeat": {count, first_s, period_s,
+    on_s[, step_samples]}}."""
+    if a is None:
+        return
+    if isinstance(a, dict):
+        if set(a) != {"repeat"}:
+            raise I.InputError(f"{where}: key 'active': an object must be {{\"repeat\": {{...}}}}, got {a!r}")
+        I.check_fields(a["repeat"], {"count": I.is_int(0, 10**6), "first_s": I.is_num(-1e6, 1e6),
+                                     "period_s": I.is_num(0, 1e6), "on_s": I.is_num(0, 1e6),
+                                     "step_samples": I.is_int(-10**9, 10**9)}, f"{where}: key 'active.repeat'")
+        missing = {"count", "first_s", "period_s", "on_s"} - set(a["repeat"])
+        if missing:
+            raise I.InputError(f"{where}: key 'active.repeat': missing {sorted(missing)}")
+        return
+    for j, iv in enumerate(a):
+        # bounded so that the sample indices fit int64 (seconds or samples)
+        if (not isinstance(iv, list) or len(iv) != 2 or I.is_num(-1e9, 1e9)(iv[0])
+                or I.is_num(-1e9, 1e9, none_ok=True)(iv[1])):
+            raise I.InputError(f"{where}: key 'active': interval {j} must be [on, off or null] "
+                               f"numbers within +-1e9, got {iv!r}")
+
+
 def load(path) -> Scene:
-    """Load a scene from a .json or .yaml file."""
+    """Load a scene from a .json or .yaml file.  Every problem (missing file, bad syntax,
+    unknown key, wrong type, value out of range) raises fmt.inputs.InputError with one
+    line that names the file and the key."""
+    from .inputs import InputError, one_line
     path = Path(path)
-    text = path.read_text()
-    if path.suffix in (".yaml", ".yml"):
-        import yaml
-        d = yaml.safe_load(text)
-    else:
-        d = json.loads(text)
-    return Scene.from_dict(d)
+    where = f"scene {path}"
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise InputError(f"{where}: {one_line(e)}") from None
+    try:
+        if path.suffix in (".yaml", ".yml"):
+            import yaml
+            d = yaml.safe_load(text)
+        else:
+            d = json.loads(text)
+    except Exception as e:  # noqa: BLE001 -- json / yaml syntax errors
+        raise InputError(f"{where}: not valid {'YAML' if path.suffix in ('.yaml', '.yml') else 'JSON'} "
+                         f"({one_line(e)})") from None
+    check_dict(d, where)
+    try:
+        return Scene.from_dict(d)
+    except InputError:
+        raise
+    except (TypeError, ValueError, KeyError) as e:
+        raise InputError(f"{where}: {one_line(e)}") from None
 
 
 # ---- the scenes shipped in sim/scenes/ ----------------------------------------------------

@@ -4,7 +4,9 @@ into cell / frame units by :meth:`TouchSettings.converted`.
 """
 from __future__ import annotations
 
+import json
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 
 from .params import SensorConfig
 
@@ -28,6 +30,20 @@ class TouchSettings:
     def replace(self, **kw) -> "TouchSettings":
         return replace(self, **kw)
 
+    @classmethod
+    def from_dict(cls, d, where: str = "settings") -> "TouchSettings":
+        """Checked construction from a JSON/YAML object: an unknown key, a wrong type or a
+        value out of range raises fmt.inputs.InputError naming the key."""
+        from . import inputs as I
+        I.check_fields(d, {
+            "threshold": I.is_int(0, 65535), "neighbourhood": I.is_str(("moore", "vn")),
+            "max_touches": I.is_int(1, 255, none_ok=True), "bias_correction": I.is_bool,
+            "max_jump_mm": I.is_num(0, lo_open=True), "hold_off_us": I.is_num(0),
+            "velocity_window_us": I.is_num(0), "max_speed_mm_s": I.is_num(0),
+            "blobs": I.is_bool, "blob_threshold": I.is_int(0, 65535),
+            "blob_min_cells": I.is_int(1, 65535)}, where)
+        return cls(**d)
+
     def as_dict(self) -> dict:
         return asdict(self)
 
@@ -42,3 +58,17 @@ class TouchSettings:
             "velocity_window_frames": frames(self.velocity_window_us),
             "max_speed_q_per_frame": int(round(self.max_speed_mm_s * frame_period_s / cell * q)),
         }
+
+
+def load(path) -> TouchSettings:
+    """TouchSettings from a JSON file of its fields (checked: :meth:`TouchSettings.from_dict`);
+    every problem raises fmt.inputs.InputError with one line naming the file and key."""
+    from .inputs import InputError, one_line
+    path = Path(path)
+    try:
+        d = json.loads(path.read_text())
+    except OSError as e:
+        raise InputError(f"settings {path}: {one_line(e)}") from None
+    except ValueError as e:
+        raise InputError(f"settings {path}: not valid JSON ({one_line(e)})") from None
+    return TouchSettings.from_dict(d, where=f"settings {path}")

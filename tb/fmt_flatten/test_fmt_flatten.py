@@ -4,7 +4,10 @@ Checks: power-on identity (offset 0, gain 1.0), bit-exact output for random offs
 and gains loaded through the calibration port, random row orders, beats on consecutive
 cycles and with gaps, back-to-back frames, the fixed latency of 5 cycles for every
 beat and end-of-frame marker, per-cell saturation bits, the sticky flag and the
-saturated-cell counter (and its clear), reset in the middle of a frame.
+saturated-cell counter (and its clear), reset in the middle of a frame, and directed
+exact halves and saturation boundaries of the rounding against a rule written out
+independently of the model (exact_halves_and_boundaries: random gains almost never give
+an exact half, so a round-half-down mutation passed the random tests).
 """
 from __future__ import annotations
 
@@ -174,6 +177,78 @@ async def random_calibration_bit_exact(dut):
     dut.sat_clr_i.value = 0
     await ReadOnly()
     assert int(dut.sat_flag_o.value) == 0 and int(dut.sat_count_o.value) == 0
+
+
+def round_half_up_ref(z: int, off: int, g: int, w: int) -> tuple[int, bool]:
+    """The rule of fmt_flatten written out independently of fmt.flatten (exact rationals):
+    q = floor(max(z - off, 0) * g / 2^14 + 1/2), saturated at 2^w - 1."""
+    from fractions import Fraction
+    top = (1 << w) - 1
+    q = int(Fraction(max(z - off, 0) * g, 1 << 14) + Fraction(1, 2))   # int() floors a positive
+    return min(q, top), q > top
+
+
+def directed_cases(w: int) -> list:
+    """(z, offset, gain) cells: exact halves (which a round-half-down or round-to-even
+    mutation gets wrong), one LSB either side of a half, the offset clamp, gain 0 and
+    full scale, and products just either side of the saturation threshold."""
+    top = (1 << w) - 1
+    cases = []
+    for g, zs in ((8192, (1, 3, 5, 7, 2 * 1234 + 1, top, top - 2)),      # x.5 with gain 0.5
+                  (4096, (2, 6, 10, top - 1)),                              # gain 0.25
+                  (2048, (4, 12, 20)), (24576, (1, 3, 5)),                  # gain 0.125, 1.5
+                  (40960, (1, 3)), (57344, (1, 3)), (1, (1 << 13,)),      # gain 2.5, 3.5, 2^-14
+                  (8191, (1, 3)), (8193, (1, 3)), (16383, (1, 2)), (16385, (1, top))):
+        cases += [(z, 0, g) for z in zs]
+    cases += [(11, 10, 8192), (1010, 1000, 8192 + 4096), (7, 7, 9999), (6, 7, 9999), (0, top, 16384),
+              (top, 0, 0), (top, 0, 16384), (top, 0, (1 << 16) - 1), (top, 1, 16385), (top - 1, 0, 16385)]
+    # products around the saturation threshold (top + 1/2) * 2^14
+    thr = top * (1 << 14) + (1 << 13)
+    near = []
+    for d in range(top, top - 3000, -1):
+        g = thr // d
+        for gg in (g - 1, g, g + 1):
+            if 0 <= gg < (1 << 16) and abs(d * gg - thr) <= 2 * d:
+                near.append((d, 0, gg))
+        if len(near) >= 12:
+            break
+    return cases + near
+
+
+@cocotb.test()
+async def exact_halves_and_boundaries(dut):
+    """Directed roundings: every exact half rounds up, every saturation boundary holds
+    (against round_half_up_ref, written independently of the model, and the model)."""
+    tb = TB(dut)
+    await tb.reset()
+    rng = random.Random(env_int("SEED", 1) + 4)
+    cases = directed_cases(tb.w)
+    n = tb.rows * tb.cols
+    halves = sum(1 for z, o, g in cases if (max(z - o, 0) * g) % (1 << 14) == 1 << 13)
+    assert halves >= 20, halves
+    sat_seen = 0
+    for i in range(0, len(cases), n):
+        chunk = cases[i:i + n] + [(0, 0, GAIN_ONE)] * (n - len(cases[i:i + n]))
+        z = np.array([c[0] for c in chunk]).reshape(tb.rows, tb.cols)
+        off = np.array([c[1] for c in chunk]).reshape(tb.rows, tb.cols)
+        gain = np.array([c[2] for c in chunk]).reshape(tb.rows, tb.cols)
+        await tb.load(off, gain)
+        sched = tb.frames_schedule(rng, [z], first_frame=i, gap_p=0.2)
+        out = await tb.run(sched)
+        tb.check(sched, out)                         # the model, as the other tests
+        for t, item in enumerate(sched):
+            if item is None or item[0] != "row":
+                continue
+            r = item[1]
+            got = tb.unpack(out[t + LATENCY - 1][3])
+            satbits = out[t + LATENCY - 1][4]
+            for c in range(tb.cols):
+                want, wsat = round_half_up_ref(int(z[r, c]), int(off[r, c]), int(gain[r, c]), tb.w)
+                assert got[c] == want, (f"cell z={z[r, c]} offset={off[r, c]} gain={gain[r, c]}: "
+                                        f"RTL {got[c]}, round half up gives {want}")
+                assert bool(satbits >> c & 1) == wsat, f"saturation of z={z[r, c]} gain={gain[r, c]}"
+                sat_seen += wsat
+    assert sat_seen >= 3
 
 
 @cocotb.test()

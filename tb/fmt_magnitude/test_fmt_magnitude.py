@@ -2,7 +2,8 @@
 
 Bit-exact magnitudes for random full-scale inputs, the extremes (-2^(W-1) on both axes,
 axes, zero), the tag and valid path, ce gating (random ce pattern: the pipeline only
-advances on ce) and the latency ITER + 3 ce cycles; the model test bounds the error
+advances on ce) and the latency ITER + 3 ce cycles, and inputs whose gain product lands
+exactly on a half LSB (IN_W = 19; they round up); the model test bounds the error
 against the exact sqrt.
 """
 from __future__ import annotations
@@ -84,6 +85,62 @@ async def random_and_extremes(dut):
     # small values (weak cells)
     re_ += rng.integers(-50, 51, 100).tolist()
     im_ += rng.integers(-50, 51, 100).tolist()
+    await run_vectors(tb, re_, im_, 1.0)
+
+
+def cordic_x(re_, im_, iters):
+    """The final CORDIC x of fmt_magnitude (the vectoring loop of the module header)."""
+    x = np.abs(np.asarray(re_, dtype=np.int64)) << R.MAG_GUARD
+    y = np.asarray(im_, dtype=np.int64) << R.MAG_GUARD
+    for i in range(iters):
+        neg = y < 0
+        dx, dy = y >> i, x >> i
+        x, y = np.where(neg, x - dx, x + dx), np.where(neg, y + dy, y - dy)
+    return x
+
+
+def half_cases(w: int, iters: int, n: int = 8):
+    """Inputs whose gain product x * GAIN_C lands exactly on a half LSB of the output
+    (x = 2^(SH-1) with GAIN_C odd, SH = GAIN_BITS + GUARD: only reachable when
+    sqrt(2) * 2^(w-1) * 2^GUARD * K >= 2^(SH-1), i.e. at IN_W = 19, not 13), with re
+    negated too (|re| enters the CORDIC).  Random inputs never hit one."""
+    sh = R.MAG_GAIN_BITS + R.MAG_GUARD
+    target = 1 << (sh - 1)
+    z = target / (1 << R.MAG_GUARD) / R.cordic_gain(iters)
+    hi = (1 << (w - 1)) - 1
+    if z > np.sqrt(2) * hi:
+        return []
+    out = []
+    for im0 in range(hi, hi - 6000, -1):
+        if z < im0:
+            continue
+        re0 = int(np.sqrt(z * z - im0 * im0))
+        re_ = np.arange(max(0, re0 - 40), min(hi, re0 + 40))
+        x = cordic_x(re_, np.full_like(re_, im0), iters)
+        out += [(int(r), im0) for r in re_[x == target]] + [(-int(r), im0) for r in re_[x == target]]
+        if len(out) >= n:
+            break
+    return out[:n]
+
+
+@cocotb.test()
+async def exact_halves(dut):
+    """Gain products exactly on a half LSB round up (a round-half-down mutation passes
+    the random vectors, which never land on one): the output is (x * GAIN_C / 2^SH)
+    + 1/2 rounded down, written out here by hand, and the model's."""
+    tb = TB(dut)
+    await tb.reset()
+    cases = half_cases(tb.w, tb.iters)
+    if not cases:
+        return                                   # IN_W = 13: no exact half exists
+    sh = R.MAG_GAIN_BITS + R.MAG_GUARD
+    gc = R.cordic_gain_const(tb.iters)
+    x = 1 << (sh - 1)
+    want = (x * gc) // (1 << sh) + 1             # x * gc / 2^SH = k + 1/2 exactly (gc odd)
+    assert (x * gc) % (1 << sh) == 1 << (sh - 1)
+    re_, im_ = [c[0] for c in cases], [c[1] for c in cases]
+    outs, _ = await tb.stream(re_, im_)
+    assert [m for _, m, _ in outs] == [want] * len(cases), (cases, outs)
     await run_vectors(tb, re_, im_, 1.0)
 
 
