@@ -15,7 +15,7 @@
 // products, s6 Moore numerators / denominator, s7 fit selection, s8 |numerator|,
 // s9..s18 dividers, s19 rounding, s20..s21 bias table (block RAM), s22 offset,
 // s23 coordinates; ellipse: s4 normalisation, s5 products, s6..s8 cubic products,
-// s9 G, CORDIC s5..s17, s18 pp, log2 to s21, s22 log sums, exp to s24.
+// s9 G, CORDIC s5..s17, s18 pp, log2 s19..s21, s22 log sums, exp to s24.
 //
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
@@ -468,14 +468,16 @@ module fmt_interp #(
     wire g_pos9  = ~s9_g[GW-1] & (|s9_g);
     wire dm_pos9 = ~s9_dmn[DMW-1] & (|s9_dmn);
 
-    wire [$clog2(GW)+11:0]  lg_g12;
-    wire [$clog2(DMW)+11:0] lg_dm12;
-    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(s9_g), .lg_o(lg_g12));
-    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(s9_dmn), .lg_o(lg_dm12));
+    // the log2 blocks work at s18 .. s21 on delayed G and dm_n (their block-RAM read data
+    // then goes straight into registers, not into a shift register)
+    wire signed [GW-1:0]  g18;
+    wire signed [DMW-1:0] dmn18;
+    fmt_interp_dly #(.W(GW + DMW), .N(9), .RST(0)) u_dly_lg (
+        .clk(clk), .rst(rst), .d_i({s9_g, s9_dmn}), .q_o({g18, dmn18}));
     wire [$clog2(GW)+11:0]  lg_g21;
     wire [$clog2(DMW)+11:0] lg_dm21;
-    fmt_interp_dly #(.W($clog2(GW) + 12 + $clog2(DMW) + 12), .N(9), .RST(0)) u_dly_lg (
-        .clk(clk), .rst(rst), .d_i({lg_g12, lg_dm12}), .q_o({lg_g21, lg_dm21}));
+    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(g18), .lg_o(lg_g21));
+    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(dmn18), .lg_o(lg_dm21));
     wire pos_ok21;
     fmt_interp_dly #(.W(1), .N(12), .RST(0)) u_dly_pos9 (
         .clk(clk), .rst(rst), .d_i(g_pos9 & dm_pos9), .q_o(pos_ok21));
