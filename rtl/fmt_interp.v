@@ -6,17 +6,26 @@
 // Fully pipelined: one candidate per clock in, touches out in the same order after
 // LAT = 24 clock cycles (cand_valid_i -> tp_valid_o, cand_eof_i -> tp_eof_o likewise).
 // No stall and no per-frame state: a frame of n candidates (n <= the contact limit)
-// occupies the input for n cycles, far below 768 clk per frame.  Constant factors are
-// shifts and adds (no DSP).
+// occupies the input for n cycles, far below 768 clk per frame (worst case: the contact
+// limit in cycles).  Products: each on 18 x 18 multipliers (DSP48E / MULT18X18D) with
+// registered operands and registered partial products; a product wider than 18 x 18 is
+// split over several multipliers (fmt_interp_mul) whose 17-bit-shifted sum has its own
+// stage.  Constant factors are shifts and adds, except p * KQ (one multiplier).
+// Stages: s1 inputs, s2 sums, s3 coefficients; position: s4 partial products, s5
+// products, s6 Moore numerators / denominator, s7 fit selection, s8 |numerator|,
+// s9..s18 dividers, s19 rounding, s20..s21 bias table (block RAM), s22 offset,
+// s23 coordinates; ellipse: s4 normalisation, s5 products, s6..s8 cubic products,
+// s9 G, CORDIC s5..s17, s18 pp, log2 s19..s21, s22 log sums, exp to s24.
 //
 // Position (per axis): Moore fit x_f = (6be - 8cd) / (16ac - 9b^2) when Moore mode, no
 // neighbour missing, a < 0 and 16ac - 9b^2 > 0; else the Von Neumann fit
 // (z[0][+1] - z[0][-1]) / (2 (2 z00 - z[0][+1] - z[0][-1])) when both neighbours exist
 // and its denominator is > 0; one neighbour missing: the one-sided estimate from the
-// ratio neighbour / z00 (same divider, edge table); else 0 (cell centre).  |offset| = round half up of a
-// 9-bit truncating quotient (fmt_div) in 1/256 cell, clamped to 128 (0.5 cell) when
-// >= 257/512; optional bias table (fmt_interp_bias_rom).  tp_x_o = col * 256 + offset
-// clamped to [0, (COLS-1) * 256], tp_y_o likewise: cells, 8 fractional bits.
+// ratio neighbour / z00 (same divider, edge table); else 0 (cell centre).  |offset| =
+// round half up of a 9-bit truncating quotient (fmt_interp_div) in 1/256 cell, clamped
+// to 128 (0.5 cell) when >= 257/512; optional bias table (fmt_interp_bias_rom).
+// tp_x_o = col * 256 + offset clamped to [0, (COLS-1) * 256], tp_y_o likewise: cells,
+// 8 fractional bits.
 // Ellipse (Moore fit only): coefficients normalised to ~10-bit cells, G = F_v * 36 dm,
 // CORDIC (fmt_interp_cordic) for |(2(a-c), 3b)| and 1/2 atan2(B, A - C), log2 ROMs
 // (fmt_interp_lg) and an exp2 ROM (fmt_interp_exp) for the semi-axes
@@ -78,6 +87,8 @@ module fmt_interp #(
     localparam Z    = HM_W;
     localparam CSW  = Z + 2;            // sum of three cells (unsigned)
     localparam CW   = Z + 4;            // a, b, c, d, e (signed): |a| <= 6 (2^Z - 1)
+    localparam BWD  = Z + 2;            // significant bits of b (signed): |b| <= 2 (2^Z - 1)
+    localparam DEW  = Z + 3;            // significant bits of d, e (signed): |d| <= 3 (2^Z - 1)
     localparam FW   = Z + 7;            // f (signed): -16 M .. 52 M
     localparam VW   = Z + 4;            // Von Neumann num / den (signed)
     localparam PRW  = 2 * CW;           // products of coefficients
@@ -230,34 +241,47 @@ module fmt_interp #(
     end
 
     // =================================================================================
-    // s4: products (position path), normalised coefficients (ellipse path)
+    // s4 .. s5: products of the position path (fmt_interp_mul: operands s3, partial
+    // products s4, products s5); normalised coefficients (ellipse path) s4
     // =================================================================================
-    reg signed [PRW-1:0] s4_be, s4_cd, s4_bd, s4_ae, s4_ac, s4_bb;
+    wire signed [PRW-1:0] s5_be, s5_cd, s5_bd, s5_ae, s5_ac, s5_bb;
+    fmt_interp_mul #(.AW(BWD), .BW(DEW), .PW(PRW)) u_mul_be (
+        .clk(clk), .a_i(s3_b[BWD-1:0]), .b_i(s3_e[DEW-1:0]), .p_o(s5_be));
+    fmt_interp_mul #(.AW(CW), .BW(DEW), .PW(PRW)) u_mul_cd (
+        .clk(clk), .a_i(s3_c), .b_i(s3_d[DEW-1:0]), .p_o(s5_cd));
+    fmt_interp_mul #(.AW(BWD), .BW(DEW), .PW(PRW)) u_mul_bd (
+        .clk(clk), .a_i(s3_b[BWD-1:0]), .b_i(s3_d[DEW-1:0]), .p_o(s5_bd));
+    fmt_interp_mul #(.AW(CW), .BW(DEW), .PW(PRW)) u_mul_ae (
+        .clk(clk), .a_i(s3_a), .b_i(s3_e[DEW-1:0]), .p_o(s5_ae));
+    fmt_interp_mul #(.AW(CW), .BW(CW), .PW(PRW)) u_mul_ac (
+        .clk(clk), .a_i(s3_a), .b_i(s3_c), .p_o(s5_ac));
+    fmt_interp_mul #(.AW(BWD), .BW(BWD), .PW(PRW)) u_mul_bb (
+        .clk(clk), .a_i(s3_b[BWD-1:0]), .b_i(s3_b[BWD-1:0]), .p_o(s5_bb));
+
+    // side information of the position path: s3 -> s6
+    localparam SIW = 4 * VW + 3 * Z + 9;
+    wire signed [VW-1:0] s6_nvx, s6_dvx, s6_nvy, s6_dvy;
+    wire                 s6_mxl, s6_mxh, s6_myl, s6_myh, s6_edge, s6_sat, s6_moore, s6_bias, s6_aneg;
+    wire [Z-1:0]         s6_znx, s6_zny, s6_z4;
+    fmt_interp_dly #(.W(SIW), .N(3), .RST(0)) u_dly_side (
+        .clk(clk), .rst(rst),
+        .d_i({s3_nvx, s3_dvx, s3_nvy, s3_dvy, s3_mxl, s3_mxh, s3_myl, s3_myh, s3_edge,
+              s3_sat, s3_moore, s3_bias, s3_a[CW-1], s3_znx, s3_zny, s3_z4}),
+        .q_o({s6_nvx, s6_dvx, s6_nvy, s6_dvy, s6_mxl, s6_mxh, s6_myl, s6_myh, s6_edge,
+              s6_sat, s6_moore, s6_bias, s6_aneg, s6_znx, s6_zny, s6_z4}));
+
     reg signed [NW-1:0]  s4_an, s4_bn, s4_cn, s4_dn, s4_en;
-    reg signed [FNW-1:0] s4_fn;
-    reg signed [VW-1:0]  s4_nvx, s4_dvx, s4_nvy, s4_dvy;
-    reg                  s4_mxl, s4_mxh, s4_myl, s4_myh, s4_edge, s4_sat, s4_moore, s4_bias, s4_aneg;
-    reg [Z-1:0]          s4_znx, s4_zny, s4_z4;
-    /* verilator lint_off WIDTHTRUNC */ // the shifted coefficients fit NW / FNW bits (see widths)
+    reg signed [FW-1:0]  s4_f;
+    reg [SHW-1:0]        s4_sh;
+    /* verilator lint_off WIDTHTRUNC */ // the shifted coefficients fit NW bits (see widths)
     always @(posedge clk) begin
-        s4_be <= s3_b * s3_e;
-        s4_cd <= s3_c * s3_d;
-        s4_bd <= s3_b * s3_d;
-        s4_ae <= s3_a * s3_e;
-        s4_ac <= s3_a * s3_c;
-        s4_bb <= s3_b * s3_b;
         s4_an <= s3_a >>> s3_sh;
         s4_bn <= s3_b >>> s3_sh;
         s4_cn <= s3_c >>> s3_sh;
         s4_dn <= s3_d >>> s3_sh;
         s4_en <= s3_e >>> s3_sh;
-        s4_fn <= s3_f >>> s3_sh;
-        s4_nvx <= s3_nvx; s4_dvx <= s3_dvx; s4_nvy <= s3_nvy; s4_dvy <= s3_dvy;
-        s4_mxl <= s3_mxl; s4_mxh <= s3_mxh; s4_myl <= s3_myl; s4_myh <= s3_myh;
-        s4_znx <= s3_znx; s4_zny <= s3_zny; s4_z4 <= s3_z4;
-        s4_edge <= s3_edge; s4_sat <= s3_sat;
-        s4_moore <= s3_moore; s4_bias <= s3_bias;
-        s4_aneg <= s3_a[CW-1];
+        s4_f  <= s3_f;
+        s4_sh <= s3_sh;
     end
     /* verilator lint_on WIDTHTRUNC */
 
@@ -275,177 +299,201 @@ module fmt_interp #(
     /* verilator lint_on PINCONNECTEMPTY */
 
     // =================================================================================
-    // s5: numerators / denominator of the Moore fit; normalised products
+    // s5: normalised products (one 18 x 18 multiplier each, operands s4, product s5)
     // =================================================================================
-    wire signed [PW-1:0] be_w = {{(PW-PRW){s4_be[PRW-1]}}, s4_be};
-    wire signed [PW-1:0] cd_w = {{(PW-PRW){s4_cd[PRW-1]}}, s4_cd};
-    wire signed [PW-1:0] bd_w = {{(PW-PRW){s4_bd[PRW-1]}}, s4_bd};
-    wire signed [PW-1:0] ae_w = {{(PW-PRW){s4_ae[PRW-1]}}, s4_ae};
-    wire signed [PW-1:0] ac_w = {{(PW-PRW){s4_ac[PRW-1]}}, s4_ac};
-    wire signed [PW-1:0] bb_w = {{(PW-PRW){s4_bb[PRW-1]}}, s4_bb};
-
-    reg signed [PW-1:0]  s5_nmx, s5_nmy, s5_dm;
     reg signed [N2W-1:0] s5_acn, s5_bbn, s5_ddn, s5_den, s5_een;
     reg signed [NW-1:0]  s5_an, s5_bn, s5_cn;
-    reg signed [FNW-1:0] s5_fn;
-    reg signed [NW+2:0]  s5_p;
-    reg signed [VW-1:0]  s5_nvx, s5_dvx, s5_nvy, s5_dvy;
-    reg                  s5_mxl, s5_mxh, s5_myl, s5_myh, s5_edge, s5_sat, s5_moore, s5_bias, s5_aneg;
-    reg [Z-1:0]          s5_znx, s5_zny, s5_z4;
+    reg signed [FW-1:0]  s5_f;
+    reg [SHW-1:0]        s5_sh;
+    reg signed [NW:0]    s5_s;
     always @(posedge clk) begin
-        // constant factors as shifts and adds (a multiplier would be an unregistered DSP)
-        s5_nmx <= (be_w <<< 2) + (be_w <<< 1) - (cd_w <<< 3);
-        s5_nmy <= (bd_w <<< 2) + (bd_w <<< 1) - (ae_w <<< 3);
-        s5_dm  <= (ac_w <<< 4) - (bb_w <<< 3) - bb_w;
         s5_acn <= s4_an * s4_cn;
         s5_bbn <= s4_bn * s4_bn;
         s5_ddn <= s4_dn * s4_dn;
         s5_den <= s4_dn * s4_en;
         s5_een <= s4_en * s4_en;
-        s5_an <= s4_an; s5_bn <= s4_bn; s5_cn <= s4_cn; s5_fn <= s4_fn;
-        s5_p  <= -(({{3{s4_an[NW-1]}}, s4_an} + {{3{s4_cn[NW-1]}}, s4_cn}) <<< 1);
-        s5_nvx <= s4_nvx; s5_dvx <= s4_dvx; s5_nvy <= s4_nvy; s5_dvy <= s4_dvy;
-        s5_mxl <= s4_mxl; s5_mxh <= s4_mxh; s5_myl <= s4_myl; s5_myh <= s4_myh;
-        s5_znx <= s4_znx; s5_zny <= s4_zny; s5_z4 <= s4_z4;
-        s5_edge <= s4_edge; s5_sat <= s4_sat;
-        s5_moore <= s4_moore; s5_bias <= s4_bias; s5_aneg <= s4_aneg;
+        s5_an <= s4_an; s5_bn <= s4_bn; s5_cn <= s4_cn;
+        s5_f  <= s4_f;  s5_sh <= s4_sh;
+        s5_s  <= {s4_an[NW-1], s4_an} + {s4_cn[NW-1], s4_cn};
     end
 
     // =================================================================================
-    // s6: fit selection per axis; ellipse products
+    // s6: numerators / denominator of the Moore fit; dm_n, f_n
     // =================================================================================
-    wire moore_ok = s5_moore & ~s5_edge & s5_aneg & (s5_dm > 0);
-    wire s5_mx = s5_mxl | s5_mxh;
-    wire s5_my = s5_myl | s5_myh;
-    wire z4_pos = |s5_z4;
-    // one neighbour missing: one-sided ratio estimate (num = +-z_nb, den = z00)
-    wire ex = ~moore_ok & (s5_mxl ^ s5_mxh) & z4_pos;
-    wire ey = ~moore_ok & (s5_myl ^ s5_myh) & z4_pos;
-    wire vx_ok = ~s5_mx & (s5_dvx > 0);
-    wire vy_ok = ~s5_my & (s5_dvy > 0);
-    wire signed [PW-1:0] znx_w = {{(PW-Z){1'b0}}, s5_znx};
-    wire signed [PW-1:0] zny_w = {{(PW-Z){1'b0}}, s5_zny};
-    wire signed [PW-1:0] z4_w  = {{(PW-Z){1'b0}}, s5_z4};
-    wire signed [PW-1:0] nvx_w = {{(PW-VW){s5_nvx[VW-1]}}, s5_nvx};
-    wire signed [PW-1:0] dvx_w = {{(PW-VW){s5_dvx[VW-1]}}, s5_dvx};
-    wire signed [PW-1:0] nvy_w = {{(PW-VW){s5_nvy[VW-1]}}, s5_nvy};
-    wire signed [PW-1:0] dvy_w = {{(PW-VW){s5_dvy[VW-1]}}, s5_dvy};
-    wire signed [PW-1:0] one_w = 1;
-    wire signed [PW-1:0] numx = moore_ok ? s5_nmx : ex ? (s5_mxl ? znx_w : -znx_w)
-                              : (vx_ok ? nvx_w : {PW{1'b0}});
-    wire signed [PW-1:0] numy = moore_ok ? s5_nmy : ey ? (s5_myl ? zny_w : -zny_w)
-                              : (vy_ok ? nvy_w : {PW{1'b0}});
-    /* verilator lint_off UNUSEDSIGNAL */ // sign bits of den: only used when den > 0
-    wire signed [PW-1:0] denx = moore_ok ? s5_dm  : ex ? z4_w : (vx_ok ? dvx_w : one_w);
-    wire signed [PW-1:0] deny = moore_ok ? s5_dm  : ey ? z4_w : (vy_ok ? dvy_w : one_w);
-    /* verilator lint_on UNUSEDSIGNAL */
-    wire fb_d = (s5_moore & ~s5_edge & ~moore_ok)
-              | (~moore_ok & ~s5_mx & ~(s5_dvx > 0))
-              | (~moore_ok & ~s5_my & ~(s5_dvy > 0))
-              | (~moore_ok & ((s5_mxl ^ s5_mxh) | (s5_myl ^ s5_myh)) & ~z4_pos);
-
+    wire signed [PW-1:0] be_w = {{(PW-PRW){s5_be[PRW-1]}}, s5_be};
+    wire signed [PW-1:0] cd_w = {{(PW-PRW){s5_cd[PRW-1]}}, s5_cd};
+    wire signed [PW-1:0] bd_w = {{(PW-PRW){s5_bd[PRW-1]}}, s5_bd};
+    wire signed [PW-1:0] ae_w = {{(PW-PRW){s5_ae[PRW-1]}}, s5_ae};
+    wire signed [PW-1:0] ac_w = {{(PW-PRW){s5_ac[PRW-1]}}, s5_ac};
+    wire signed [PW-1:0] bb_w = {{(PW-PRW){s5_bb[PRW-1]}}, s5_bb};
     wire signed [DMW-1:0] acn_w = {{(DMW-N2W){s5_acn[N2W-1]}}, s5_acn};
     wire signed [DMW-1:0] bbn_w = {{(DMW-N2W){s5_bbn[N2W-1]}}, s5_bbn};
-    reg [PW-2:0]         s6_magx, s6_magy, s6_denx, s6_deny;
-    reg                  s6_sgx, s6_sgy, s6_fb, s6_mok, s6_edge, s6_sat, s6_bias, s6_ex, s6_ey;
+
+    reg signed [PW-1:0]  s6_nmx, s6_nmy, s6_dm;
     reg signed [DMW-1:0] s6_dmn;
-    reg signed [N3W-1:0] s6_cdd, s6_bde, s6_aee;
     reg signed [FNW-1:0] s6_fn;
-    /* verilator lint_off WIDTHTRUNC */ // |num|, den > 0 fit PW-1 bits; dm_n fits DMW bits
+    /* verilator lint_off WIDTHTRUNC */ // dm_n fits DMW bits, f_n FNW bits
     always @(posedge clk) begin
-        s6_magx <= numx[PW-1] ? -numx : numx;
-        s6_magy <= numy[PW-1] ? -numy : numy;
-        s6_denx <= denx;
-        s6_deny <= deny;
-        s6_sgx  <= numx[PW-1];
-        s6_sgy  <= numy[PW-1];
-        s6_fb   <= fb_d;
-        s6_mok  <= moore_ok;
-        s6_edge <= s5_edge;
-        s6_sat  <= s5_sat;
-        s6_bias <= s5_bias;
-        s6_ex   <= ex;
-        s6_ey   <= ey;
-        s6_dmn  <= (acn_w <<< 4) - (bbn_w <<< 3) - bbn_w;
-        s6_cdd  <= s5_cn * s5_ddn;
-        s6_bde  <= s5_bn * s5_den;
-        s6_aee  <= s5_an * s5_een;
-        s6_fn   <= s5_fn;
+        // constant factors as shifts and adds
+        s6_nmx <= (be_w <<< 2) + (be_w <<< 1) - (cd_w <<< 3);
+        s6_nmy <= (bd_w <<< 2) + (bd_w <<< 1) - (ae_w <<< 3);
+        s6_dm  <= (ac_w <<< 4) - (bb_w <<< 3) - bb_w;
+        s6_dmn <= (acn_w <<< 4) - (bbn_w <<< 3) - bbn_w;
+        s6_fn  <= s5_f >>> s5_sh;
     end
     /* verilator lint_on WIDTHTRUNC */
 
-    // ---- offset dividers: q = floor(|num| * 512 / den), s7 .. s16 ----
+    // ellipse products: operands s5 / s6, partial products s6 / s7, products s7 / s8
+    wire signed [N3W-1:0] s7_cdd, s7_bde, s7_aee;
+    fmt_interp_mul #(.AW(NW), .BW(N2W), .PW(N3W)) u_mul_cdd (
+        .clk(clk), .a_i(s5_cn), .b_i(s5_ddn), .p_o(s7_cdd));
+    fmt_interp_mul #(.AW(NW), .BW(N2W), .PW(N3W)) u_mul_bde (
+        .clk(clk), .a_i(s5_bn), .b_i(s5_den), .p_o(s7_bde));
+    fmt_interp_mul #(.AW(NW), .BW(N2W), .PW(N3W)) u_mul_aee (
+        .clk(clk), .a_i(s5_an), .b_i(s5_een), .p_o(s7_aee));
+    wire signed [GW-1:0] s8_fdm;
+    fmt_interp_mul #(.AW(FNW), .BW(DMW), .PW(GW)) u_mul_fdm (
+        .clk(clk), .a_i(s6_fn), .b_i(s6_dmn), .p_o(s8_fdm));
+
+    // =================================================================================
+    // s7: fit selection per axis (signed numerator, denominator, flags)
+    // =================================================================================
+    wire moore_ok = s6_moore & ~s6_edge & s6_aneg & (s6_dm > 0);
+    wire s6_mx = s6_mxl | s6_mxh;
+    wire s6_my = s6_myl | s6_myh;
+    wire z4_pos = |s6_z4;
+    // one neighbour missing: one-sided ratio estimate (num = +-z_nb, den = z00)
+    wire ex = ~moore_ok & (s6_mxl ^ s6_mxh) & z4_pos;
+    wire ey = ~moore_ok & (s6_myl ^ s6_myh) & z4_pos;
+    wire vx_ok = ~s6_mx & (s6_dvx > 0);
+    wire vy_ok = ~s6_my & (s6_dvy > 0);
+    wire signed [PW-1:0] znx_w = {{(PW-Z){1'b0}}, s6_znx};
+    wire signed [PW-1:0] zny_w = {{(PW-Z){1'b0}}, s6_zny};
+    wire signed [PW-1:0] z4_w  = {{(PW-Z){1'b0}}, s6_z4};
+    wire signed [PW-1:0] nvx_w = {{(PW-VW){s6_nvx[VW-1]}}, s6_nvx};
+    wire signed [PW-1:0] dvx_w = {{(PW-VW){s6_dvx[VW-1]}}, s6_dvx};
+    wire signed [PW-1:0] nvy_w = {{(PW-VW){s6_nvy[VW-1]}}, s6_nvy};
+    wire signed [PW-1:0] dvy_w = {{(PW-VW){s6_dvy[VW-1]}}, s6_dvy};
+    wire signed [PW-1:0] one_w = 1;
+    wire signed [PW-1:0] numx = moore_ok ? s6_nmx : ex ? (s6_mxl ? znx_w : -znx_w)
+                              : (vx_ok ? nvx_w : {PW{1'b0}});
+    wire signed [PW-1:0] numy = moore_ok ? s6_nmy : ey ? (s6_myl ? zny_w : -zny_w)
+                              : (vy_ok ? nvy_w : {PW{1'b0}});
+    /* verilator lint_off UNUSEDSIGNAL */ // sign bits of den: only used when den > 0
+    wire signed [PW-1:0] denx = moore_ok ? s6_dm  : ex ? z4_w : (vx_ok ? dvx_w : one_w);
+    wire signed [PW-1:0] deny = moore_ok ? s6_dm  : ey ? z4_w : (vy_ok ? dvy_w : one_w);
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire fb_d = (s6_moore & ~s6_edge & ~moore_ok)
+              | (~moore_ok & ~s6_mx & ~(s6_dvx > 0))
+              | (~moore_ok & ~s6_my & ~(s6_dvy > 0))
+              | (~moore_ok & ((s6_mxl ^ s6_mxh) | (s6_myl ^ s6_myh)) & ~z4_pos);
+
+    reg signed [PW-1:0]  s7_numx, s7_numy;
+    reg [PW-2:0]         s7_denx, s7_deny;
+    reg                  s7_fb, s7_mok, s7_edge, s7_sat, s7_bias, s7_ex, s7_ey;
+    reg signed [DMW-1:0] s7_dmn;
+    /* verilator lint_off WIDTHTRUNC */ // den > 0 fits PW-1 bits
+    always @(posedge clk) begin
+        s7_numx <= numx;
+        s7_numy <= numy;
+        s7_denx <= denx;
+        s7_deny <= deny;
+        s7_fb   <= fb_d;
+        s7_mok  <= moore_ok;
+        s7_edge <= s6_edge;
+        s7_sat  <= s6_sat;
+        s7_bias <= s6_bias;
+        s7_ex   <= ex;
+        s7_ey   <= ey;
+        s7_dmn  <= s6_dmn;
+    end
+    /* verilator lint_on WIDTHTRUNC */
+
+    // =================================================================================
+    // s8: |numerator| and its sign; qn
+    // =================================================================================
+    wire signed [QNW-1:0] cdd_w = {{(QNW-N3W){s7_cdd[N3W-1]}}, s7_cdd};
+    wire signed [QNW-1:0] bde_w = {{(QNW-N3W){s7_bde[N3W-1]}}, s7_bde};
+    wire signed [QNW-1:0] aee_w = {{(QNW-N3W){s7_aee[N3W-1]}}, s7_aee};
+    reg [PW-2:0]         s8_magx, s8_magy, s8_denx, s8_deny;
+    reg                  s8_sgx, s8_sgy, s8_fb, s8_mok, s8_edge, s8_sat, s8_bias, s8_ex, s8_ey;
+    reg signed [QNW-1:0] s8_qn;
+    reg signed [DMW-1:0] s8_dmn;
+    /* verilator lint_off WIDTHTRUNC */ // |num| fits PW-1 bits
+    always @(posedge clk) begin
+        // |num| = (num ^ sign) + sign: one adder
+        s8_magx <= (s7_numx ^ {PW{s7_numx[PW-1]}}) + {{(PW-1){1'b0}}, s7_numx[PW-1]};
+        s8_magy <= (s7_numy ^ {PW{s7_numy[PW-1]}}) + {{(PW-1){1'b0}}, s7_numy[PW-1]};
+        s8_sgx  <= s7_numx[PW-1];
+        s8_sgy  <= s7_numy[PW-1];
+        s8_denx <= s7_denx;
+        s8_deny <= s7_deny;
+        s8_fb   <= s7_fb;
+        s8_mok  <= s7_mok;
+        s8_edge <= s7_edge;
+        s8_sat  <= s7_sat;
+        s8_bias <= s7_bias;
+        s8_ex   <= s7_ex;
+        s8_ey   <= s7_ey;
+        s8_qn   <= (cdd_w <<< 1) - (bde_w <<< 1) - bde_w + (aee_w <<< 1);
+        s8_dmn  <= s7_dmn;
+    end
+    /* verilator lint_on WIDTHTRUNC */
+
+    // ---- offset dividers: q = floor(|num| * 512 / den), s9 .. s18 ----
     wire [QW-1:0] qx, qy;
     wire          ovx, ovy;
-    /* verilator lint_off PINCONNECTEMPTY */ // valid travels in the control delay line
-    fmt_div #(.NUM_W(PW - 1 + QW), .DEN_W(PW - 1), .QW(QW)) u_divx (
-        .clk(clk), .rst(rst), .valid_i(1'b0), .num_i({s6_magx, {QW{1'b0}}}), .den_i(s6_denx),
-        .valid_o(), .quot_o(qx), .ovf_o(ovx));
-    fmt_div #(.NUM_W(PW - 1 + QW), .DEN_W(PW - 1), .QW(QW)) u_divy (
-        .clk(clk), .rst(rst), .valid_i(1'b0), .num_i({s6_magy, {QW{1'b0}}}), .den_i(s6_deny),
-        .valid_o(), .quot_o(qy), .ovf_o(ovy));
-    /* verilator lint_on PINCONNECTEMPTY */
+    fmt_interp_div #(.MAG_W(PW - 1), .DEN_W(PW - 1), .QW(QW)) u_divx (
+        .clk(clk), .mag_i(s8_magx), .den_i(s8_denx), .quot_o(qx), .ovf_o(ovx));
+    fmt_interp_div #(.MAG_W(PW - 1), .DEN_W(PW - 1), .QW(QW)) u_divy (
+        .clk(clk), .mag_i(s8_magy), .den_i(s8_deny), .quot_o(qy), .ovf_o(ovy));
 
-    // side information of the position path: s6 -> s16
-    wire s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias, s16_ex, s16_ey;
+    // side information of the position path: s8 -> s18
+    wire s18_sgx, s18_sgy, s18_mok, s18_fb, s18_edge, s18_sat, s18_bias, s18_ex, s18_ey;
     fmt_interp_dly #(.W(9), .N(QW + 1), .RST(0)) u_dly_pos (
         .clk(clk), .rst(rst),
-        .d_i({s6_sgx, s6_sgy, s6_mok, s6_fb, s6_edge, s6_sat, s6_bias, s6_ex, s6_ey}),
-        .q_o({s16_sgx, s16_sgy, s16_mok, s16_fb, s16_edge, s16_sat, s16_bias, s16_ex, s16_ey}));
+        .d_i({s8_sgx, s8_sgy, s8_mok, s8_fb, s8_edge, s8_sat, s8_bias, s8_ex, s8_ey}),
+        .q_o({s18_sgx, s18_sgy, s18_mok, s18_fb, s18_edge, s18_sat, s18_bias, s18_ex, s18_ey}));
 
     // =================================================================================
-    // ellipse path s7 .. s9: qn, G
+    // ellipse path s9: G = f_n dm_n - 12 qn
     // =================================================================================
-    wire signed [QNW-1:0] cdd_w = {{(QNW-N3W){s6_cdd[N3W-1]}}, s6_cdd};
-    wire signed [QNW-1:0] bde_w = {{(QNW-N3W){s6_bde[N3W-1]}}, s6_bde};
-    wire signed [QNW-1:0] aee_w = {{(QNW-N3W){s6_aee[N3W-1]}}, s6_aee};
-    reg signed [QNW-1:0] s7_qn;
-    wire signed [GW-1:0]  q12_w;
-    reg signed [DMW-1:0] s7_dmn;
-    reg signed [FNW-1:0] s7_fn;
-    reg signed [GW-1:0]  s8_fdm, s8_q12;
-    reg signed [DMW-1:0] s8_dmn;
+    wire signed [GW-1:0] qn_w = {{(GW-QNW){s8_qn[QNW-1]}}, s8_qn};
     reg signed [GW-1:0]  s9_g;
     reg signed [DMW-1:0] s9_dmn;
-    assign q12_w = {{(GW-QNW){s7_qn[QNW-1]}}, s7_qn};
     always @(posedge clk) begin
-        s7_qn  <= (cdd_w <<< 1) - (bde_w <<< 1) - bde_w + (aee_w <<< 1);
-        s7_dmn <= s6_dmn;
-        s7_fn  <= s6_fn;
-        s8_fdm <= s7_fn * s7_dmn;
-        s8_q12 <= (q12_w <<< 3) + (q12_w <<< 2);
-        s8_dmn <= s7_dmn;
-        s9_g   <= s8_fdm - s8_q12;
+        s9_g   <= s8_fdm - (qn_w <<< 3) - (qn_w <<< 2);
         s9_dmn <= s8_dmn;
     end
     wire g_pos9  = ~s9_g[GW-1] & (|s9_g);
     wire dm_pos9 = ~s9_dmn[DMW-1] & (|s9_dmn);
 
-    wire [$clog2(GW)+11:0]  lg_g12;
-    wire [$clog2(DMW)+11:0] lg_dm12;
-    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(s9_g), .lg_o(lg_g12));
-    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(s9_dmn), .lg_o(lg_dm12));
+    // the log2 blocks work at s18 .. s21 on delayed G and dm_n (their block-RAM read data
+    // then goes straight into registers, not into a shift register)
+    wire signed [GW-1:0]  g18;
+    wire signed [DMW-1:0] dmn18;
+    fmt_interp_dly #(.W(GW + DMW), .N(9), .RST(0)) u_dly_lg (
+        .clk(clk), .rst(rst), .d_i({s9_g, s9_dmn}), .q_o({g18, dmn18}));
     wire [$clog2(GW)+11:0]  lg_g21;
     wire [$clog2(DMW)+11:0] lg_dm21;
-    fmt_interp_dly #(.W($clog2(GW) + 12 + $clog2(DMW) + 12), .N(9), .RST(0)) u_dly_lg (
-        .clk(clk), .rst(rst), .d_i({lg_g12, lg_dm12}), .q_o({lg_g21, lg_dm21}));
+    fmt_interp_lg #(.X_W(GW)) u_lg_g (.clk(clk), .x_i(g18), .lg_o(lg_g21));
+    fmt_interp_lg #(.X_W(DMW)) u_lg_dm (.clk(clk), .x_i(dmn18), .lg_o(lg_dm21));
     wire pos_ok21;
     fmt_interp_dly #(.W(1), .N(12), .RST(0)) u_dly_pos9 (
         .clk(clk), .rst(rst), .d_i(g_pos9 & dm_pos9), .q_o(pos_ok21));
 
-    // ---- pp = p * KQ + (|s| K << 8) at s18 ----
-    // p * KQ beside the CORDIC: operand s15, product s16, result s17 (the registers XST
-    // packs into one DSP48E), then one adder at s18
-    wire signed [NW+2:0] p14;
-    fmt_interp_dly #(.W(NW + 3), .N(9), .RST(0)) u_dly_p (
-        .clk(clk), .rst(rst), .d_i(s5_p), .q_o(p14));
-    reg signed [NW+2:0]  s15_p;
-    reg signed [PPW-1:0] s16_pkq, s17_pkq, s18_pp;
+    // ---- pp = p * KQ + (|s| K << 8) at s18, p = -2 (an + cn) ----
+    // p formed from the delayed sum at s16 (operand register), p * KQ at s17 (product
+    // register at the multiplier), one adder at s18 (its P register)
+    wire signed [NW:0] s15_s;
+    fmt_interp_dly #(.W(NW + 1), .N(10), .RST(0)) u_dly_p (
+        .clk(clk), .rst(rst), .d_i(s5_s), .q_o(s15_s));
+    reg signed [NW+2:0]  s16_p;
+    reg signed [PPW-1:0] s17_pkq, s18_pp;
     /* verilator lint_off WIDTHTRUNC */ // pp < 3.4e8 fits PPW bits
     always @(posedge clk) begin
-        s15_p   <= p14;
-        s16_pkq <= {{(PPW-NW-3){s15_p[NW+2]}}, s15_p} * KQ;
-        s17_pkq <= s16_pkq;
+        s16_p   <= -({{2{s15_s[NW]}}, s15_s} <<< 1);
+        s17_pkq <= {{(PPW-NW-3){s16_p[NW+2]}}, s16_p} * KQ;
         s18_pp  <= s17_pkq + $signed({{(PPW-IW-2){1'b0}}, cor_mag} << 8);
     end
     /* verilator lint_on WIDTHTRUNC */
@@ -462,16 +510,14 @@ module fmt_interp #(
     wire signed [LW-1:0] lgp = {{(LW-$clog2(PPW)-12){1'b0}}, lg_pp21};
     localparam signed [LW-1:0] LCMAJ_W = LC_MAJ[LW-1:0];
     localparam signed [LW-1:0] LCMIN_W = LC_MIN[LW-1:0];
-    reg signed [LW-1:0] s22_lmaj, s22_lmin;
+    // the sums go straight to the exp blocks' first registers (block-RAM address, k)
+    wire signed [LW-1:0] lmaj = lgg + lgp - (lgd <<< 1) - LCMAJ_W;
+    wire signed [LW-1:0] lmin = lgg - lgd - lgp + LCMIN_W;
     reg                 s22_ok;
-    always @(posedge clk) begin
-        s22_lmaj <= lgg + lgp - (lgd <<< 1) - LCMAJ_W;
-        s22_lmin <= lgg - lgd - lgp + LCMIN_W;
-        s22_ok   <= pos_ok21 & pp_pos21;
-    end
+    always @(posedge clk) s22_ok <= pos_ok21 & pp_pos21;
     wire [15:0] ax_maj24, ax_min24;
-    fmt_interp_exp #(.LW(LW)) u_exp_maj (.clk(clk), .l_i(s22_lmaj), .axis_o(ax_maj24));
-    fmt_interp_exp #(.LW(LW)) u_exp_min (.clk(clk), .l_i(s22_lmin), .axis_o(ax_min24));
+    fmt_interp_exp #(.LW(LW)) u_exp_maj (.clk(clk), .l_i(lmaj), .axis_o(ax_maj24));
+    fmt_interp_exp #(.LW(LW)) u_exp_min (.clk(clk), .l_i(lmin), .axis_o(ax_min24));
     wire ell_ok24;
     fmt_interp_dly #(.W(1), .N(2), .RST(0)) u_dly_eok (
         .clk(clk), .rst(rst), .d_i(s22_ok), .q_o(ell_ok24));
@@ -485,77 +531,77 @@ module fmt_interp #(
         .clk(clk), .rst(rst), .d_i(ang_r[15:8]), .q_o(ang24));
 
     // =================================================================================
-    // position s17: round / clamp; s18: bias table; s19: offset; s20: coordinates
+    // position s19: round / clamp; s20 .. s21: bias table (block RAM, output register);
+    // s22: offset; s23: coordinates
     // =================================================================================
     // clamp (fit offsets only); the edge estimate indexes its table by q >> 1 (255 on
     // overflow, ratio >= 1)
-    wire clx = ~s16_ex & (ovx | (qx >= 257));
-    wire cly = ~s16_ey & (ovy | (qy >= 257));
+    wire clx = ~s18_ex & (ovx | (qx >= 257));
+    wire cly = ~s18_ey & (ovy | (qy >= 257));
     /* verilator lint_off UNUSEDSIGNAL */ // (q + 1) >> 1 for q <= 256: bits 8:1 only
     wire [QW:0] qx1 = {1'b0, qx} + 1'b1;
     wire [QW:0] qy1 = {1'b0, qy} + 1'b1;
     /* verilator lint_on UNUSEDSIGNAL */
-    reg [7:0] s17_rx, s17_ry;
-    reg       s17_sgx, s17_sgy, s17_mok, s17_bias, s17_ex, s17_ey;
-    reg [3:0] s17_flags;
+    reg [7:0] s19_rx, s19_ry;
+    reg       s19_sgx, s19_sgy, s19_mok, s19_bias, s19_ex, s19_ey;
+    reg [3:0] s19_flags;
     always @(posedge clk) begin
-        s17_rx  <= s16_ex ? (ovx ? 8'd255 : qx[8:1]) : (clx ? 8'd128 : qx1[8:1]);
-        s17_ry  <= s16_ey ? (ovy ? 8'd255 : qy[8:1]) : (cly ? 8'd128 : qy1[8:1]);
-        s17_ex  <= s16_ex;
-        s17_ey  <= s16_ey;
-        s17_sgx <= s16_sgx;
-        s17_sgy <= s16_sgy;
-        s17_mok <= s16_mok;
-        s17_bias <= s16_bias;
-        s17_flags <= {s16_mok, s16_edge, s16_sat, s16_fb | clx | cly};
-    end
-    wire [7:0] bx18, by18;
-    fmt_interp_bias_rom u_bias_x (.clk(clk), .addr_i({s17_ex, s17_mok, s17_rx}), .data_o(bx18));
-    fmt_interp_bias_rom u_bias_y (.clk(clk), .addr_i({s17_ey, s17_mok, s17_ry}), .data_o(by18));
-    reg [7:0] s18_rx, s18_ry;
-    reg       s18_sgx, s18_sgy, s18_bias, s18_ex, s18_ey;
-    always @(posedge clk) begin
-        s18_rx <= s17_rx; s18_ry <= s17_ry;
-        s18_sgx <= s17_sgx; s18_sgy <= s17_sgy; s18_bias <= s17_bias;
-        s18_ex <= s17_ex; s18_ey <= s17_ey;
-    end
-    wire [ROW_W-1:0] row18;
-    wire [COL_W-1:0] col18;
-    fmt_interp_dly #(.W(ROW_W + COL_W), .N(17), .RST(0)) u_dly_rc (
-        .clk(clk), .rst(rst), .d_i({s1_row, s1_col}), .q_o({row18, col18}));
-    // s19: the offsets (table or rounded quotient) and their cells; s20: coordinates
-    reg [7:0]        s19_ox, s19_oy;
-    reg              s19_sgx, s19_sgy;
-    reg [ROW_W-1:0]  s19_row;
-    reg [COL_W-1:0]  s19_col;
-    always @(posedge clk) begin
-        s19_ox  <= (s18_bias | s18_ex) ? bx18 : s18_rx;
-        s19_oy  <= (s18_bias | s18_ey) ? by18 : s18_ry;
+        s19_rx  <= s18_ex ? (ovx ? 8'd255 : qx[8:1]) : (clx ? 8'd128 : qx1[8:1]);
+        s19_ry  <= s18_ey ? (ovy ? 8'd255 : qy[8:1]) : (cly ? 8'd128 : qy1[8:1]);
+        s19_ex  <= s18_ex;
+        s19_ey  <= s18_ey;
         s19_sgx <= s18_sgx;
         s19_sgy <= s18_sgy;
-        s19_row <= row18;
-        s19_col <= col18;
+        s19_mok <= s18_mok;
+        s19_bias <= s18_bias;
+        s19_flags <= {s18_mok, s18_edge, s18_sat, s18_fb | clx | cly};
     end
-    wire signed [18:0] colq = {{(11-COL_W){1'b0}}, s19_col, 8'd0};
-    wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, s19_row, 8'd0};
-    wire signed [18:0] oxs  = {11'd0, s19_ox};
-    wire signed [18:0] oys  = {11'd0, s19_oy};
-    wire signed [18:0] xs = s19_sgx ? colq - oxs : colq + oxs;
-    wire signed [18:0] ys = s19_sgy ? rowq - oys : rowq + oys;
+    wire [7:0] bx21, by21;
+    fmt_interp_bias_rom u_bias_x (.clk(clk), .addr_i({s19_ex, s19_mok, s19_rx}), .data_o(bx21));
+    fmt_interp_bias_rom u_bias_y (.clk(clk), .addr_i({s19_ey, s19_mok, s19_ry}), .data_o(by21));
+    wire [7:0] rx21, ry21;
+    wire       sgx21, sgy21, bias21, ex21, ey21;
+    fmt_interp_dly #(.W(21), .N(2), .RST(0)) u_dly_rom (
+        .clk(clk), .rst(rst),
+        .d_i({s19_rx, s19_ry, s19_sgx, s19_sgy, s19_bias, s19_ex, s19_ey}),
+        .q_o({rx21, ry21, sgx21, sgy21, bias21, ex21, ey21}));
+    wire [ROW_W-1:0] row21;
+    wire [COL_W-1:0] col21;
+    fmt_interp_dly #(.W(ROW_W + COL_W), .N(20), .RST(0)) u_dly_rc (
+        .clk(clk), .rst(rst), .d_i({s1_row, s1_col}), .q_o({row21, col21}));
+    // s22: the offsets (table or rounded quotient) and their cells; s23: coordinates
+    reg [7:0]        s22_ox, s22_oy;
+    reg              s22_sgx, s22_sgy;
+    reg [ROW_W-1:0]  s22_row;
+    reg [COL_W-1:0]  s22_col;
+    always @(posedge clk) begin
+        s22_ox  <= (bias21 | ex21) ? bx21 : rx21;
+        s22_oy  <= (bias21 | ey21) ? by21 : ry21;
+        s22_sgx <= sgx21;
+        s22_sgy <= sgy21;
+        s22_row <= row21;
+        s22_col <= col21;
+    end
+    wire signed [18:0] colq = {{(11-COL_W){1'b0}}, s22_col, 8'd0};
+    wire signed [18:0] rowq = {{(11-ROW_W){1'b0}}, s22_row, 8'd0};
+    wire signed [18:0] oxs  = {11'd0, s22_ox};
+    wire signed [18:0] oys  = {11'd0, s22_oy};
+    wire signed [18:0] xs = s22_sgx ? colq - oxs : colq + oxs;
+    wire signed [18:0] ys = s22_sgy ? rowq - oys : rowq + oys;
     localparam signed [18:0] XMAX = (COLS - 1) * 256;
     localparam signed [18:0] YMAX = (ROWS - 1) * 256;
-    reg [15:0] s20_x, s20_y;
+    reg [15:0] s23_x, s23_y;
     /* verilator lint_off WIDTHTRUNC */ // clamped values fit 16 bits
     always @(posedge clk) begin
-        s20_x <= xs[18] ? 19'sd0 : (xs > XMAX ? XMAX : xs);
-        s20_y <= ys[18] ? 19'sd0 : (ys > YMAX ? YMAX : ys);
+        s23_x <= xs[18] ? 19'sd0 : (xs > XMAX ? XMAX : xs);
+        s23_y <= ys[18] ? 19'sd0 : (ys > YMAX ? YMAX : ys);
     end
     /* verilator lint_on WIDTHTRUNC */
-    fmt_interp_dly #(.W(32), .N(4), .RST(0)) u_dly_xy (
-        .clk(clk), .rst(rst), .d_i({s20_x, s20_y}), .q_o({tp_x_o, tp_y_o}));
+    fmt_interp_dly #(.W(32), .N(1), .RST(0)) u_dly_xy (
+        .clk(clk), .rst(rst), .d_i({s23_x, s23_y}), .q_o({tp_x_o, tp_y_o}));
     wire [3:0] flags24;
-    fmt_interp_dly #(.W(4), .N(7), .RST(0)) u_dly_flg (
-        .clk(clk), .rst(rst), .d_i(s17_flags), .q_o(flags24));
+    fmt_interp_dly #(.W(4), .N(5), .RST(0)) u_dly_flg (
+        .clk(clk), .rst(rst), .d_i(s19_flags), .q_o(flags24));
     fmt_interp_dly #(.W(Z), .N(LAT - 1), .RST(0)) u_dly_str (
         .clk(clk), .rst(rst), .d_i(s1_z[4]), .q_o(tp_strength_o));
 

@@ -3,8 +3,9 @@
 // Pre-rotation: when u < 0, (u, v) -> (-u, -v) and the angle starts at pi; then N
 // iterations i = 0..N-1: if v >= 0 {u += v >>> i; v -= u >>> i; z += atan(2^-i)} else
 // the opposite (arithmetic shifts truncate toward -inf; u and v update from the old
-// values).  Outputs: mag_o = u_N ~ K_N * |(u, v)| (K_12 = 1.64676), ang_o = z mod 2^16
-// in units of 2 pi / 65536 (= atan2(v, u)).  Table atan(2^-i) in the same unit, rounded;
+// values; each update is one adder, its operand inverted with a carry in to subtract).
+// Outputs: mag_o = u_N ~ K_N * |(u, v)| (K_12 = 1.64676), ang_o = z mod 2^16 in units
+// of 2 pi / 65536 (= atan2(v, u)).  Table atan(2^-i) in the same unit, rounded;
 // the model (fmt.interp.CORDIC_ATAN) generates it and sim/tests/test_interp.py checks
 // that this file holds the same numbers.
 // Latency: N + 1 clock cycles.  Twin: fmt.interp.cordic_fixed.
@@ -73,16 +74,15 @@ module fmt_interp_cordic #(
             localparam [15:0] AT = atan_tab(s);
             wire signed [W-1:0] us = u_q[s] >>> s;
             wire signed [W-1:0] vs = v_q[s] >>> s;
+            // one adder per word: the operand inverted (plus a carry in) subtracts
+            wire                neg = v_q[s][W-1];
+            wire [W-1:0]        u_n = u_q[s] + (vs ^ {W{neg}}) + {{(W-1){1'b0}}, neg};
+            wire [W-1:0]        v_n = v_q[s] + (us ^ {W{~neg}}) + {{(W-1){1'b0}}, ~neg};
+            wire [15:0]         z_n = z_q[s] + (AT ^ {16{neg}}) + {15'd0, neg};
             always @(posedge clk) begin
-                if (!v_q[s][W-1]) begin
-                    u_q[s+1] <= u_q[s] + vs;
-                    v_q[s+1] <= v_q[s] - us;
-                    z_q[s+1] <= z_q[s] + AT;
-                end else begin
-                    u_q[s+1] <= u_q[s] - vs;
-                    v_q[s+1] <= v_q[s] + us;
-                    z_q[s+1] <= z_q[s] - AT;
-                end
+                u_q[s+1] <= u_n;
+                v_q[s+1] <= v_n;
+                z_q[s+1] <= z_n;
                 if (rst) vld_q[s+1] <= 1'b0;
                 else     vld_q[s+1] <= vld_q[s];
             end

@@ -5,7 +5,8 @@
 // n < 8 the missing bits are zeros), LOG_ROM[m] = round(4096 * log2(1 + (m + 0.5)/256))
 // (12 fractional bits, < 4096).  Error |lg_o/4096 - log2 x| <= 0.0028 + 1/8192.
 // x = 0 gives n = 0 and an undefined fraction (callers check x > 0).
-// ROM rtl/fmt_interp_log.hex (256 x 12 bit) is written by `python -m fmt.generate`.
+// ROM rtl/fmt_interp_log.hex (256 x 12 bit, block RAM) is written by
+// `python -m fmt.generate`.
 // Latency: 3 clock cycles.  Twin: fmt.interp.lg_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -19,6 +20,7 @@ module fmt_interp_lg #(
 );
     localparam NB = $clog2(X_W);
 
+    (* rom_style = "block" *)
     reg [11:0] rom [0:255];
     initial begin
 `ifdef FMT_ROM_DIR
@@ -31,7 +33,7 @@ module fmt_interp_lg #(
     // The search in two steps of 8 bits (x zero-extended to XP = 8 * NG bits):
     // s1: the highest non-zero byte g and the 16-bit window x[8g+7 : 8g-8] (zeros
     //     below bit 0); s2: the leading one p of the window's top byte and the 8 bits
-    //     after it, n = 8 g + p; s3: ROM.
+    //     after it, n = 8 g + p, and the ROM read (block RAM); s3: the read data registered.
     localparam NG = (X_W + 7) / 8;                  // bytes
     localparam GB = (NG > 1) ? $clog2(NG) : 1;      // byte index width
     localparam XP = 8 * NG;
@@ -73,14 +75,14 @@ module fmt_interp_lg #(
     wire [NB-1:0] n_d = {g_q, p_d};
     /* verilator lint_on WIDTHEXPAND */
 
+    // s2: the block RAM's read register (address m_d), s3: its output register
     reg [NB-1:0] n_q, n2_q;
-    reg [7:0]    m_q;
-    reg [11:0]   f_q;
+    reg [11:0]   rd_q, f_q;
     always @(posedge clk) begin
         n_q  <= n_d;
-        m_q  <= m_d;
+        rd_q <= rom[m_d];
         n2_q <= n_q;
-        f_q  <= rom[m_q];
+        f_q  <= rd_q;
     end
     assign lg_o = {n2_q, f_q};
 endmodule
