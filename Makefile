@@ -10,6 +10,7 @@
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
 #   make synth-core  the whole default core in one Yosys run -> build/synth/core_default.json
 #   make timing  routed ECP5 Fmax and xc5v logic depth of every block -> build/timing/report.json
+#   make board-xc5v  write the XC5VSX95T board's ISE project (fpga/xc5vsx95t; ISE not here)
 # Every target installs what it needs the first time (iverilog from Debian, a pinned
 # Python environment in .venv); a second run reinstalls nothing.
 
@@ -33,7 +34,7 @@ PORT         ?= 5555
 SIM          ?=
 export SIM
 
-.PHONY: all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: board-xc5v all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -127,6 +128,11 @@ synth-core: setup
 # TIMING.md (scripts/timing_blocks.json; about an hour); timing-smoke: two small blocks
 timing: setup
 	$(VPY) scripts/timing.py
+
+# the XC5VSX95T board: writes the ISE project (FuseSoC/edalize); without ISE it stops
+# with one line after writing it (fpga/xc5vsx95t/README.md)
+board-xc5v: setup
+	$(MAKE) -C fpga/xc5vsx95t
 
 timing-smoke: setup
 	$(VPY) scripts/timing.py --smoke --report smoke_report.json

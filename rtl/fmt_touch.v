@@ -32,10 +32,11 @@
 //
 // Latency, processing-clock cycles from the frame's last heat-map row beat (hm_eof on
 // the next cycle) to its last event on ev_*, dial 0, consumer ready: flatten 5,
-// localmax 6 + n (n candidates; more when many maxima sit in the last rows),
-// interp 24, tracker events + 2 x stale picks + 3 after tp_eof (fmt.tracker.tail_cycles;
-// no stale picks unless touches compete for a slot), event port 5 -- measured by
-// tb/fmt_touch (see its docstring and the README for the numbers).
+// localmax <= 14 + n + m (n candidates, m maxima in the rows next to the last one;
+// 12 + n without them), interp 24, tracker m + l + n + 7 after tp_eof for m moves, l
+// lifts, n news without stale picks (see fmt_tracker's header; stale picks only when
+// touches compete for a slot), event port 5 -- measured by tb/fmt_touch (see its
+// docstring and the README for the numbers).
 `default_nettype none
 `include "fmt_defaults.vh"
 
