@@ -211,24 +211,8 @@ struct Channel {
     static std::vector<uint64_t> read_hex(const std::string& path) {
         FILE* f = std::fopen(path.c_str(), "rb");
         if (!f) die("cannot open " + path);
-        std::string buf;
-        char tmp[1 << 16];
-        size_t n;
-        while ((n = std::fread(tmp, 1, sizeof tmp, f)) > 0) buf.append(tmp, n);
         std::fclose(f);
-        std::vector<uint64_t> out;
-        uint64_t v = 0;
-        bool in = false;
-        for (const char ch : buf) {
-            int d = -1;
-            if (ch >= '0' && ch <= '9') d = ch - '0';
-            else if (ch >= 'a' && ch <= 'f') d = ch - 'a' + 10;
-            else if (ch >= 'A' && ch <= 'F') d = ch - 'A' + 10;
-            if (d >= 0) { v = (v << 4) | static_cast<uint64_t>(d); in = true; }
-            else if (in) { out.push_back(v); v = 0; in = false; }
-        }
-        if (in) out.push_back(v);
-        return out;
+        return Effects::read_hex(path);         // the one hex parser (channel_fx.h)
     }
 
     void load_effects(const Job& j) {
