@@ -30,7 +30,7 @@
 //            (R1..R_SB again, reinserted SB + 1 cycles later; several in flight, no
 //            assignment meanwhile).  Empty queue, nothing in flight: MATCH ends.
 //            The loop is only the head's compare-and-select: no search in the loop.
-//   EV       in the cycle MATCH ends and after: one lift per cycle (lowest slot first,
+//   EV       from the cycle after MATCH ends: one lift per cycle (lowest slot first,
 //            active, unmatched, miss + 1 >= hold_off_i), then one new per cycle
 //            (unmatched touches in arrival order; the first free slot after the
 //            round-robin pointer; generation + 1; no free slot: dropped, sticky
@@ -48,9 +48,11 @@
 // Latency (tp_eof in cycle c, the frame's last touch in cycle a <= c; SB = 4 at 16
 // slots): first MATCH decision in cycle d0 = max(c + 1, a + SB + 3); without stale
 // pops MATCH ends m cycles later (m moves); l lifts and n news take one cycle each;
-// the last event is on the output in cycle d0 + m + l + n + 1, i.e. m + l + n + 7
-// cycles after tp_eof when the last touch came the cycle before (was m + 2k + l + n +
-// d + 4 with k stale picks and d touches without a slot, which now cost nothing).
+// the last event is on the output in cycle d0 + m + l + n + 1 + e (e = 1 if l + n > 0:
+// lifts and news start the cycle after MATCH ends, so that their masks and picks come
+// from registers only), i.e. m + l + n + 7 + e cycles after tp_eof when the last touch
+// came the cycle before (was m + 2k + l + n + d + 4 with k stale picks and d touches
+// without a slot, which now cost nothing).
 // Stale pops: 1 cycle each, and the round waits for the last recomputed key (SB + 1
 // cycles).  Worst case (16 touches ranking 16 slots alike: 120 stale pops): MATCH 211,
 // last event 218 cycles after tp_eof (was 260), busy 4 cycles more; with the 16 touch
@@ -386,10 +388,11 @@ module fmt_tracker #(
     wire [MT-1:0] tused_n = tused_q | asg_t;
     wire [MT-1:0] tval_n  = tval_q | (arrive ? (one << wa_t) : {MT{1'b0}});
 
-    wire          ev_ph    = m_done | state_q[2];
-    wire          iss_lift = ev_ph & l_any_q;
-    wire          iss_new  = ev_ph & ~l_any_q & u_any_q & f_any_q;
-    wire          ev_done  = ev_ph & ~l_any_q & ~(u_any_q & f_any_q);
+    // lifts and news issue from the cycle after MATCH ends (EV), so the masks and their
+    // picks update from registers only; a frame with none ends in the m_done cycle
+    wire          iss_lift = state_q[2] & l_any_q;
+    wire          iss_new  = state_q[2] & ~l_any_q & u_any_q & f_any_q;
+    wire          ev_done  = (m_done | state_q[2]) & ~l_any_q & ~(u_any_q & f_any_q);
     wire          iss_upd  = state_q[3] & p_any_q;
     wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
     wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
@@ -403,8 +406,9 @@ module fmt_tracker #(
         src_d = src_q;
         upm_d = upm_q;
         hm_d  = src_q;
-        if (state_q[0] || (state_q[1] && !m_done)) begin
-            // shadows of the pending lifts and news, exact when MATCH ends
+        if (state_q[0] || state_q[1]) begin
+            // shadows of the pending lifts and news, exact when MATCH ends (no
+            // assignment in that cycle, so they hold into EV)
             lm_d  = act_q & ~sused_n & lexp_q;
             um_d  = tval_n & ~tused_n;
             fm_d  = ~act_q;
@@ -423,7 +427,9 @@ module fmt_tracker #(
             hm_d  = src_q & ~f_pick_q;
             src_d = (|hm_d) ? hm_d : fm_d;
         end
-        if (ev_done)
+        // hold-off updates: tracked from the registers until UPD (act_q and sused_q are
+        // final in the ev_done cycle, which issues nothing), then one pick per update
+        if (!state_q[3])
             upm_d = act_q & ~sused_q;
         else if (iss_upd)
             upm_d = upm_q & ~p_pick_q;
@@ -629,7 +635,7 @@ module fmt_tracker #(
                     if (f_pick_q[s_i])
                         gen_q[s_i*GEN_W +: GEN_W] <= gen_q[s_i*GEN_W +: GEN_W] + 1'b1;
             end
-            if (ev_ph) state_q <= S_EV;
+            if (m_done) state_q <= S_EV;
             if (ev_done) begin
                 if (u_any_q) noslot_flag_o <= 1'b1;
                 state_q <= S_UPD;

@@ -9,10 +9,10 @@ frame.  Also measures and checks the tail latency: the frame's last event is on 
 output exactly tail_latency cycles after the tp_eof cycle (a cycle model of the RTL's
 pipeline: the last touch's key reaches the sorted queue SB + 3 cycles after it came,
 match_cycles replays the queue's assignments and stale pops on the model's candidate
-matrix, then one cycle per lift and new), and that busy_o falls 4 cycles after that
-(h + 5 with h contacts in hold-off, updated one per cycle).  The worst case of the
-match (all touches ranking the slots alike, 120 stale pops at 16) is a test of its
-own; the lazy model's stale picks (fmt.tracker.lazy_greedy) are logged beside.
+matrix, then, with lifts or news, one cycle and one per lift and new), and that busy_o
+falls 4 cycles after that (h + 5 with h contacts in hold-off, updated one per cycle).
+The worst case of the match (all touches ranking the slots alike, 120 stale pops at
+16) is a test of its own; the lazy model's stale picks (fmt.tracker.lazy_greedy) are logged beside.
 """
 from __future__ import annotations
 
@@ -199,13 +199,14 @@ def tail_latency(events, dm, eof: int, last_touch, sb: int) -> tuple[int, int]:
     after edge eof + lat - 1 (a plain register would be lat = 1).  The last touch (edge
     ``last_touch``) has its key in the queue sb + 3 cycles later (A1 distances, A2 row
     write, sb tree stages, insert), MATCH starts the cycle after tp_eof: first decision
-    d0 = max(1, last_touch + sb + 3 - eof) cycles after it; then match_cycles; then one cycle
-    per lift and new (issued in the cycle MATCH ends), and the cycle that marks the
-    last event.  Returns (lat, stale pops)."""
+    d0 = max(1, last_touch + sb + 3 - eof) cycles after it; then match_cycles; then, if
+    the frame has lifts or news, one cycle (they issue from the cycle after MATCH ends)
+    and one cycle per lift and new; and the cycle that marks the last event.
+    Returns (lat, stale pops)."""
     mc, pops = match_cycles(dm, sb) if dm is not None else (0, 0)
     d0 = max(1, last_touch + sb + 3 - eof) if last_touch is not None else 1
     ln = sum(1 for e in events if e.type in ("lift", "new"))
-    return d0 + mc + ln + 1, pops
+    return d0 + mc + ln + (1 if ln else 0) + 1, pops
 
 
 async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=None,
