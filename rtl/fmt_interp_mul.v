@@ -7,7 +7,7 @@
 // registered straight at the multiplier output (the M register); the next stage adds the
 // partial products shifted by 17 / 34 bits (the cascade adder) into the P register.
 // Operands come from the caller's flip-flops (the multipliers' A/B registers), which
-// must be fed by logic, not by a plain delay line (Yosys would merge that into SRLs).
+// must be fed by a computed value, not by a plain delay line (Yosys would merge that into SRLs).
 // Latency: 2 clock cycles (M, P).  Twin: the products of fmt.interp.interp_fixed.
 `default_nettype none
 `include "fmt_defaults.vh"

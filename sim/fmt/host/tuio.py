@@ -89,7 +89,7 @@ def _osc_message(addr: str, args: list, now: float):
     b = OscMessageBuilder(addr)
     timetag = None
     for v in args:
-        if v is None:                          # frm's time tag: an 8-byte placeholder
+        if v is None:                          # frm's time tag: an 8-byte slot patched below
             timetag = ntp.system_time_to_ntp(now)
             b.add_arg(0, b.ARG_TYPE_INT64)
         elif isinstance(v, float):
@@ -101,7 +101,7 @@ def _osc_message(addr: str, args: list, now: float):
     msg = b.build()
     if timetag is None:
         return msg
-    # python-osc builds no 't' argument: the int64 placeholder has the time tag's size,
+    # python-osc builds no 't' argument: the int64 slot has the time tag's size,
     # so its type letter and its 8 bytes are replaced in place
     dg = bytearray(msg.dgram)
     tags_at = dg.index(b",", len(addr))
@@ -109,7 +109,7 @@ def _osc_message(addr: str, args: list, now: float):
     k = dg.index(b"h", tags_at, tags_end)
     dg[k] = ord("t")
     pos = (tags_end // 4 + 1) * 4
-    for ch in dg[tags_at + 1:k].decode():  # args before the placeholder
+    for ch in dg[tags_at + 1:k].decode():  # args before the slot
         pos += 4 if ch in "if" else 8 if ch in "hdt" else 0
     dg[pos:pos + 8] = timetag
     return OscMessage(bytes(dg))
