@@ -76,5 +76,57 @@ module fmt_div #(
     assign valid_o = vld_q[QW];
     assign ovf_o   = ovf_q[QW];
     assign quot_o  = ovf_q[QW] ? {QW{1'b1}} : lq_q[QW];
+
+`ifdef FORMAL
+    // Formal properties (SymbiYosys, formal/fmt_div.sby; never seen by synthesis).
+    // A shadow pipeline carries each input beside its stage and multiplies the
+    // quotient bits decided so far by the divisor, by shift and add (f_prod): in stage s
+    // the partial remainder, the numerator bits still to use and that product add up
+    // to the numerator, and the remainder stays below the divisor; at the output this
+    // says quot * den <= num < (quot + 1) * den.  Overflow: ovf_o == (num >= den * 2^QW).
+    localparam FW = NUM_W + QW + DEN_W + 1;          // no sum or shift can overflow
+    reg f_past_q = 1'b0;
+    always @(posedge clk) f_past_q <= 1'b1;
+    always @(*) if (!f_past_q) assume (rst);
+    genvar fs;
+    generate
+        for (fs = 0; fs <= QW; fs = fs + 1) begin : g_f
+            reg [NUM_W-1:0] num_q;                   // the stage's input
+            reg [FW-1:0]    prod_q;                  // its quotient bits so far x den, aligned
+            reg             full_q = 1'b0;           // the stage holds a real input
+            reg             f_vld;                   // its valid_i (reset clears)
+            if (fs == 0) begin : g_in
+                always @(posedge clk) begin
+                    num_q  <= num_i;
+                    prod_q <= {FW{1'b0}};
+                    full_q <= 1'b1;
+                    f_vld  <= rst ? 1'b0 : valid_i;
+                end
+            end else begin : g_step
+                always @(posedge clk) begin
+                    num_q  <= g_f[fs-1].num_q;
+                    prod_q <= g_f[fs-1].prod_q
+                              + (g_stage[fs-1].take ? ({{(FW-DEN_W){1'b0}}, den_q[fs-1]} << (QW - fs)) : {FW{1'b0}});
+                    full_q <= g_f[fs-1].full_q;
+                    f_vld  <= rst ? 1'b0 : g_f[fs-1].f_vld;
+                end
+            end
+            // numerator bits not yet used, and the remainder, at their weight
+            wire [FW-1:0] rest = ({{(FW-DEN_W){1'b0}}, rem_q[fs]} << (QW - fs))
+                                 + (lq_q[fs] >> fs);
+            wire [FW-1:0] n    = {{(FW-NUM_W){1'b0}}, num_q};
+            wire [FW-1:0] d    = {{(FW-DEN_W){1'b0}}, den_q[fs]};
+            always @(posedge clk) begin
+                if (f_past_q && full_q) begin
+                    assert (ovf_q[fs] == (n >= (d << QW)));
+                    if (!ovf_q[fs]) assert (rest + prod_q == n && rem_q[fs] < den_q[fs]);
+                end
+                if (f_past_q) assert (vld_q[fs] == f_vld);
+                if (f_past_q && $past(rst)) assert (!vld_q[fs]);
+            end
+        end
+    endgenerate
+    always @(posedge clk) if (f_past_q && g_f[QW].full_q && ovf_o) assert (quot_o == {QW{1'b1}});
+`endif
 endmodule
 `default_nettype wire

@@ -273,6 +273,86 @@ module fmt_latency #(
             hist_data_o <= hist_first_ok_q[hist_addr_i] ? hist_first_mem[hist_addr_i] : {NUM_W{1'b0}};
     end
 
+`ifdef FORMAL
+    // Formal properties (SymbiYosys, formal/fmt_latency.sby, at small widths; never seen
+    // by synthesis): counters saturate instead of wrapping and say so, the histograms
+    // count every measured event exactly once (bin forwarding included), reset and
+    // clear give the documented state one cycle later.
+    reg f_past_q = 1'b0;
+    always @(posedge clk) f_past_q <= 1'b1;
+    always @(*) if (!f_past_q) assume (rst);
+    // shadow counts of the events through stage 1, one bit wider, stopping at 2^NUM_W
+    localparam [NUM_W:0] F_TOP = {1'b1, {NUM_W{1'b0}}};
+    localparam [NUM_W-1:0] F_MAX = {NUM_W{1'b1}};
+    reg [NUM_W:0] f_nf_q, f_nl_q, f_nt_q;
+    always @(posedge clk) begin
+        if (rst || clear_i) begin
+            f_nf_q <= {(NUM_W+1){1'b0}};
+            f_nl_q <= {(NUM_W+1){1'b0}};
+            f_nt_q <= {(NUM_W+1){1'b0}};
+        end else begin
+            if (s1_first_q && f_nf_q != F_TOP) f_nf_q <= f_nf_q + 1'b1;
+            if (s1_last_q  && f_nl_q != F_TOP) f_nl_q <= f_nl_q + 1'b1;
+            if (s1_trig_q  && f_nt_q != F_TOP) f_nt_q <= f_nt_q + 1'b1;
+        end
+    end
+    // what a reader of the histograms sees, summed over the bins
+    localparam SUM_W = NUM_W + HIST_BINS_W + 1;
+    reg [SUM_W-1:0] f_hf_sum, f_hl_sum;
+    integer fb;
+    always @(*) begin
+        f_hf_sum = {SUM_W{1'b0}};
+        f_hl_sum = {SUM_W{1'b0}};
+        for (fb = 0; fb < BINS; fb = fb + 1) begin
+            if (hist_first_ok_q[fb]) f_hf_sum = f_hf_sum + hist_first_mem[fb];
+            if (hist_last_ok_q[fb])  f_hl_sum = f_hl_sum + hist_last_mem[fb];
+        end
+    end
+    wire [NUM_W-1:0] f_nf = f_nf_q[NUM_W] ? F_MAX : f_nf_q[NUM_W-1:0];
+    wire [NUM_W-1:0] f_nl = f_nl_q[NUM_W] ? F_MAX : f_nl_q[NUM_W-1:0];
+    wire [NUM_W-1:0] f_nt = f_nt_q[NUM_W] ? F_MAX : f_nt_q[NUM_W-1:0];
+    always @(posedge clk) begin
+        if (f_past_q && !$past(rst)) begin
+            // counts: exact below the top, then stuck at all ones with sat_o set
+            assert (first_count_o == f_nf && last_count_o == f_nl && trig_count_o == f_nt);
+            assert (f_nf_q <= F_TOP && f_nl_q <= F_TOP && f_nt_q <= F_TOP);
+            if (f_nf_q[NUM_W] || f_nl_q[NUM_W] || f_nt_q[NUM_W]) assert (sat_o);
+            // sat_o is sticky
+            assert (!$past(sat_o) || sat_o);
+            // min / last / max are ordered once there is an event, untouched before
+            if (first_count_o != 0) assert (first_min_o <= first_last_o && first_last_o <= first_max_o);
+            else                    assert (first_min_o == CNT_MAX && first_max_o == 0);
+            if (last_count_o != 0)  assert (last_min_o <= last_last_o && last_last_o <= last_max_o);
+            else                    assert (last_min_o == CNT_MAX && last_max_o == 0);
+            if (trig_count_o != 0)  assert (trig_min_o <= trig_last_o && trig_last_o <= trig_max_o);
+            else                    assert (trig_min_o == CNT_MAX && trig_max_o == 0);
+            // the histograms hold every counted event once: the bins plus the event in
+            // stage 2 are the count (while nothing saturated)
+            if (!sat_o) begin
+                assert (f_hf_sum + s2_first_q == first_count_o);
+                assert (f_hl_sum + s2_last_q  == last_count_o);
+            end
+            // the forwarded value is the bin's stored value (inductive helpers)
+            if (fw_f_q) assert (hist_first_ok_q[s2_bin_q] && hist_first_mem[s2_bin_q] == fw_f_val_q);
+            if (fw_l_q) assert (hist_last_ok_q[s2_bin_q]  && hist_last_mem[s2_bin_q]  == fw_l_val_q);
+            if (s2_first_q && !fw_f_q) assert (s2_hf_q == (hist_first_ok_q[s2_bin_q] ? hist_first_mem[s2_bin_q] : {NUM_W{1'b0}}));
+            if (s2_last_q  && !fw_l_q) assert (s2_hl_q == (hist_last_ok_q[s2_bin_q]  ? hist_last_mem[s2_bin_q]  : {NUM_W{1'b0}}));
+            // a clear empties the statistics and the pipeline one cycle later
+            if ($past(clear_i))
+                assert (first_count_o == 0 && last_count_o == 0 && trig_count_o == 0 &&
+                        hist_first_ok_q == 0 && hist_last_ok_q == 0 && !s2_first_q && !s2_last_q);
+        end
+        // one cycle after reset: the reset state
+        if (f_past_q && $past(rst))
+            assert (now_q == 0 && !sat_o && !trig_armed_o && stamp_ok_q == 0 &&
+                    seen_first_q == {SLOTS{1'b1}} && trig_sync_q == 3'b000 &&
+                    !s1_first_q && !s1_last_q && !s1_trig_q && !s2_first_q && !s2_last_q &&
+                    !fw_f_q && !fw_l_q && first_count_o == 0 && last_count_o == 0 &&
+                    trig_count_o == 0 && first_min_o == CNT_MAX && first_max_o == 0 &&
+                    hist_first_ok_q == 0 && hist_last_ok_q == 0);
+    end
+`endif
+
 endmodule
 
 `default_nettype wire
