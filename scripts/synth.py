@@ -66,6 +66,14 @@ def summarize(cells: dict[str, int]) -> dict:
 
 
 WIDEMUX = 0   # --widemux N: synth_xilinx -widemux N (wide muxes on MUXF7/MUXF8, as XST maps them)
+ABC = "abc9"  # --abc plain: the LUT mapping step with Yosys's plain `abc` instead of `abc9`
+
+# synth_xilinx's map_luts step (`help synth_xilinx`, xc5v: LUT6, wide LUTs on MUXF7/MUXF8)
+# with `abc` in place of `abc9`; the other steps are synth_xilinx's own
+PLAIN_ABC_MAP_LUTS = ("opt_expr -mux_undef -noclkinv; abc -luts 2:2,3,6:5,10,20; clean; "
+                      "xilinx_srl -fixed -minlen 3; "
+                      "techmap -map +/xilinx/lut_map.v -map +/xilinx/cells_map.v -D LUT_WIDTH=6; "
+                      "xilinx_dffopt; opt_lut_ins -tech xilinx; ")
 
 
 def synth_one(top: str, params: dict, label: str) -> dict:
@@ -73,12 +81,14 @@ def synth_one(top: str, params: dict, label: str) -> dict:
     files = " ".join(str(p) for p in sources(top))
     incs = " ".join(f"-I{d}" for d in INCLUDE_DIRS)
     chparam = " ".join(f"-set {k} {v}" for k, v in params.items())
-    tag = label + (f"_wm{WIDEMUX}" if WIDEMUX else "")
+    tag = label + (f"_wm{WIDEMUX}" if WIDEMUX else "") + ("_abc" if ABC == "plain" else "")
     stat_json = OUT / f"{tag}.stat.json"
+    synth = f"synth_xilinx -family xc5v -top {top} -noiopad" + (f" -widemux {WIDEMUX}" if WIDEMUX else "")
+    if ABC == "plain":
+        synth = f"{synth} -run :map_luts; {PLAIN_ABC_MAP_LUTS}{synth} -run finalize:"
     script = (f"read_verilog {incs} {files}; "
               + (f"chparam {chparam} {top}; " if chparam else "")
-              + f"synth_xilinx -family xc5v -top {top} -noiopad"
-              + (f" -widemux {WIDEMUX}" if WIDEMUX else "") + "; "
+              + synth + "; "
               + f"tee -q -o {stat_json} stat -json")
     t0 = time.time()
     log = OUT / f"{tag}.log"
@@ -108,9 +118,12 @@ def main(argv=None) -> int:
     ap.add_argument("--report", default="report.json", help="file name under build/synth/")
     ap.add_argument("--widemux", type=int, default=0,
                     help="synth_xilinx -widemux N (default off: wide muxes as LUT trees)")
+    ap.add_argument("--abc", choices=("abc9", "plain"), default="abc9",
+                    help="LUT mapper: abc9 (synth_xilinx's default) or plain abc")
     a = ap.parse_args(argv)
-    global WIDEMUX
+    global WIDEMUX, ABC
     WIDEMUX = a.widemux
+    ABC = a.abc
     cfg = json.loads(TOPS.read_text()) if TOPS.exists() else {}
     jobs = []   # (label, top, params)
     for name in module_names():
@@ -136,7 +149,7 @@ def main(argv=None) -> int:
             except Exception as e:  # report every failure, then fail
                 failed.append(label)
                 print(f"{label}: FAILED\n{e}", file=sys.stderr)
-    report = {"part": PART, "widemux": a.widemux, "modules": results}
+    report = {"part": PART, "widemux": a.widemux, "abc": a.abc, "modules": results}
     # The whole core at the default size is too large for a quick Yosys run, so its use
     # of the part is the sum of its blocks' separate syntheses, each counted as many
     # times as the core instantiates it (_core_sum: [[label, count], ...]).
