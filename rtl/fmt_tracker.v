@@ -319,13 +319,47 @@ module fmt_tracker #(
     wire [SB-1:0] h_t = qt_q[0 +: SB];
     wire [SB-1:0] h_s = qs_q[0 +: SB];
 
+    // The key's compare with every entry is made a cycle ahead, from the two nodes of
+    // the last tree stage (registers; the leaves when SB = 1), against the entries and
+    // the key inserted in that cycle; each result moves along with its entry (the same
+    // 4:1 select, c_qnext).  ca_q[i] / cb_q[i]: node a / b sorts before entry i (D, t);
+    // cs_q: b is the root (nmin).  The pair is exact whenever the root is a key.
+    wire [KW-1:0] nx_a, nx_b;                 // the root's two inputs' keys {invalid, D}
+    generate
+        if (SB >= 2) begin : g_nx
+            assign nx_a = tr_q[(MTP-4)*NW+SB +: KW];
+            assign nx_b = tr_q[(MTP-3)*NW+SB +: KW];
+        end else begin : g_nx1
+            assign nx_a = lf[SB +: KW];
+            assign nx_b = lf[NW+SB +: KW];
+        end
+    endgenerate
+    wire [SB-1:0] nx_t = rt_q[(SB-1)*SB +: SB];  // the next key's touch
+    reg  [MT-1:0] ca_q, cb_q;
+    reg           cs_q;
+    reg  [MT+1:0] ca_n, cb_n;      // now: node a / b before entry j - 1 (ends: don't care)
+    reg           ca_k, cb_k;      // now: node a / b before the key inserted now
+    always @* begin : c_qcmp
+        integer i;
+        ca_n[0] = 1'b1;
+        cb_n[0] = 1'b1;
+        for (i = 0; i < MT; i = i + 1) begin
+            ca_n[i+1] = {nx_a[DW-1:0], nx_t} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]};
+            cb_n[i+1] = {nx_b[DW-1:0], nx_t} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]};
+        end
+        ca_n[MT+1] = 1'b1;
+        cb_n[MT+1] = 1'b1;
+        ca_k = {nx_a[DW-1:0], nx_t} < {key_d_q, key_t_q};
+        cb_k = {nx_b[DW-1:0], nx_t} < {key_d_q, key_t_q};
+    end
+
     // xl[j]: the key sorts before entry j - 1 (or that entry is empty); xl[0] = 0
     reg  [MT+1:0]       xl;
     always @* begin : c_qlt
         integer i;
         xl[0] = 1'b0;
         for (i = 0; i < MT; i = i + 1)
-            xl[i+1] = ~qv_q[i] | ({key_d_q, key_t_q} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]});
+            xl[i+1] = ~qv_q[i] | (cs_q ? cb_q[i] : ca_q[i]);
         xl[MT+1] = 1'b1;
     end
     // next state of entry i, a 4:1 select per entry: 0 keep, 1 entry i + 1 (a pop),
@@ -360,7 +394,7 @@ module fmt_tracker #(
             qeq[i] = xq[(i+2)*QE+QE-1] && (xq[(i+2)*QE +: SB] == h_s);
         end
     end
-    reg [MT-1:0]    qv_d, qst_d;
+    reg [MT-1:0]    qv_d, qst_d, ca_d, cb_d;
     reg [MT*DW-1:0] qd_d;
     reg [MT*SB-1:0] qt_d, qs_d;
     always @* begin : c_qnext
@@ -368,10 +402,22 @@ module fmt_tracker #(
         reg [QE-1:0] e;
         for (i = 0; i < MT; i = i + 1) begin
             case (qsel[2*i +: 2])
-                2'd0:    e = xq[(i+1)*QE +: QE];
-                2'd1:    e = xq[(i+2)*QE +: QE];
-                2'd2:    e = xq[i*QE +: QE];
-                default: e = kq;
+                2'd0: begin
+                    e = xq[(i+1)*QE +: QE];
+                    {ca_d[i], cb_d[i]} = {ca_n[i+1], cb_n[i+1]};
+                end
+                2'd1: begin
+                    e = xq[(i+2)*QE +: QE];
+                    {ca_d[i], cb_d[i]} = {ca_n[i+2], cb_n[i+2]};
+                end
+                2'd2: begin
+                    e = xq[i*QE +: QE];
+                    {ca_d[i], cb_d[i]} = {ca_n[i], cb_n[i]};
+                end
+                default: begin
+                    e = kq;
+                    {ca_d[i], cb_d[i]} = {ca_k, cb_k};
+                end
             endcase
             {qv_d[i], qst_d[i], qd_d[i*DW +: DW], qt_d[i*SB +: SB], qs_d[i*SB +: SB]} = e;
             qst_d[i] = e[QE-2] | (q_asg & qeq[i]);   // an assignment pops: e is entry i + 1
@@ -529,6 +575,9 @@ module fmt_tracker #(
             qd_q           <= {(MT*DW){1'b0}};
             qt_q           <= {(MT*SB){1'b0}};
             qs_q           <= {(MT*SB){1'b0}};
+            ca_q           <= {MT{1'b0}};
+            cb_q           <= {MT{1'b0}};
+            cs_q           <= 1'b0;
             op_v_q         <= 1'b0;
             op_typ_q       <= T_NEW;
             op_t_q         <= {SB{1'b0}};
@@ -600,6 +649,9 @@ module fmt_tracker #(
             qd_q  <= qd_d;
             qt_q  <= qt_d;
             qs_q  <= qs_d;
+            ca_q  <= ca_d;
+            cb_q  <= cb_d;
+            cs_q  <= nx_b < nx_a;
 
             inflight_q <= arrive | a1_v_q | q_stale | (|rv_q[SB-1:0]);
 
