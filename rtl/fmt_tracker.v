@@ -19,10 +19,13 @@
 //            last frame, hold_jump_i in hold-off), the row {cand, D} per slot written
 //            to a LUT RAM.  R1..R_SB: the row read back and its minimum over the free
 //            candidate slots, key (D, s), ties to the lower slot, one tree level per
-//            stage (SB stages).  Then the key is inserted into a sorted queue.
+//            stage, the last two levels in one (a 4:1 minimum; SB - 1 tree stages, none
+//            at SB = 1); stage R_SB registers the key with its compare against every
+//            queue entry, made from the root a cycle ahead (the result moves along with
+//            its entry).  Then the key is inserted into a sorted queue.
 //   MATCH    (after tp_eof; greedy nearest pairs, smallest (D, t, s) first) the queue
 //            holds each touch's cached key sorted by (D, t), MAX_TOUCHES entries, insert and
-//            pop in one cycle (compare with every entry, 4:1 select).  Cached keys
+//            pop in one cycle (registered compare bits, 4:1 select).  Cached keys
 //            only grow as slots are taken, so each is a lower bound: per cycle, if the
 //            head's slot is free and no key is in flight, the head IS the greedy pair:
 //            it is assigned (a move) and every entry naming that slot marked stale; a
