@@ -472,16 +472,15 @@ module fmt_tracker #(
     wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
     wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
 
-    // next masks and their picks; src_d = hm_d when not empty, else sf_d (the free-slot
-    // pick: both lowest bits side by side, then the select)
-    reg  [MT-1:0] lm_d, um_d, fm_d, src_d, upm_d, hm_d, sf_d, fpk_d;
+    // next masks and their picks
+    reg  [MT-1:0] lm_d, um_d, fm_d, src_d, upm_d, hm_d;
     always @* begin
         lm_d  = lm_q;
         um_d  = um_q;
         fm_d  = fm_q;
+        src_d = src_q;
         upm_d = upm_q;
         hm_d  = src_q;
-        sf_d  = src_q;
         if (state_q[0] || state_q[1]) begin
             // shadows of the pending lifts and news, exact when MATCH ends (no
             // assignment in that cycle, so they hold into EV)
@@ -489,22 +488,20 @@ module fmt_tracker #(
             um_d  = tval_n & ~tused_n;
             fm_d  = ~act_q;
             hm_d  = ~act_q & therm_q;
-            sf_d  = fm_d;
+            src_d = (|hm_d) ? hm_d : fm_d;
         end else if (iss_lift) begin
             // the lifted slot is free for the news
             lm_d  = lm_q & ~l_pick_q;
             fm_d  = fm_q | l_pick_q;
             hm_d  = fm_d & therm_q;
-            sf_d  = fm_d;
+            src_d = (|hm_d) ? hm_d : fm_d;
         end else if (iss_new) begin
             // src: free slots after the last pick (from the pointer), else all free slots
             um_d  = um_q & ~u_pick_q;
             fm_d  = fm_q & ~f_pick_q;
             hm_d  = src_q & ~f_pick_q;
-            sf_d  = fm_d;
+            src_d = (|hm_d) ? hm_d : fm_d;
         end
-        src_d = (|hm_d) ? hm_d : sf_d;
-        fpk_d = (|hm_d) ? lowest(hm_d) : lowest(sf_d);
         // hold-off updates: tracked from the registers until UPD (act_q and sused_q are
         // final in the ev_done cycle, which issues nothing), then one pick per update
         if (!state_q[3])
@@ -699,7 +696,7 @@ module fmt_tracker #(
             upm_q    <= upm_d;
             l_pick_q <= lowest(lm_d);
             u_pick_q <= lowest(um_d);
-            f_pick_q <= fpk_d;
+            f_pick_q <= lowest(src_d);
             p_pick_q <= lowest(upm_d);
             l_any_q  <= |lm_d;
             u_any_q  <= |um_d;
