@@ -19,10 +19,13 @@
 //            last frame, hold_jump_i in hold-off), the row {cand, D} per slot written
 //            to a LUT RAM.  R1..R_SB: the row read back and its minimum over the free
 //            candidate slots, key (D, s), ties to the lower slot, one tree level per
-//            stage (SB stages).  Then the key is inserted into a sorted queue.
+//            stage, the last two levels in one (a 4:1 minimum; SB - 1 tree stages, none
+//            at SB = 1); stage R_SB registers the key with its compare against every
+//            queue entry, made from the root a cycle ahead (the result moves along with
+//            its entry).  Then the key is inserted into a sorted queue.
 //   MATCH    (after tp_eof; greedy nearest pairs, smallest (D, t, s) first) the queue
 //            holds each touch's cached key sorted by (D, t), MAX_TOUCHES entries, insert and
-//            pop in one cycle (compare with every entry, 4:1 select).  Cached keys
+//            pop in one cycle (registered compare bits, 4:1 select).  Cached keys
 //            only grow as slots are taken, so each is a lower bound: per cycle, if the
 //            head's slot is free and no key is in flight, the head IS the greedy pair:
 //            it is assigned (a move) and every entry naming that slot marked stale; a
@@ -128,7 +131,7 @@ module fmt_tracker #(
     localparam KW    = DW + 1;               // tree key {invalid, D}
     localparam NW    = KW + SB;              // tree node {invalid, D, slot}
     localparam RW    = MT * KW;              // distance-RAM row: {cand, D} per slot
-    localparam TN    = MTP - 1;              // row-minimum tree nodes (stage registers)
+    localparam TNN   = (MTP > 4) ? MTP - 4 : 1;  // 2:1 tree nodes in registers (none: 1 unused)
     localparam TD_W  = 16 + 16 + HM_W + 16 + 16 + 8 + 8;  // touch record width
 
     localparam [3:0] S_IDLE = 4'b0001, S_MATCH = 4'b0010, S_EV = 4'b0100, S_UPD = 4'b1000;
@@ -141,6 +144,27 @@ module fmt_tracker #(
         input [NW-1:0] b;
         begin
             nmin = (b[NW-1:SB] < a[NW-1:SB]) ? b : a;
+        end
+    endfunction
+    // smallest of four tree nodes, ties to the lowest (a, b, c, d = ascending slots):
+    // the six compares side by side, then one 4:1 select
+    function [NW-1:0] nmin4;
+        input [NW-1:0] a;
+        input [NW-1:0] b;
+        input [NW-1:0] c;
+        input [NW-1:0] d;
+        reg ba, ca, da, cb, db, dc;        // xy: x sorts strictly before y
+        begin
+            ba = b[NW-1:SB] < a[NW-1:SB];
+            ca = c[NW-1:SB] < a[NW-1:SB];
+            da = d[NW-1:SB] < a[NW-1:SB];
+            cb = c[NW-1:SB] < b[NW-1:SB];
+            db = d[NW-1:SB] < b[NW-1:SB];
+            dc = d[NW-1:SB] < c[NW-1:SB];
+            if (!ba && !ca && !da)     nmin4 = a;
+            else if (ba && !cb && !db) nmin4 = b;
+            else if (ca && cb && !dc)  nmin4 = c;
+            else                       nmin4 = d;
         end
     endfunction
     // index of a one-hot vector
@@ -204,12 +228,14 @@ module fmt_tracker #(
     reg                 a1_v_q;
     reg [SB-1:0]        a1_t_q;
     reg [MT*KW-1:0]     dq_q;                     // {D >= 2^16, D mod 2^16} per slot
-    // row minimum: request, R1, R2, R3 (key)
-    // (request = stage 0; tree stage k = 1..SB holds MTP >> k nodes from node
-    // MTP - (MTP >> (k - 1)); the root, node TN - 1, is the touch's key)
+    // row minimum: request (stage 0), tree stages 1..SB-1 (stage k < SB - 1 holds
+    // MTP >> k nodes from node MTP - (MTP >> (k - 1)); stage SB - 1 the root, the last two
+    // levels in one), key (stage SB: the root and its compares with the queue)
     reg [SB:0]          rv_q;                     // stage valid
     reg [(SB+1)*SB-1:0] rt_q;                     // stage touch index
-    reg [TN*NW-1:0]     tr_q;                     // tree nodes {invalid, D, slot}
+    reg [TNN*NW-1:0]    tr_q;                     // 2:1 tree nodes {invalid, D, slot}
+    reg [NW-1:0]        key_q;                    // the key {invalid, D, slot}
+    reg [MT-1:0]        kc_q;                     // the key sorts before entry i (D, t)
     // sorted key queue (entry 0 = head)
     reg [MT-1:0]        qv_q, qst_q;              // valid, stale (slot taken since)
     reg [MT*DW-1:0]     qd_q;
@@ -279,11 +305,12 @@ module fmt_tracker #(
     end
 
     // ---- row minimum over the free candidate slots, one tree level per stage -----------
-    // (ties to the lower slot; the leaves are the row read in stage 1)
+    // (ties to the lower slot; the leaves are the row read in stage 1; the last two
+    // levels in one stage, a 4:1 minimum; SB = 1: the one level is combinational)
     wire [SB-1:0]    rq_t = rt_q[0 +: SB];
     wire [RW-1:0]    rrow = dmem[rq_t];
     reg  [MTP*NW-1:0] lf;
-    reg  [TN*NW-1:0]  tr_d;
+    reg  [TNN*NW-1:0] tr_d;
     always @* begin : c_tree
         integer s_i, k, l;
         for (s_i = 0; s_i < MTP; s_i = s_i + 1) begin
@@ -293,18 +320,39 @@ module fmt_tracker #(
             else
                 lf[s_i*NW +: NW] = {{KW{1'b1}}, s_i[SB-1:0]};
         end
-        for (l = 0; l < MTP / 2; l = l + 1)
-            tr_d[l*NW +: NW] = nmin(lf[(2*l)*NW +: NW], lf[(2*l+1)*NW +: NW]);
+        tr_d = {(TNN*NW){1'b0}};
+        if (SB > 2)
+            for (l = 0; l < MTP / 2; l = l + 1)
+                tr_d[l*NW +: NW] = nmin(lf[(2*l)*NW +: NW], lf[(2*l+1)*NW +: NW]);
         // stage k - 1 starts at node MTP - (MTP >> (k - 2)), stage k at MTP - (MTP >> (k - 1))
-        for (k = 2; k <= SB; k = k + 1)
+        for (k = 2; k <= SB - 2; k = k + 1)
             for (l = 0; l < (MTP >> k); l = l + 1)
                 tr_d[(MTP-(MTP>>(k-1))+l)*NW +: NW] =
                     nmin(tr_q[(MTP-(MTP>>(k-2))+2*l)*NW +: NW],
                          tr_q[(MTP-(MTP>>(k-2))+2*l+1)*NW +: NW]);
     end
-    wire [NW-1:0] root    = tr_q[(TN-1)*NW +: NW];
-    wire [DW-1:0] key_d_q = root[NW-2 -: DW];
-    wire [SB-1:0] key_s_q = root[SB-1:0];
+    // the root (stage SB - 1) and its touch
+    wire [NW-1:0] root;
+    generate
+        if (SB > 2) begin : g_root
+            wire [NW-1:0] root_d = nmin4(tr_q[(MTP-8)*NW +: NW], tr_q[(MTP-7)*NW +: NW],
+                                         tr_q[(MTP-6)*NW +: NW], tr_q[(MTP-5)*NW +: NW]);
+            reg  [NW-1:0] rootq_q;
+            assign root = rootq_q;
+            always @(posedge clk) rootq_q <= root_d;
+        end else if (SB == 2) begin : g_root2
+            wire [NW-1:0] root_d = nmin4(lf[0 +: NW], lf[NW +: NW], lf[2*NW +: NW],
+                                         lf[3*NW +: NW]);
+            reg  [NW-1:0] rootq_q;
+            assign root = rootq_q;
+            always @(posedge clk) rootq_q <= root_d;
+        end else begin : g_root1
+            assign root = nmin(lf[0 +: NW], lf[NW +: NW]);
+        end
+    endgenerate
+    wire [SB-1:0] root_t  = rt_q[(SB-1)*SB +: SB];
+    wire [DW-1:0] key_d_q = key_q[NW-2 -: DW];
+    wire [SB-1:0] key_s_q = key_q[SB-1:0];
     wire [SB-1:0] key_t_q = rt_q[SB*SB +: SB];
 
     // ---- sorted queue of the touches' keys (D, t) ---------------------------------------
@@ -315,9 +363,24 @@ module fmt_tracker #(
     wire q_stale  = in_match & qv_q[0] & qst_q[0];                // head: recompute its key
     wire q_pop    = q_asg | q_stale;
     wire m_done   = in_match & ~qv_q[0] & ~inflight_q;            // no candidate pair left
-    wire key_ins  = rv_q[SB] & ~root[NW-1];
+    wire key_ins  = rv_q[SB] & ~key_q[NW-1];
     wire [SB-1:0] h_t = qt_q[0 +: SB];
     wire [SB-1:0] h_s = qs_q[0 +: SB];
+
+    // The key's compare with every entry is made a cycle ahead, from the root (stage
+    // SB - 1) against the entries and the key inserted in that cycle; each result moves
+    // along with its entry (the same 4:1 select, c_qnext) into kc_q.  kc_q is exact
+    // whenever the key is.
+    reg  [MT+1:0] kc_n;            // now: the root before entry j - 1 (ends: don't care)
+    reg           kc_k;            // now: the root before the key inserted now
+    always @* begin : c_qcmp
+        integer i;
+        kc_n[0] = 1'b1;
+        for (i = 0; i < MT; i = i + 1)
+            kc_n[i+1] = {root[NW-2 -: DW], root_t} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]};
+        kc_n[MT+1] = 1'b1;
+        kc_k = {root[NW-2 -: DW], root_t} < {key_d_q, key_t_q};
+    end
 
     // xl[j]: the key sorts before entry j - 1 (or that entry is empty); xl[0] = 0
     reg  [MT+1:0]       xl;
@@ -325,7 +388,7 @@ module fmt_tracker #(
         integer i;
         xl[0] = 1'b0;
         for (i = 0; i < MT; i = i + 1)
-            xl[i+1] = ~qv_q[i] | ({key_d_q, key_t_q} < {qd_q[i*DW +: DW], qt_q[i*SB +: SB]});
+            xl[i+1] = ~qv_q[i] | kc_q[i];
         xl[MT+1] = 1'b1;
     end
     // next state of entry i, a 4:1 select per entry: 0 keep, 1 entry i + 1 (a pop),
@@ -360,7 +423,7 @@ module fmt_tracker #(
             qeq[i] = xq[(i+2)*QE+QE-1] && (xq[(i+2)*QE +: SB] == h_s);
         end
     end
-    reg [MT-1:0]    qv_d, qst_d;
+    reg [MT-1:0]    qv_d, qst_d, kc_d;
     reg [MT*DW-1:0] qd_d;
     reg [MT*SB-1:0] qt_d, qs_d;
     always @* begin : c_qnext
@@ -368,10 +431,22 @@ module fmt_tracker #(
         reg [QE-1:0] e;
         for (i = 0; i < MT; i = i + 1) begin
             case (qsel[2*i +: 2])
-                2'd0:    e = xq[(i+1)*QE +: QE];
-                2'd1:    e = xq[(i+2)*QE +: QE];
-                2'd2:    e = xq[i*QE +: QE];
-                default: e = kq;
+                2'd0: begin
+                    e = xq[(i+1)*QE +: QE];
+                    kc_d[i] = kc_n[i+1];
+                end
+                2'd1: begin
+                    e = xq[(i+2)*QE +: QE];
+                    kc_d[i] = kc_n[i+2];
+                end
+                2'd2: begin
+                    e = xq[i*QE +: QE];
+                    kc_d[i] = kc_n[i];
+                end
+                default: begin
+                    e = kq;
+                    kc_d[i] = kc_k;
+                end
             endcase
             {qv_d[i], qst_d[i], qd_d[i*DW +: DW], qt_d[i*SB +: SB], qs_d[i*SB +: SB]} = e;
             qst_d[i] = e[QE-2] | (q_asg & qeq[i]);   // an assignment pops: e is entry i + 1
@@ -523,12 +598,14 @@ module fmt_tracker #(
             dq_q           <= {(MT*KW){1'b0}};
             rv_q           <= {(SB+1){1'b0}};
             rt_q           <= {((SB+1)*SB){1'b0}};
-            tr_q           <= {(TN*NW){1'b0}};
+            tr_q           <= {(TNN*NW){1'b0}};
             qv_q           <= {MT{1'b0}};
             qst_q          <= {MT{1'b0}};
             qd_q           <= {(MT*DW){1'b0}};
             qt_q           <= {(MT*SB){1'b0}};
             qs_q           <= {(MT*SB){1'b0}};
+            kc_q           <= {MT{1'b0}};
+            key_q          <= {1'b1, {(NW-1){1'b0}}};
             op_v_q         <= 1'b0;
             op_typ_q       <= T_NEW;
             op_t_q         <= {SB{1'b0}};
@@ -600,6 +677,8 @@ module fmt_tracker #(
             qd_q  <= qd_d;
             qt_q  <= qt_d;
             qs_q  <= qs_d;
+            kc_q  <= kc_d;
+            key_q <= root;
 
             inflight_q <= arrive | a1_v_q | q_stale | (|rv_q[SB-1:0]);
 
