@@ -162,7 +162,19 @@ module fmt_localmax #(
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] jx_q;                  // the row to read to start there
     reg                 jv_q;                  // some row was ready
-    wire                adv;                   // the step pipeline advances
+    // The step pipeline advances when no maximum is being serialised (rem_q = 0).  The
+    // enable is a register, computed a cycle early from rem_q's next value (adv_d
+    // below), in copies: the window's 1,960 flip-flops, the frame-store read register
+    // and output register, the step pipeline and the serialiser each take their own, so
+    // no enable net fans out from logic to thousands of flip-flops.
+    localparam NWC = (COLS >= 5) ? COLS / 5 : 1;    // window-shift enable copies
+    localparam NOC = (COLS >= 10) ? COLS / 10 : 1;  // output-register enable copies
+    reg                 advc_q;                // adv: the step pipeline and the rules
+    reg                 advs_q;                // adv: the serialiser
+    reg                 advr_q;                // adv: the frame-store read register
+    reg [NOC-1:0]       advo_q;                // adv: the output register, by column group
+    reg [NWC-1:0]       wsh_q;                 // adv and v2_q: the window shifts, by column group
+    wire                adv = advc_q;          // (rem_q == 0)
 
     reg [ROWS-1:0] ready;                      // present with its neighbours, not finished
     reg [ROWS-1:0] fin_ok;                     // not finished and the row below present
@@ -224,10 +236,7 @@ module fmt_localmax #(
     reg [RW-1:0]        w0_q, w1_q, w2_q;      // window: rows x-1 (P), x-2, x-3 of the last step
 
     always @(posedge clk) begin
-        if (adv) begin
-            rd_q <= mem[a0_q];
-            do_q <= rd_q;
-        end
+        if (advr_q) rd_q <= mem[a0_q];
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
@@ -268,8 +277,44 @@ module fmt_localmax #(
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     reg                 mtop_q, mbot_q;        // w1_q is the first / last row
-    assign adv = (rem_q == {COLS{1'b0}});
-    wire [COLS-1:0] rem_low = rem_q & ~(rem_q - 1'b1);
+    wire [COLS-1:0] rem_m1  = rem_q - 1'b1;
+    wire [COLS-1:0] rem_low = rem_q & ~rem_m1;   // its lowest maximum, one-hot
+    wire [COLS-1:0] rem_nx  = rem_q & rem_m1;    // the others
+    wire [COLS-1:0] mask_n  = part_q & down_n;   // P's maxima (final mask)
+    // adv's next value (rem_q's next value is 0)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|mask_n)) : !(|rem_nx));
+    // the window shifts next cycle: adv then, and a step in s2 then
+    wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
+
+    // the enable copies (keep: one flip-flop each, not merged by synthesis)
+    (* keep *) always @(posedge clk) advc_q <= adv_d;
+    (* keep *) always @(posedge clk) advs_q <= adv_d;
+    (* keep *) always @(posedge clk) advr_q <= adv_d;
+    genvar gk;
+    generate
+        for (gk = 0; gk < NOC; gk = gk + 1) begin : g_advo
+            (* keep *) always @(posedge clk) advo_q[gk] <= adv_d;
+        end
+        for (gk = 0; gk < NWC; gk = gk + 1) begin : g_wsh
+            (* keep *) always @(posedge clk) wsh_q[gk] <= wsh_d;
+        end
+    endgenerate
+
+    // the output register (N) and the window, per column, enabled by their group's copy
+    generate
+        for (gk = 0; gk < COLS; gk = gk + 1) begin : g_win
+            always @(posedge clk) begin
+                if (advo_q[(gk * NOC) / COLS])
+                    do_q[gk*HM_W +: HM_W] <= rd_q[gk*HM_W +: HM_W];
+                if (wsh_q[(gk * NWC) / COLS]) begin
+                    w0_q[gk*HM_W +: HM_W] <= do_q[gk*HM_W +: HM_W];
+                    w1_q[gk*HM_W +: HM_W] <= w0_q[gk*HM_W +: HM_W];
+                    w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
+                    part_q[gk]            <= part_n[gk];
+                end
+            end
+        end
+    endgenerate
 
     // column index, its quotient and remainder by 3, as ORs of the one-hot lowest bit
     localparam NPC  = COLS + 2;
@@ -462,16 +507,12 @@ module fmt_localmax #(
             r1_q <= r0_q;  t1_q <= t0_q;  x1_q <= x0_q;  f1_q <= f0_q;
             r2_q <= r1_q;  t2_q <= t1_q;  x2_q <= x1_q;  f2_q <= f1_q;
             if (v2_q) begin
-                w0_q   <= do_q;
-                w1_q   <= w0_q;
-                w2_q   <= w1_q;
-                part_q <= part_n;
                 mrow_q <= r2_q;
                 mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
                 mbot_q <= x2_q;
             end
         end
-        if (rem_q != {COLS{1'b0}}) begin
+        if (!advs_q) begin
             icol_q <= lo_col;
             iq_q   <= lo_q;
             ig0_q  <= lo_g0;
@@ -561,12 +602,12 @@ module fmt_localmax #(
             end
 
             // ---- serialiser ----
-            if (rem_q != {COLS{1'b0}}) begin
-                rem_q <= rem_q & ~rem_low;
+            if (!advs_q) begin                 // rem_q != 0
+                rem_q <= rem_nx;
                 iv_q  <= 1'b1;
             end else begin
                 iv_q  <= 1'b0;
-                if (v2_q && f2_q) rem_q <= part_q & down_n;
+                if (v2_q && f2_q) rem_q <= mask_n;
             end
             pv_q    <= iv_q;
             cap_v_q <= pv_q;
