@@ -206,23 +206,31 @@ module fmt_localmax #(
     end
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // The rules read fin_ok, nxt_ok and the lowest ready row one cycle late (registered,
-    // indexed by one-hot rows: a few LUT levels).  Safe: rows only arrive in between, and
-    // the only row finished in the last cycle is the previous cur, never indexed now
-    // (rule c checks its row against done_q itself).
-    reg [ROWS-1:0] fin_ok_q, nxt_ok_q;         // fin_ok, nxt_ok one cycle old
+    // The rules read fin_ok, nxt_ok and the lowest ready row one cycle late (indexed by
+    // one-hot rows).  Safe: rows only arrive in between, and the only row finished in the
+    // last cycle is the previous cur, never indexed now (rule c checks its row against
+    // done_q itself).  Rules a and b are registered: computed a cycle early for each row
+    // the next cur can be (cur, cur + 1, the start row jx) and chosen by the step taken.
     reg [ROWS-1:0] cur1h_q;                    // cur_q one-hot
     reg [ROWS-1:0] j1h_q, jx1h_q;              // lowest ready row j, jx_q: one-hot
     reg            jx0_q;                      // jx_q = 0
+    reg            rule_a_q, rule_b_q;         // rules a and b (below), registered
     wire run    = (state_q == S_RUN);
-    wire rule_a = cv_q && cp_q && |(cur1h_q & fin_ok_q);  // finish cur (read cur + 1)
-    wire rule_b = cv_q && |(cur1h_q & nxt_ok_q);          // move on to a ready cur + 1
+    wire rule_a = rule_a_q;                    // cv, cp and fin_ok[cur]: finish cur (read cur + 1)
+    wire rule_b = rule_b_q;                    // cv and nxt_ok[cur]: move on to a ready cur + 1
     wire rule_c = jv_q && !(|(j1h_q & done_q));           // start at the ready row j
     wire issue  = run && adv && (rule_a || rule_b || rule_c);
     wire last_c = cur1h_q[ROWS-1];
     wire [ROW_IDX_W-1:0] cur_p1 = cur_q + 1'b1;
     wire [ROW_IDX_W-1:0] x_row  = (rule_a || rule_b) ? cur_p1 : jx_q;
     wire [ROWS-1:0] jx1h_d = (rdy_low >> 1) | {{(ROWS-1){1'b0}}, rdy_low[0]};
+    // rules a and b for the next cycle, per candidate next cur: unchanged, cur + 1, jx
+    wire [ROWS-1:0] cur1h_up = cur1h_q << 1;
+    wire a_hold = |(cur1h_q  & fin_ok),  b_hold = |(cur1h_q  & nxt_ok);
+    wire a_up   = |(cur1h_up & fin_ok),  b_up   = |(cur1h_up & nxt_ok);
+    wire a_jump = |(jx1h_q   & fin_ok),  b_jump = |(jx1h_q   & nxt_ok);
+    wire ab     = rule_a || rule_b;        // the step reads cur + 1
+    wire vstep  = rule_a && last_c;        // the virtual step: no cur after it
 
     // step pipeline: s0 address register, s1 block-RAM read, s2 its output register
     reg [AW-1:0]        a0_q;
@@ -496,8 +504,6 @@ module fmt_localmax #(
         j1h_q    <= rdy_low;
         jx1h_q   <= jx1h_d;
         jx0_q    <= rdy_low[0] | rdy_low[1];
-        fin_ok_q <= fin_ok;
-        nxt_ok_q <= nxt_ok;
         if (adv) begin
             a0_q <= {pb_q, x_row};
             r0_q <= cur_q;
@@ -543,6 +549,8 @@ module fmt_localmax #(
             cv_q     <= 1'b0;
             cp_q     <= 1'b0;
             jv_q     <= 1'b0;
+            rule_a_q <= 1'b0;
+            rule_b_q <= 1'b0;
             state_q  <= S_RUN;
             v0_q     <= 1'b0;
             v1_q     <= 1'b0;
@@ -588,6 +596,14 @@ module fmt_localmax #(
                 v0_q <= issue;
                 v1_q <= v0_q;
                 v2_q <= v1_q;
+            end
+            // rules a and b of the next cycle (cv, cp and cur1h_q as the step leaves them)
+            if (issue) begin
+                rule_a_q <= !vstep && (ab ? a_up : (jx0_q && a_jump));
+                rule_b_q <= !vstep && (ab ? b_up : b_jump);
+            end else begin
+                rule_a_q <= cv_q && cp_q && a_hold;
+                rule_b_q <= cv_q && b_hold;
             end
             if (issue) begin
                 if (rule_a) done_q <= done_q | cur1h_q;
@@ -645,6 +661,8 @@ module fmt_localmax #(
                 found_q      <= {FOUND_W{1'b0}};
                 done_q       <= {ROWS{1'b0}};
                 cv_q         <= 1'b0;
+                rule_a_q     <= 1'b0;
+                rule_b_q     <= 1'b0;
                 if (pb_q) arr1_q <= {ROWS{1'b0}};
                 else      arr0_q <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
