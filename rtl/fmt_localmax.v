@@ -19,7 +19,8 @@
 //   SW0  choose the step: finish the current row r (read r + 1; after the last row a
 //        virtual step without a read), move on to a ready r + 1, or start at the lowest
 //        ready row s (read s - 1, then s, then s + 1: 3 reads, 1 per row after that);
-//        address register
+//        address register (the finish and move-on rules are registers, computed a cycle
+//        early for each row the step can leave as r: r, r + 1 or s)
 //   SW1  block-RAM read, SW2 its output register (N, the new row)
 //   SW3  one comparator bank against the previous step's row P = N's row - 1 (the
 //        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
@@ -28,7 +29,9 @@
 //        neighbours) and P's final mask (its partial AND its later neighbours in N).
 //        The window shifts (w2 <- w1 <- w0 <- N): w2, w1, w0 = rows P - 1, P, P + 1.
 //   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
-//        a row with k maxima holds the window k cycles)
+//        a row with k maxima holds the window k cycles; the stall enable is a register,
+//        computed a cycle early from the serialiser's next mask, in copies per column
+//        group, so no clock enable of the window fans out from logic)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
 //        the rows outside the sensor, registered)
