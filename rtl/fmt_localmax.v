@@ -147,7 +147,11 @@ module fmt_localmax #(
         if (hm_valid_i) mem[{wb_q, hm_row_i}] <= hm_data_i;
     end
 
-    wire [ROWS-1:0] arr_p = pb_q ? arr1_q : arr0_q;
+    // the processing buffer's arrival bitmap, kept as its own register (= pb_q ? arr1_q :
+    // arr0_q in every cycle; updated below with arr0_q / arr1_q)
+    reg  [ROWS-1:0] arrp_q;
+    wire [ROWS-1:0] arr_p = arrp_q;
+    wire [ROWS-1:0] hm_1h = {{(ROWS-1){1'b0}}, hm_valid_i} << hm_row_i;   // the row arriving
 
     // ---- sweep scheduler ------------------------------------------------------------------
     // A step reads one row x of the processing buffer into the window.  The comparators
@@ -164,7 +168,7 @@ module fmt_localmax #(
     reg                 cp_q;                  // the partial mask of cur_q is complete
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] jx_q;                  // the row to read to start there
-    reg                 jv_q;                  // some row was ready
+    reg                 rule_c_q;              // rule c (below), registered
     // The step pipeline advances when no maximum is being serialised (rem_q = 0).  The
     // enable is a register, computed a cycle early from rem_q's next value (adv_d
     // below), in copies: the window's 1,960 flip-flops, the frame-store read register
@@ -215,13 +219,13 @@ module fmt_localmax #(
     // done_q itself).  Rules a and b are registered: computed a cycle early for each row
     // the next cur can be (cur, cur + 1, the start row jx) and chosen by the step taken.
     reg [ROWS-1:0] cur1h_q;                    // cur_q one-hot
-    reg [ROWS-1:0] j1h_q, jx1h_q;              // lowest ready row j, jx_q: one-hot
+    reg [ROWS-1:0] jx1h_q;                     // jx_q one-hot
     reg            jx0_q;                      // jx_q = 0
     reg            rule_a_q, rule_b_q;         // rules a and b (below), registered
     wire run    = (state_q == S_RUN);
     wire rule_a = rule_a_q;                    // cv, cp and fin_ok[cur]: finish cur (read cur + 1)
     wire rule_b = rule_b_q;                    // cv and nxt_ok[cur]: move on to a ready cur + 1
-    wire rule_c = jv_q && !(|(j1h_q & done_q));           // start at the ready row j
+    wire rule_c = rule_c_q;                    // some row j was ready and is not finished: start at j
     wire issue  = run && adv && (rule_a || rule_b || rule_c);
     wire last_c = cur1h_q[ROWS-1];
     wire [ROW_IDX_W-1:0] cur_p1 = cur_q + 1'b1;
@@ -504,7 +508,6 @@ module fmt_localmax #(
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
         jx_q     <= jx_d;
-        j1h_q    <= rdy_low;
         jx1h_q   <= jx1h_d;
         jx0_q    <= rdy_low[0] | rdy_low[1];
         if (adv) begin
@@ -551,7 +554,8 @@ module fmt_localmax #(
             cur_q    <= {ROW_IDX_W{1'b0}};
             cv_q     <= 1'b0;
             cp_q     <= 1'b0;
-            jv_q     <= 1'b0;
+            rule_c_q <= 1'b0;
+            arrp_q   <= {ROWS{1'b0}};
             rule_a_q <= 1'b0;
             rule_b_q <= 1'b0;
             state_q  <= S_RUN;
@@ -584,6 +588,10 @@ module fmt_localmax #(
                 if (wb_q) arr1_q[hm_row_i] <= 1'b1;
                 else      arr0_q[hm_row_i] <= 1'b1;
             end
+            if (releasing)                       // pb_q flips; arr_p clears
+                arrp_q <= (pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}});
+            else
+                arrp_q <= arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}});
             if (hm_eof_i) begin
                 eofs_q[wb_q] <= 1'b1;
                 if (wb_q) frm1_q <= hm_frame_i;
@@ -594,7 +602,9 @@ module fmt_localmax #(
             end
 
             // ---- sweep ----
-            jv_q <= |ready;
+            // rule c of the next cycle: the lowest ready row j (not finished: ready), unless
+            // the step now finishes it (j = cur)
+            rule_c_q <= (|ready) && !(issue && rule_a && (|(rdy_low & cur1h_q)));
             if (adv) begin
                 v0_q <= issue;
                 v1_q <= v0_q;
