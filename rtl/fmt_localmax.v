@@ -57,7 +57,8 @@
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
 // per row in a run) plus the virtual step (121), one cycle per maximum (at most 600:
 // Von Neumann checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of
-// emission (19): 750 < 768.
+// emission (19): 750 < 768.  (The registered stall enable and rules take every step in
+// the same cycle as the combinational ones did: no latency or cycle count moved.)
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
