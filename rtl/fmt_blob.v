@@ -438,16 +438,17 @@ module fmt_blob #(
             pk0[i*PK_W +: PK_W] = {x1_m_q[i] ? x1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}},
                                    i[COL_IDX_W-1:0]};
     end
-    reg  [PN2*PK_W-1:0] x2_pk_q;
-    reg  [PN4*PK_W-1:0] x3_pk_q;
-    reg  [PK_W-1:0]     y4_pk_q;
-    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
-    wire [PN0*PK_W-1:0] pk3 = pk_half({{((PN0-PN2)*PK_W){1'b0}}, x2_pk_q}, PN2);
-    wire [PN0*PK_W-1:0] pk5 = pk_half({{((PN0-PN4)*PK_W){1'b0}}, x3_pk_q}, PN4);
+    // levels per stage: X2 one, X3 two, X4 two, X5 one
+    reg  [PN1*PK_W-1:0] x2_pk_q;
+    reg  [PN3*PK_W-1:0] x3_pk_q;
+    reg  [PN5*PK_W-1:0] y4_pk_q;
     /* verilator lint_off UNUSEDSIGNAL */     // entries beyond a level's count are 0
-    wire [PN0*PK_W-1:0] pk2 = pk_half(pk1, PN1);
-    wire [PN0*PK_W-1:0] pk4 = pk_half(pk3, PN3);
-    wire [PN0*PK_W-1:0] pk6 = pk_half(pk5, PN5);
+    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
+    wire [PN0*PK_W-1:0] pk2 = pk_half({{((PN0-PN1)*PK_W){1'b0}}, x2_pk_q}, PN1);
+    wire [PN0*PK_W-1:0] pk3 = pk_half(pk2, PN2);
+    wire [PN0*PK_W-1:0] pk4 = pk_half({{((PN0-PN3)*PK_W){1'b0}}, x3_pk_q}, PN3);
+    wire [PN0*PK_W-1:0] pk5 = pk_half(pk4, PN4);
+    wire [PN0*PK_W-1:0] pk6 = pk_half({{((PN0-PN5)*PK_W){1'b0}}, y4_pk_q}, PN5);
     /* verilator lint_on UNUSEDSIGNAL */
     // synthesis translate_off
     initial begin
@@ -466,21 +467,41 @@ module fmt_blob #(
     reg [AREA_W-1:0]    x3_cnt_q;
     reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
-    reg [SX_W-1:0]      x3_sx_q;
-    reg [SZ_W-1:0]      ts;
-    reg [SX_W-1:0]      tx;
+    reg [NG*SX_W-1:0]   x3_gw_q;              // per group: sum z*c
+    reg [NG*SZ_W-1:0]   tr_s;                 // sum z: a balanced tree over the groups
+    reg [NG*SX_W-1:0]   gw;
     always @(*) begin : c_x3
-        integer g, b;
-        ts = {SZ_W{1'b0}};
-        tx = {SX_W{1'b0}};
+        integer g, b, n;
         for (g = 0; g < NG; g = g + 1) begin
-            ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
-            // sum z*c = sum over groups of (sum z*(c mod 8) + 8g * sum z), shift-add
-            tx = tx + {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            tr_s[g*SZ_W +: SZ_W] = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            // sum z*c of the group = sum z*(c mod 8) + 8g * sum z, shift-add
+            gw[g*SX_W +: SX_W] = {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
             for (b = 0; b < COL_IDX_W; b = b + 1)
                 if ((((g * GS) >> b) & 1) == 1)
-                    tx = tx + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
+                    gw[g*SX_W +: SX_W] = gw[g*SX_W +: SX_W]
+                        + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
         end
+        // pairwise: entry k = entries 2k + 2k+1 (written after both are read)
+        for (n = NG; n > 1; n = (n + 1) / 2)
+            for (g = 0; g < (n + 1) / 2; g = g + 1)
+                if (2 * g + 1 < n)
+                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W]
+                                         + tr_s[((2*g+1 < NG) ? 2*g+1 : 0)*SZ_W +: SZ_W];
+                else
+                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W];
+    end
+    // X4: sum z*c, a balanced tree over the groups' sums
+    reg [NG*SX_W-1:0]   tr_x;
+    always @(*) begin : c_x4
+        integer g, n;
+        tr_x = x3_gw_q;
+        for (n = NG; n > 1; n = (n + 1) / 2)
+            for (g = 0; g < (n + 1) / 2; g = g + 1)
+                if (2 * g + 1 < n)
+                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W]
+                                         + tr_x[((2*g+1 < NG) ? 2*g+1 : 0)*SX_W +: SX_W];
+                else
+                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W];
     end
 
 
@@ -492,6 +513,7 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     reg [FE_W-1:0]      y5_e_q;
     reg [SY_W-1:0]      y4_ylo_q, y4_yhi_q;
+    reg [SX_W-1:0]      y4_sx_q;
     reg [SY_W-1:0]      ylo, yhi;
     always @(*) begin : c_sy
         integer b;
@@ -514,13 +536,14 @@ module fmt_blob #(
     localparam F_PC  = F_PK + HM_W;
     localparam F_CMN = F_PC + COL_IDX_W;
     localparam F_CMX = F_CMN + COL_IDX_W;
-    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W){1'b0}}, x3_sx_q,
+    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W+SX_W){1'b0}},
                              x3_s_q, x3_cnt_q, x3_row_q, x3_lc_q, x3_f_q};
     wire [FE_W-1:0] y4_ev;
-    assign y4_ev[F_SY-1:0]         = y4_e_q[F_SY-1:0];
+    assign y4_ev[F_SX-1:0]         = y4_e_q[F_SX-1:0];
+    assign y4_ev[F_SX +: SX_W]     = y4_sx_q;
     assign y4_ev[F_SY +: SY_W]     = y4_ylo_q + y4_yhi_q;
-    assign y4_ev[F_PK +: HM_W]     = y4_pk_q[COL_IDX_W +: HM_W];
-    assign y4_ev[F_PC +: COL_IDX_W] = y4_pk_q[0 +: COL_IDX_W];
+    assign y4_ev[F_PK +: HM_W]     = pk6[COL_IDX_W +: HM_W];
+    assign y4_ev[F_PC +: COL_IDX_W] = pk6[0 +: COL_IDX_W];
     assign y4_ev[FE_W-1:F_CMN]     = y4_e_q[FE_W-1:F_CMN];
 
     // ---- the event FIFO (distributed RAM), read into L1 --------------------------------
@@ -622,15 +645,23 @@ module fmt_blob #(
                    && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
     end
+    // L0 selects only (no forwarding); the step of this cycle is registered (s_*) and
+    // applied in L1, one cycle later, together with the step of that cycle
     wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
-    wire             l0_hit = bnd && do_run && |(l0_oh_q & l2_m_q);
-    // (the victim compare per column beside the select, not after it)
-    wire             ren0 = bnd ? |(l0_oh_q & ren_c) : |(l0_oh_q & ren_p);
-    wire [LBL_W-1:0] y0 = l0_hit ? lrun : ((do_merge && ren0) ? x_q : y0_raw);
+    wire             l0_hp  = bnd && |(l0_oh_q & l2_m_q);  // under this cycle's run, if any
+    reg              s_mrg_q, s_run_q;        // the step of the cycle before: a merge, a run
+    reg  [LBL_W-1:0] s_v_q, s_x_q, s_lrun_q;  // its victim, survivor, run label
+    reg              l1_hp_q;                 // L1's label column under that step's run
+    // L1's label after the step of the cycle before (ya), and whether it is this
+    // cycle's merge victim (eqa: the three candidates compared beside the select)
+    wire             sa_run = l1_hp_q && s_run_q;
+    wire             sa_mrg = s_mrg_q && (l1_y_q == s_v_q);
+    wire [LBL_W-1:0] ya  = sa_run ? s_lrun_q : (sa_mrg ? s_x_q : l1_y_q);
+    wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
+                         : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
     // L1: this cycle's step (a run of the previous row only for the row's first event)
     wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
-    wire [LBL_W-1:0] y1 = l1_hit ? lrun
-                        : ((do_merge && l1_y_q == l2_y_q) ? x_q : l1_y_q);
+    wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
     assign           l0_free = !l0_v_q || l1_ld;
@@ -986,12 +1017,13 @@ module fmt_blob #(
         x1_z_q   <= e1_z_q;
         x1_row_q <= e1_row_q;
         x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
-        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk2[PN2*PK_W-1:0];
+        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk1[PN1*PK_W-1:0];
         x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= pk4[PN4*PK_W-1:0];
-        y4_e_q <= x3_ev;  y4_pk_q <= pk6[PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        x3_s_q <= tr_s[SZ_W-1:0];  x3_gw_q <= gw;  x3_pk_q <= pk3[PN3*PK_W-1:0];
+        y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        y4_sx_q <= tr_x[SX_W-1:0];
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
@@ -999,8 +1031,17 @@ module fmt_blob #(
             l1_e_q  <= l0_e_q;
             l1_oh_q <= l0_oh_q;
             l1_m_q  <= l1_m;
-            l1_y_q  <= y0;
+            l1_y_q  <= y0_raw;
+            l1_hp_q <= l0_hp;
+        end else begin                        // (held: no step this cycle; the pending
+            l1_y_q  <= ya;                    //  one applied now)
+            l1_hp_q <= 1'b0;
         end
+        s_mrg_q  <= do_merge;
+        s_run_q  <= do_run;
+        s_v_q    <= l2_y_q;
+        s_x_q    <= x_q;
+        s_lrun_q <= lrun;
         if (l2_ld) begin
             l2_e_q <= l1_e_q;
             l2_y_q <= y1;
@@ -1073,6 +1114,8 @@ module fmt_blob #(
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
+            s_mrg_q  <= 1'b0;
+            s_run_q  <= 1'b0;
             pk_v_q   <= 1'b0;
             idle_q   <= 1'b0;
             abort_q  <= 1'b0;
