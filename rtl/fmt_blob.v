@@ -162,6 +162,8 @@ module fmt_blob #(
     localparam ADDR_W = $clog2(2 * ROWS);
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;
+    localparam NPR    = (COLS + 1) / 2;              // column pairs
+    localparam LR_W   = COLS + NPR * LBL_W;          // lr_mem word: on-cells, pair labels
     localparam MB     = MAX_BLOBS;
     localparam MBI_W  = (MB > 1) ? $clog2(MB) : 1;   // list index width
     // accumulator / list entry fields
@@ -710,12 +712,31 @@ module fmt_blob #(
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
     (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*(LBL_W+1)-1:0] lr_mem [0:ROWS-1];     // {on-cells, labels} of a row
+    reg [LR_W-1:0]           lr_mem [0:ROWS-1];     // {on-cells, pair labels} of a row
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
     wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
+    // The run's cells share its label at the row end, and two run starts are never
+    // adjacent: per column pair one label is kept, the label of the pair's run start (if
+    // any).  Written one cycle after the row end, from C and the row's on-cells then.
+    reg                  lr_we_q;
+    reg [ROW_IDX_W-1:0]  lr_row_q;
+    reg [COLS-1:0]       lr_on_q;
+    reg [NPR*LBL_W-1:0]  lr_pl;
+    always @(*) begin : c_lr_pl
+        integer j;
+        for (j = 0; j < NPR; j = j + 1)
+            if (2 * j + 1 >= COLS
+                || (lr_on_q[2*j] && (j == 0 || !lr_on_q[(j > 0) ? 2*j-1 : 0])))
+                lr_pl[j*LBL_W +: LBL_W] = c_q[(2*j)*LBL_W +: LBL_W];
+            else
+                lr_pl[j*LBL_W +: LBL_W] = c_q[((2*j+1 < COLS) ? 2*j+1 : 0)*LBL_W +: LBL_W];
+    end
     always @(posedge clk) begin
-        if (row_done) lr_mem[l2_row] <= {on_l2, c_nx};
+        lr_we_q  <= row_done && !rst;
+        lr_row_q <= l2_row;
+        lr_on_q  <= on_l2;
+        if (lr_we_q) lr_mem[lr_row_q] <= {lr_on_q, lr_pl};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -890,7 +911,7 @@ module fmt_blob #(
     reg                  bw_v1_q, bw_v_q;     // block-RAM read of row bw_row1_q / bw_row_q
     reg [ROW_IDX_W-1:0]  bw_row1_q, bw_row_q;
     reg [NL*(LBL_W+1)-1:0] fr_rd1_q, fr_rd_q; // continuation record of row r
-    reg [COLS*(LBL_W+1)-1:0] lr_rd1_q, lr_rd_q;   // on-cells and labels of row r
+    reg [LR_W-1:0]       lr_rd1_q, lr_rd_q;   // on-cells and pair labels of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg                  mask_ok_q;           // the mask holds a complete frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
@@ -945,15 +966,23 @@ module fmt_blob #(
     reg                  mk_v_q;
     reg [ROW_IDX_W-1:0]  mk_row_q;
     reg [NL:1]           mk_s_q;
-    reg [COLS*(LBL_W+1)-1:0] mk_lr_q;     // (C keeps older labels in off columns)
+    reg [LR_W-1:0]       mk_lr_q;
     reg [NLP-1:0]        mk_s_pad;
-    reg [COLS-1:0]       mk_bits;
+    reg [COLS-1:0]       mk_on, mk_st;
+    /* verilator lint_off UNUSEDSIGNAL */     // mk_fill[COLS]: a carry beyond the last column
+    wire [COLS:0]        mk_fill = {1'b0, mk_on} + {1'b0, mk_st};
+    /* verilator lint_on UNUSEDSIGNAL */
+    // a run's cells get the status of its label, from its start: the status bit added at
+    // the start carries through the run (its cells become 0) and stops after it
+    wire [COLS-1:0]      mk_bits = mk_on & ~mk_fill[COLS-1:0];
     always @(*) begin : c_mk
         integer c;
         mk_s_pad = {NLP{1'b0}};
         mk_s_pad[NL:1] = mk_s_q;
+        mk_on = mk_lr_q[NPR*LBL_W +: COLS];
         for (c = 0; c < COLS; c = c + 1)
-            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]] && mk_lr_q[COLS*LBL_W + c];
+            mk_st[c] = mk_on[c] && (c == 0 || !mk_on[(c > 0) ? c - 1 : 0])
+                    && mk_s_pad[mk_lr_q[(c/2)*LBL_W +: LBL_W]];
     end
     (* ram_style = "distributed" *)
     reg [COLS-1:0]       mask_mem [0:ROWS-1];
