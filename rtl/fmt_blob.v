@@ -16,13 +16,17 @@
 //       so a row has at most ceil(COLS/2) events (a row without any: one empty event).
 //   E : one event per cycle (lowest remaining event column, one carry chain), the C
 //       run's columns for a RUN event.
-//   X1..X5: the run's sums (area, sum z, sum z*c, sum z*r = r * sum z by shift and add,
-//       peak and its first column by a tournament of two levels per stage, extent),
-//       then the event enters a 32-entry FIFO (LUT RAM).  The extraction runs ahead of
-//       the labelling by up to the FIFO depth.
-//   L1: the label under the event's label column: the previous row's labels P (one per
-//       column, 0 = background), or the current row's labels C when the step in L2
-//       ends the previous row this cycle; that step is forwarded (its rename, its run).
+//   X1..X5: the run's sums: X2 the masked cells' sums per 8-column group and the
+//       extent; X3 sum z over the groups (a balanced tree) and each group's sum z*c;
+//       X4 sum z*c (a balanced tree) and the two halves of sum z*r = r * sum z (shift
+//       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
+//       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
+//       extraction runs ahead of the labelling by up to the FIFO depth.
+//   L0, L1: the label under the event's label column: L0 selects it from the previous
+//       row's labels P (one per column, 0 = background), or from the current row's
+//       labels C when the step in L2 may end the previous row first; the step of that
+//       cycle is registered (its victim, survivor, run label) and applied in L1,
+//       together with the step of L1's own cycle (its rename, its run).
 //   L2: one step per cycle (x = the label of the current C run, y = L1's label):
 //         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
@@ -50,18 +54,22 @@
 // by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
 // then blob_eof_o (also for a frame without blobs).
 //
-// Membership (for removing the fingers inside blobs): the labelling stores the label
-// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
-// of row r, whether it continued into row r+1 and as which label (after the merges of
-// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
+// Membership (for removing the fingers inside blobs): the labelling stores the labels
+// of every row at its end (lr_mem: the row's on-cells and, per column pair, the label
+// of the run that starts in the pair, if any: a run's cells share its label, and two
+// run starts are never adjacent); at the end of row r+1, for each label of row r,
+// whether it continued into row r+1 and as which label (after the merges of row r+1)
+// (fr_mem); and the close engine stores, per label and row r, whether the
 // label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
-// not continue, its close record; one stage later every cell of the row gets its
-// label's status, a row of the mask (mask_mem, LUT RAM, ROWS x COLS bits: every blob,
-// also those beyond MAX_BLOBS: blobs.blob_mask_fixed).  Query port: (mask_q_row_i,
-// mask_q_col_i) -> the row's mask word one cycle later -> mask_q_data_o = the cell's
-// bit two cycles after the address; one query per cycle, pipelined.  mask_ready_o
+// not continue, its close record; one stage later every run start of the row gets its
+// label's status, and the runs whose start has status 1 are filled by one addition
+// (on + starts: the carry runs through the run), a row of the mask (mask_mem, LUT RAM,
+// ROWS x COLS bits: every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed).
+// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word one cycle later ->
+// mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
+// pipelined.  mask_ready_o
 // (with mask_frame_o) marks the mask written; it stays readable until the next frame's
 // pass starts (that frame is labelled; never before its last row), queries in between
 // return 0.  An incomplete frame gives mask_ready_o with an all-zero mask.
@@ -83,7 +91,8 @@
 // ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
 // first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
 // combs 652, weave (the most merges with the most runs) 652 cycles: within the
-// 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
+// 768-cycle frame period at 3 x fs (python -m pytest -q -s tb/fmt_blob -k default;
+// unchanged by the L0/L1 and X3/X4 splits of 2026-11-27).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
 // Settings are used live: change them between frames (the threshold applies to a row
