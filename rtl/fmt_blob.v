@@ -352,7 +352,8 @@ module fmt_blob #(
     reg                 x1_v_q;
     reg [EF_W-1:0]      x1_f_q;
     reg [COLS-1:0]      x1_m_q, x1_lc_q;
-    reg [RW-1:0]        x1_z_q;               // the row (masked by x1_m_q in X2)
+    reg [RW-1:0]        x1_z_q;               // the run's cells (the others 0: masked as
+                                              // they are registered, a synchronous reset)
     reg [ROW_IDX_W-1:0] x1_row_q;
     // ---- X2: group sums, run extent ---------------------------------------------------
     reg [ROW_IDX_W-1:0] x2_row_q;
@@ -388,7 +389,7 @@ module fmt_blob #(
         for (g = 0; g < NG; g = g + 1) begin
             // the group's 8 masked cells (0 beyond the last column)
             for (i = 0; i < GS; i = i + 1)
-                gz[i*HM_W +: HM_W] = (g * GS + i < COLS && x1_m_q[(g * GS + i < COLS) ? g * GS + i : 0])
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS)
                                    ? x1_z_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
                                    : {HM_W{1'b0}};
             // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
@@ -446,7 +447,7 @@ module fmt_blob #(
     always @(*) begin : c_pk0
         integer i;
         for (i = 0; i < COLS; i = i + 1)
-            pk0[i*PK_W +: PK_W] = {x1_m_q[i] ? x1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}},
+            pk0[i*PK_W +: PK_W] = {x1_z_q[i*HM_W +: HM_W],
                                    i[COL_IDX_W-1:0]};
     end
     // levels per stage: X2 one, X3 two, X4 two, X5 one
@@ -1052,7 +1053,8 @@ module fmt_blob #(
         x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
         x1_m_q   <= ev_m;
         x1_lc_q  <= ev_lc;
-        x1_z_q   <= e1_z_q;
+        for (i = 0; i < COLS; i = i + 1)
+            x1_z_q[i*HM_W +: HM_W] <= ev_m[i] ? e1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
         x1_row_q <= e1_row_q;
         x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
         x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk1[PN1*PK_W-1:0];
