@@ -657,21 +657,17 @@ module fmt_blob #(
                    && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
     end
-    // L0 selects only (no forwarding) and compares with this cycle's victim; the step of
-    // this cycle is registered (s_*) and applied in L1, one cycle later, together with
-    // the step of that cycle
+    // L0 selects only (no forwarding); the step of this cycle is registered (s_*) and
+    // applied in L1, one cycle later, together with the step of that cycle
     wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
     wire             l0_hp  = bnd && |(l0_oh_q & l2_m_q);  // under this cycle's run, if any
     reg              s_mrg_q, s_run_q;        // the step of the cycle before: a merge, a run
-    reg  [LBL_W-1:0] s_x_q, s_lrun_q;         // its survivor, run label
+    reg  [LBL_W-1:0] s_v_q, s_x_q, s_lrun_q;  // its victim, survivor, run label
     reg              l1_hp_q;                 // L1's label column under that step's run
-    reg              l1_vm_q;                 // L1's label is that step's victim
-    // (the victim compare per column beside the select, not after it)
-    wire             ren0 = bnd ? |(l0_oh_q & ren_c) : |(l0_oh_q & ren_p);
     // L1's label after the step of the cycle before (ya), and whether it is this
     // cycle's merge victim (eqa: the three candidates compared beside the select)
     wire             sa_run = l1_hp_q && s_run_q;
-    wire             sa_mrg = s_mrg_q && l1_vm_q;
+    wire             sa_mrg = s_mrg_q && (l1_y_q == s_v_q);
     wire [LBL_W-1:0] ya  = sa_run ? s_lrun_q : (sa_mrg ? s_x_q : l1_y_q);
     wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
                          : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
@@ -1077,14 +1073,13 @@ module fmt_blob #(
             l1_m_q  <= l1_m;
             l1_y_q  <= y0_raw;
             l1_hp_q <= l0_hp;
-            l1_vm_q <= ren0;
         end else begin                        // (held: no step this cycle; the pending
             l1_y_q  <= ya;                    //  one applied now)
             l1_hp_q <= 1'b0;
-            l1_vm_q <= 1'b0;
         end
         s_mrg_q  <= do_merge;
         s_run_q  <= do_run;
+        s_v_q    <= l2_y_q;
         s_x_q    <= x_q;
         s_lrun_q <= lrun;
         if (l2_ld) begin
