@@ -42,7 +42,10 @@
 //       that it never does); nothing is ever dropped.
 //   A : the command updates the per-label accumulators (LUT RAM, one write, two reads,
 //       one of them shared with the close engine): NEW writes the run, ADD combines the
-//       run, MERGE combines label y into x.
+//       run, MERGE combines label y into x.  The reads are registered and the update
+//       written one cycle later (W); an operand that the update of the cycle before
+//       wrote is taken from that update's register.  (A closed label is read two
+//       cycles after its last update at the earliest: the close timing is unchanged.)
 //   C : the close engine takes one closed label per cycle (picked one cycle ahead):
 //       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
 //       (fmt_sorted_list: area descending, ties by the raster index of the region's
@@ -789,6 +792,16 @@ module fmt_blob #(
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
     assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
+    // W: the update is applied one cycle after its reads (both read ports registered);
+    // an operand written by the update of the cycle before is taken from w_res_q
+    reg  [1:0]       w_op_q;
+    reg  [LBL_W-1:0] w_a_q;
+    reg  [E_W-1:0]   w_ra_q, w_y_q, w_res_q;
+    reg              w_fa_q, w_fb_q;          // operand A / Y is the update of the cycle before
+    wire             w_wr  = (w_op_q != OP_NONE);
+    wire [E_W-1:0]   w_x   = w_fa_q ? w_res_q : w_ra_q;
+    wire [E_W-1:0]   w_yy  = w_fb_q ? w_res_q : w_y_q;
+    wire [E_W-1:0]   w_res = (w_op_q == OP_NEW) ? w_yy : combine(w_x, w_yy);
     // the close engine's next label (lowest pending), picked one cycle ahead
     reg  [LBL_W-1:0] pk_q;
     reg              pk_v_q;
@@ -1019,7 +1032,7 @@ module fmt_blob #(
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
                    || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
-                   || cl_v_q || (|pend_q) || pk_v_q;
+                   || w_wr || cl_v_q || (|pend_q) || pk_v_q;
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
@@ -1098,15 +1111,15 @@ module fmt_blob #(
         x4_last_q <= row_done && l2_lastrow;
         x4_lp_q  <= livep_nx;
         x4_lc_q  <= livec_nx;
-        // accumulators
-        begin
-            case (x4_op_q)                    // (OP_NONE when no step)
-                OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
-                OP_ADD,
-                OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_y);
-                default:  ;
-            endcase
-        end
+        // accumulators: K reads (label A, and label B of a MERGE), W combines and writes
+        w_op_q  <= x4_op_q;                   // (OP_NONE when no step)
+        w_a_q   <= x4_a_q;
+        w_ra_q  <= acc_q[x4_a_q];
+        w_y_q   <= acc_y;
+        w_fa_q  <= w_wr && (x4_a_q == w_a_q);
+        w_fb_q  <= w_wr && x4_mrg_q && (x4_b_q == w_a_q);
+        w_res_q <= w_res;
+        if (w_wr) acc_q[w_a_q] <= w_res;
         if (cl_go) begin
             cl_e_q   <= acc_b;
             cl_row_q <= crow_q[pk_q];
@@ -1170,6 +1183,7 @@ module fmt_blob #(
             x2_v_q   <= 1'b0;
             x3_v_q   <= 1'b0;
             x4_v_q   <= 1'b0;
+            w_op_q   <= OP_NONE;
             cl_v_q   <= 1'b0;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
