@@ -16,13 +16,17 @@
 //       so a row has at most ceil(COLS/2) events (a row without any: one empty event).
 //   E : one event per cycle (lowest remaining event column, one carry chain), the C
 //       run's columns for a RUN event.
-//   X1..X5: the run's sums (area, sum z, sum z*c, sum z*r = r * sum z by shift and add,
-//       peak and its first column by a tournament of two levels per stage, extent),
-//       then the event enters a 32-entry FIFO (LUT RAM).  The extraction runs ahead of
-//       the labelling by up to the FIFO depth.
-//   L1: the label under the event's label column: the previous row's labels P (one per
-//       column, 0 = background), or the current row's labels C when the step in L2
-//       ends the previous row this cycle; that step is forwarded (its rename, its run).
+//   X1..X5: the run's sums: X2 the masked cells' sums per 8-column group and the
+//       extent; X3 sum z over the groups (a balanced tree) and each group's sum z*c;
+//       X4 sum z*c (a balanced tree) and the two halves of sum z*r = r * sum z (shift
+//       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
+//       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
+//       extraction runs ahead of the labelling by up to the FIFO depth.
+//   L0, L1: the label under the event's label column: L0 selects it from the previous
+//       row's labels P (one per column, 0 = background), or from the current row's
+//       labels C when the step in L2 may end the previous row first; the step of that
+//       cycle is registered (its victim, survivor, run label) and applied in L1,
+//       together with the step of L1's own cycle (its rename, its run).
 //   L2: one step per cycle (x = the label of the current C run, y = L1's label):
 //         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
@@ -38,7 +42,10 @@
 //       that it never does); nothing is ever dropped.
 //   A : the command updates the per-label accumulators (LUT RAM, one write, two reads,
 //       one of them shared with the close engine): NEW writes the run, ADD combines the
-//       run, MERGE combines label y into x.
+//       run, MERGE combines label y into x.  The reads are registered and the update
+//       written one cycle later (W); an operand that the update of the cycle before
+//       wrote is taken from that update's register.  (A closed label is read two
+//       cycles after its last update at the earliest: the close timing is unchanged.)
 //   C : the close engine takes one closed label per cycle (picked one cycle ahead):
 //       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
 //       (fmt_sorted_list: area descending, ties by the raster index of the region's
@@ -50,18 +57,22 @@
 // by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
 // then blob_eof_o (also for a frame without blobs).
 //
-// Membership (for removing the fingers inside blobs): the labelling stores the label
-// of every cell at the end of its row (lr_mem); at the end of row r+1, for each label
-// of row r, whether it continued into row r+1 and as which label (after the merges of
-// row r+1) (fr_mem); and the close engine stores, per label and row r, whether the
+// Membership (for removing the fingers inside blobs): the labelling stores the labels
+// of every row at its end (lr_mem: the row's on-cells and, per column pair, the label
+// of the run that starts in the pair, if any: a run's cells share its label, and two
+// run starts are never adjacent); at the end of row r+1, for each label of row r,
+// whether it continued into row r+1 and as which label (after the merges of row r+1)
+// (fr_mem); and the close engine stores, per label and row r, whether the
 // label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
-// not continue, its close record; one stage later every cell of the row gets its
-// label's status, a row of the mask (mask_mem, LUT RAM, ROWS x COLS bits: every blob,
-// also those beyond MAX_BLOBS: blobs.blob_mask_fixed).  Query port: (mask_q_row_i,
-// mask_q_col_i) -> the row's mask word one cycle later -> mask_q_data_o = the cell's
-// bit two cycles after the address; one query per cycle, pipelined.  mask_ready_o
+// not continue, its close record; one stage later every run start of the row gets its
+// label's status, and the runs whose start has status 1 are filled by one addition
+// (on + starts: the carry runs through the run), a row of the mask (mask_mem, LUT RAM,
+// ROWS x COLS bits: every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed).
+// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word one cycle later ->
+// mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
+// pipelined.  mask_ready_o
 // (with mask_frame_o) marks the mask written; it stays readable until the next frame's
 // pass starts (that frame is labelled; never before its last row), queries in between
 // return 0.  An incomplete frame gives mask_ready_o with an all-zero mask.
@@ -83,7 +94,8 @@
 // ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
 // first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
 // combs 652, weave (the most merges with the most runs) 652 cycles: within the
-// 768-cycle frame period at 3 x fs.  A frame must be finished (blob_eof_o and the
+// 768-cycle frame period at 3 x fs (python -m pytest -q -s tb/fmt_blob -k default;
+// unchanged by the L0/L1 and X3/X4 splits of 2026-11-27).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
 // Settings are used live: change them between frames (the threshold applies to a row
@@ -162,6 +174,8 @@ module fmt_blob #(
     localparam ADDR_W = $clog2(2 * ROWS);
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;
+    localparam NPR    = (COLS + 1) / 2;              // column pairs
+    localparam LR_W   = COLS + NPR * LBL_W;          // lr_mem word: on-cells, pair labels
     localparam MB     = MAX_BLOBS;
     localparam MBI_W  = (MB > 1) ? $clog2(MB) : 1;   // list index width
     // accumulator / list entry fields
@@ -341,7 +355,8 @@ module fmt_blob #(
     reg                 x1_v_q;
     reg [EF_W-1:0]      x1_f_q;
     reg [COLS-1:0]      x1_m_q, x1_lc_q;
-    reg [RW-1:0]        x1_z_q;               // the row (masked by x1_m_q in X2)
+    reg [RW-1:0]        x1_z_q;               // the run's cells (the others 0: masked as
+                                              // they are registered, a synchronous reset)
     reg [ROW_IDX_W-1:0] x1_row_q;
     // ---- X2: group sums, run extent ---------------------------------------------------
     reg [ROW_IDX_W-1:0] x2_row_q;
@@ -377,7 +392,7 @@ module fmt_blob #(
         for (g = 0; g < NG; g = g + 1) begin
             // the group's 8 masked cells (0 beyond the last column)
             for (i = 0; i < GS; i = i + 1)
-                gz[i*HM_W +: HM_W] = (g * GS + i < COLS && x1_m_q[(g * GS + i < COLS) ? g * GS + i : 0])
+                gz[i*HM_W +: HM_W] = (g * GS + i < COLS)
                                    ? x1_z_q[((g * GS + i < COLS) ? g * GS + i : 0)*HM_W +: HM_W]
                                    : {HM_W{1'b0}};
             // sum z and sum z * (c mod 8) by a balanced tree of 13 adders:
@@ -435,19 +450,20 @@ module fmt_blob #(
     always @(*) begin : c_pk0
         integer i;
         for (i = 0; i < COLS; i = i + 1)
-            pk0[i*PK_W +: PK_W] = {x1_m_q[i] ? x1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}},
+            pk0[i*PK_W +: PK_W] = {x1_z_q[i*HM_W +: HM_W],
                                    i[COL_IDX_W-1:0]};
     end
-    reg  [PN2*PK_W-1:0] x2_pk_q;
-    reg  [PN4*PK_W-1:0] x3_pk_q;
-    reg  [PK_W-1:0]     y4_pk_q;
-    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
-    wire [PN0*PK_W-1:0] pk3 = pk_half({{((PN0-PN2)*PK_W){1'b0}}, x2_pk_q}, PN2);
-    wire [PN0*PK_W-1:0] pk5 = pk_half({{((PN0-PN4)*PK_W){1'b0}}, x3_pk_q}, PN4);
+    // levels per stage: X2 one, X3 two, X4 two, X5 one
+    reg  [PN1*PK_W-1:0] x2_pk_q;
+    reg  [PN3*PK_W-1:0] x3_pk_q;
+    reg  [PN5*PK_W-1:0] y4_pk_q;
     /* verilator lint_off UNUSEDSIGNAL */     // entries beyond a level's count are 0
-    wire [PN0*PK_W-1:0] pk2 = pk_half(pk1, PN1);
-    wire [PN0*PK_W-1:0] pk4 = pk_half(pk3, PN3);
-    wire [PN0*PK_W-1:0] pk6 = pk_half(pk5, PN5);
+    wire [PN0*PK_W-1:0] pk1 = pk_half(pk0, PN0);
+    wire [PN0*PK_W-1:0] pk2 = pk_half({{((PN0-PN1)*PK_W){1'b0}}, x2_pk_q}, PN1);
+    wire [PN0*PK_W-1:0] pk3 = pk_half(pk2, PN2);
+    wire [PN0*PK_W-1:0] pk4 = pk_half({{((PN0-PN3)*PK_W){1'b0}}, x3_pk_q}, PN3);
+    wire [PN0*PK_W-1:0] pk5 = pk_half(pk4, PN4);
+    wire [PN0*PK_W-1:0] pk6 = pk_half({{((PN0-PN5)*PK_W){1'b0}}, y4_pk_q}, PN5);
     /* verilator lint_on UNUSEDSIGNAL */
     // synthesis translate_off
     initial begin
@@ -466,21 +482,41 @@ module fmt_blob #(
     reg [AREA_W-1:0]    x3_cnt_q;
     reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
-    reg [SX_W-1:0]      x3_sx_q;
-    reg [SZ_W-1:0]      ts;
-    reg [SX_W-1:0]      tx;
+    reg [NG*SX_W-1:0]   x3_gw_q;              // per group: sum z*c
+    reg [NG*SZ_W-1:0]   tr_s;                 // sum z: a balanced tree over the groups
+    reg [NG*SX_W-1:0]   gw;
     always @(*) begin : c_x3
-        integer g, b;
-        ts = {SZ_W{1'b0}};
-        tx = {SX_W{1'b0}};
+        integer g, b, n;
         for (g = 0; g < NG; g = g + 1) begin
-            ts = ts + {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
-            // sum z*c = sum over groups of (sum z*(c mod 8) + 8g * sum z), shift-add
-            tx = tx + {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            tr_s[g*SZ_W +: SZ_W] = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            // sum z*c of the group = sum z*(c mod 8) + 8g * sum z, shift-add
+            gw[g*SX_W +: SX_W] = {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
             for (b = 0; b < COL_IDX_W; b = b + 1)
                 if ((((g * GS) >> b) & 1) == 1)
-                    tx = tx + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
+                    gw[g*SX_W +: SX_W] = gw[g*SX_W +: SX_W]
+                        + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
         end
+        // pairwise: entry k = entries 2k + 2k+1 (written after both are read)
+        for (n = NG; n > 1; n = (n + 1) / 2)
+            for (g = 0; g < (n + 1) / 2; g = g + 1)
+                if (2 * g + 1 < n)
+                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W]
+                                         + tr_s[((2*g+1 < NG) ? 2*g+1 : 0)*SZ_W +: SZ_W];
+                else
+                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W];
+    end
+    // X4: sum z*c, a balanced tree over the groups' sums
+    reg [NG*SX_W-1:0]   tr_x;
+    always @(*) begin : c_x4
+        integer g, n;
+        tr_x = x3_gw_q;
+        for (n = NG; n > 1; n = (n + 1) / 2)
+            for (g = 0; g < (n + 1) / 2; g = g + 1)
+                if (2 * g + 1 < n)
+                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W]
+                                         + tr_x[((2*g+1 < NG) ? 2*g+1 : 0)*SX_W +: SX_W];
+                else
+                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W];
     end
 
 
@@ -492,6 +528,7 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     reg [FE_W-1:0]      y5_e_q;
     reg [SY_W-1:0]      y4_ylo_q, y4_yhi_q;
+    reg [SX_W-1:0]      y4_sx_q;
     reg [SY_W-1:0]      ylo, yhi;
     always @(*) begin : c_sy
         integer b;
@@ -514,13 +551,14 @@ module fmt_blob #(
     localparam F_PC  = F_PK + HM_W;
     localparam F_CMN = F_PC + COL_IDX_W;
     localparam F_CMX = F_CMN + COL_IDX_W;
-    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W){1'b0}}, x3_sx_q,
+    wire [FE_W-1:0] x3_ev = {x3_cmax_q, x3_cmin_q, {(COL_IDX_W+HM_W+SY_W+SX_W){1'b0}},
                              x3_s_q, x3_cnt_q, x3_row_q, x3_lc_q, x3_f_q};
     wire [FE_W-1:0] y4_ev;
-    assign y4_ev[F_SY-1:0]         = y4_e_q[F_SY-1:0];
+    assign y4_ev[F_SX-1:0]         = y4_e_q[F_SX-1:0];
+    assign y4_ev[F_SX +: SX_W]     = y4_sx_q;
     assign y4_ev[F_SY +: SY_W]     = y4_ylo_q + y4_yhi_q;
-    assign y4_ev[F_PK +: HM_W]     = y4_pk_q[COL_IDX_W +: HM_W];
-    assign y4_ev[F_PC +: COL_IDX_W] = y4_pk_q[0 +: COL_IDX_W];
+    assign y4_ev[F_PK +: HM_W]     = pk6[COL_IDX_W +: HM_W];
+    assign y4_ev[F_PC +: COL_IDX_W] = pk6[0 +: COL_IDX_W];
     assign y4_ev[FE_W-1:F_CMN]     = y4_e_q[FE_W-1:F_CMN];
 
     // ---- the event FIFO (distributed RAM), read into L1 --------------------------------
@@ -622,15 +660,23 @@ module fmt_blob #(
                    && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
     end
+    // L0 selects only (no forwarding); the step of this cycle is registered (s_*) and
+    // applied in L1, one cycle later, together with the step of that cycle
     wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
-    wire             l0_hit = bnd && do_run && |(l0_oh_q & l2_m_q);
-    // (the victim compare per column beside the select, not after it)
-    wire             ren0 = bnd ? |(l0_oh_q & ren_c) : |(l0_oh_q & ren_p);
-    wire [LBL_W-1:0] y0 = l0_hit ? lrun : ((do_merge && ren0) ? x_q : y0_raw);
+    wire             l0_hp  = bnd && |(l0_oh_q & l2_m_q);  // under this cycle's run, if any
+    reg              s_mrg_q, s_run_q;        // the step of the cycle before: a merge, a run
+    reg  [LBL_W-1:0] s_v_q, s_x_q, s_lrun_q;  // its victim, survivor, run label
+    reg              l1_hp_q;                 // L1's label column under that step's run
+    // L1's label after the step of the cycle before (ya), and whether it is this
+    // cycle's merge victim (eqa: the three candidates compared beside the select)
+    wire             sa_run = l1_hp_q && s_run_q;
+    wire             sa_mrg = s_mrg_q && (l1_y_q == s_v_q);
+    wire [LBL_W-1:0] ya  = sa_run ? s_lrun_q : (sa_mrg ? s_x_q : l1_y_q);
+    wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
+                         : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
     // L1: this cycle's step (a run of the previous row only for the row's first event)
     wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
-    wire [LBL_W-1:0] y1 = l1_hit ? lrun
-                        : ((do_merge && l1_y_q == l2_y_q) ? x_q : l1_y_q);
+    wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
     assign           l0_free = !l0_v_q || l1_ld;
@@ -679,12 +725,31 @@ module fmt_blob #(
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
     (* ram_style = "block" *)                 // one write, one synchronous read
-    reg [COLS*(LBL_W+1)-1:0] lr_mem [0:ROWS-1];     // {on-cells, labels} of a row
+    reg [LR_W-1:0]           lr_mem [0:ROWS-1];     // {on-cells, pair labels} of a row
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
     wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
+    // The run's cells share its label at the row end, and two run starts are never
+    // adjacent: per column pair one label is kept, the label of the pair's run start (if
+    // any).  Written one cycle after the row end, from C and the row's on-cells then.
+    reg                  lr_we_q;
+    reg [ROW_IDX_W-1:0]  lr_row_q;
+    reg [COLS-1:0]       lr_on_q;
+    reg [NPR*LBL_W-1:0]  lr_pl;
+    always @(*) begin : c_lr_pl
+        integer j;
+        for (j = 0; j < NPR; j = j + 1)
+            if (2 * j + 1 >= COLS
+                || (lr_on_q[2*j] && (j == 0 || !lr_on_q[(j > 0) ? 2*j-1 : 0])))
+                lr_pl[j*LBL_W +: LBL_W] = c_q[(2*j)*LBL_W +: LBL_W];
+            else
+                lr_pl[j*LBL_W +: LBL_W] = c_q[((2*j+1 < COLS) ? 2*j+1 : 0)*LBL_W +: LBL_W];
+    end
     always @(posedge clk) begin
-        if (row_done) lr_mem[l2_row] <= {on_l2, c_nx};
+        lr_we_q  <= row_done && !rst;
+        lr_row_q <= l2_row;
+        lr_on_q  <= on_l2;
+        if (lr_we_q) lr_mem[lr_row_q] <= {lr_on_q, lr_pl};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
     end
@@ -727,6 +792,16 @@ module fmt_blob #(
     wire [LBL_W-1:0] acc_b_lbl;
     wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
     assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
+    // W: the update is applied one cycle after its reads (both read ports registered);
+    // an operand written by the update of the cycle before is taken from w_res_q
+    reg  [1:0]       w_op_q;
+    reg  [LBL_W-1:0] w_a_q;
+    reg  [E_W-1:0]   w_ra_q, w_y_q, w_res_q;
+    reg              w_fa_q, w_fb_q;          // operand A / Y is the update of the cycle before
+    wire             w_wr  = (w_op_q != OP_NONE);
+    wire [E_W-1:0]   w_x   = w_fa_q ? w_res_q : w_ra_q;
+    wire [E_W-1:0]   w_yy  = w_fb_q ? w_res_q : w_y_q;
+    wire [E_W-1:0]   w_res = (w_op_q == OP_NEW) ? w_yy : combine(w_x, w_yy);
     // the close engine's next label (lowest pending), picked one cycle ahead
     reg  [LBL_W-1:0] pk_q;
     reg              pk_v_q;
@@ -859,7 +934,7 @@ module fmt_blob #(
     reg                  bw_v1_q, bw_v_q;     // block-RAM read of row bw_row1_q / bw_row_q
     reg [ROW_IDX_W-1:0]  bw_row1_q, bw_row_q;
     reg [NL*(LBL_W+1)-1:0] fr_rd1_q, fr_rd_q; // continuation record of row r
-    reg [COLS*(LBL_W+1)-1:0] lr_rd1_q, lr_rd_q;   // on-cells and labels of row r
+    reg [LR_W-1:0]       lr_rd1_q, lr_rd_q;   // on-cells and pair labels of row r
     reg [NL:1]           sn_q;                // status (blob) of the labels of row r+1
     reg                  mask_ok_q;           // the mask holds a complete frame
     reg                  bw_busy_q;           // the frame's membership pass is not done
@@ -914,15 +989,23 @@ module fmt_blob #(
     reg                  mk_v_q;
     reg [ROW_IDX_W-1:0]  mk_row_q;
     reg [NL:1]           mk_s_q;
-    reg [COLS*(LBL_W+1)-1:0] mk_lr_q;     // (C keeps older labels in off columns)
+    reg [LR_W-1:0]       mk_lr_q;
     reg [NLP-1:0]        mk_s_pad;
-    reg [COLS-1:0]       mk_bits;
+    reg [COLS-1:0]       mk_on, mk_st;
+    /* verilator lint_off UNUSEDSIGNAL */     // mk_fill[COLS]: a carry beyond the last column
+    wire [COLS:0]        mk_fill = {1'b0, mk_on} + {1'b0, mk_st};
+    /* verilator lint_on UNUSEDSIGNAL */
+    // a run's cells get the status of its label, from its start: the status bit added at
+    // the start carries through the run (its cells become 0) and stops after it
+    wire [COLS-1:0]      mk_bits = mk_on & ~mk_fill[COLS-1:0];
     always @(*) begin : c_mk
         integer c;
         mk_s_pad = {NLP{1'b0}};
         mk_s_pad[NL:1] = mk_s_q;
+        mk_on = mk_lr_q[NPR*LBL_W +: COLS];
         for (c = 0; c < COLS; c = c + 1)
-            mk_bits[c] = mk_s_pad[mk_lr_q[c*LBL_W +: LBL_W]] && mk_lr_q[COLS*LBL_W + c];
+            mk_st[c] = mk_on[c] && (c == 0 || !mk_on[(c > 0) ? c - 1 : 0])
+                    && mk_s_pad[mk_lr_q[(c/2)*LBL_W +: LBL_W]];
     end
     (* ram_style = "distributed" *)
     reg [COLS-1:0]       mask_mem [0:ROWS-1];
@@ -949,7 +1032,7 @@ module fmt_blob #(
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
                    || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
-                   || cl_v_q || (|pend_q) || pk_v_q;
+                   || w_wr || cl_v_q || (|pend_q) || pk_v_q;
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
@@ -983,15 +1066,17 @@ module fmt_blob #(
         x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
         x1_m_q   <= ev_m;
         x1_lc_q  <= ev_lc;
-        x1_z_q   <= e1_z_q;
+        for (i = 0; i < COLS; i = i + 1)
+            x1_z_q[i*HM_W +: HM_W] <= ev_m[i] ? e1_z_q[i*HM_W +: HM_W] : {HM_W{1'b0}};
         x1_row_q <= e1_row_q;
         x2_f_q <= x1_f_q | {3'b000, |x1_lc_q, 1'b0};  x2_lc_q <= lc_enc;  x2_row_q <= x1_row_q;
-        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk2[PN2*PK_W-1:0];
+        x2_gs_q <= gs;  x2_gx_q <= gx;  x2_pk_q <= pk1[PN1*PK_W-1:0];
         x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= ts;  x3_sx_q <= tx;  x3_pk_q <= pk4[PN4*PK_W-1:0];
-        y4_e_q <= x3_ev;  y4_pk_q <= pk6[PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        x3_s_q <= tr_s[SZ_W-1:0];  x3_gw_q <= gw;  x3_pk_q <= pk3[PN3*PK_W-1:0];
+        y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
+        y4_sx_q <= tr_x[SX_W-1:0];
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
@@ -999,8 +1084,17 @@ module fmt_blob #(
             l1_e_q  <= l0_e_q;
             l1_oh_q <= l0_oh_q;
             l1_m_q  <= l1_m;
-            l1_y_q  <= y0;
+            l1_y_q  <= y0_raw;
+            l1_hp_q <= l0_hp;
+        end else begin                        // (held: no step this cycle; the pending
+            l1_y_q  <= ya;                    //  one applied now)
+            l1_hp_q <= 1'b0;
         end
+        s_mrg_q  <= do_merge;
+        s_run_q  <= do_run;
+        s_v_q    <= l2_y_q;
+        s_x_q    <= x_q;
+        s_lrun_q <= lrun;
         if (l2_ld) begin
             l2_e_q <= l1_e_q;
             l2_y_q <= y1;
@@ -1017,15 +1111,15 @@ module fmt_blob #(
         x4_last_q <= row_done && l2_lastrow;
         x4_lp_q  <= livep_nx;
         x4_lc_q  <= livec_nx;
-        // accumulators
-        begin
-            case (x4_op_q)                    // (OP_NONE when no step)
-                OP_NEW:   acc_q[x4_a_q] <= x4_e_q;
-                OP_ADD,
-                OP_MERGE: acc_q[x4_a_q] <= combine(acc_q[x4_a_q], acc_y);
-                default:  ;
-            endcase
-        end
+        // accumulators: K reads (label A, and label B of a MERGE), W combines and writes
+        w_op_q  <= x4_op_q;                   // (OP_NONE when no step)
+        w_a_q   <= x4_a_q;
+        w_ra_q  <= acc_q[x4_a_q];
+        w_y_q   <= acc_y;
+        w_fa_q  <= w_wr && (x4_a_q == w_a_q);
+        w_fb_q  <= w_wr && x4_mrg_q && (x4_b_q == w_a_q);
+        w_res_q <= w_res;
+        if (w_wr) acc_q[w_a_q] <= w_res;
         if (cl_go) begin
             cl_e_q   <= acc_b;
             cl_row_q <= crow_q[pk_q];
@@ -1073,6 +1167,8 @@ module fmt_blob #(
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
+            s_mrg_q  <= 1'b0;
+            s_run_q  <= 1'b0;
             pk_v_q   <= 1'b0;
             idle_q   <= 1'b0;
             abort_q  <= 1'b0;
@@ -1087,6 +1183,7 @@ module fmt_blob #(
             x2_v_q   <= 1'b0;
             x3_v_q   <= 1'b0;
             x4_v_q   <= 1'b0;
+            w_op_q   <= OP_NONE;
             cl_v_q   <= 1'b0;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;

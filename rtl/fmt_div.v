@@ -3,12 +3,14 @@
 // quot_o = floor(num_i / den_i) (low QW bits) and ovf_o = (num_i >= den_i * 2^QW),
 // i.e. the quotient does not fit in QW bits (then quot_o is all ones).  den_i = 0
 // always gives ovf_o = 1.
-// Long division with a narrow remainder: when the quotient fits, the numerator's high
-// part num >> QW is below den, so every partial remainder stays below den (DEN_W bits).
-// Stage s (s = 0..QW-1) appends numerator bit QW-1-s to the partial remainder,
-// subtracts den when it fits (a DEN_W + 1 bit subtractor) and shifts the quotient bit
-// into the register that held the numerator's low bits.  On overflow the stages work
-// on a truncated remainder and the result is replaced by all ones.
+// Non-restoring long division with a narrow remainder: when the quotient fits, the
+// numerator's high part num >> QW is below den, and every partial remainder r stays in
+// [-den, den) (DEN_W + 1 bits, signed).  Stage s (s = 0..QW-1) appends numerator bit
+// QW-1-s to r and subtracts den when r >= 0, adds it when r < 0 (one DEN_W + 2 bit
+// adder/subtractor, no select after it); the quotient bit is 1 when the result is
+// >= 0 (the same bits as restoring division) and is shifted into the register that held
+// the numerator's low bits.  On overflow the stages work on a truncated remainder and
+// the result is replaced by all ones.
 // Latency: QW + 1 clock cycles from num_i/den_i/valid_i to quot_o/ovf_o/valid_o (one
 // input register holding the overflow test, then one register per quotient bit).
 // Twin: fmt.interp.div_fixed.
@@ -36,7 +38,8 @@ module fmt_div #(
     localparam CW   = (HI_W > DEN_W) ? HI_W : DEN_W;
 
     reg [DEN_W-1:0] den_q [0:QW];
-    reg [DEN_W-1:0] rem_q [0:QW];             // partial remainder (< den unless overflow)
+    reg [DEN_W:0]   rem_q [0:QW];             // partial remainder, signed, in [-den, den)
+                                              // (unless overflow)
     reg [QW-1:0]    lq_q  [0:QW];             // numerator bits still to use (top) and
                                               // quotient bits decided so far (bottom)
     reg             ovf_q [0:QW];
@@ -48,7 +51,7 @@ module fmt_div #(
     wire [CW-1:0]   den_c = {{(CW-DEN_W){1'b0}}, den_i};
     always @(posedge clk) begin
         den_q[0] <= den_i;
-        rem_q[0] <= hi_c[DEN_W-1:0];
+        rem_q[0] <= {1'b0, hi_c[DEN_W-1:0]};
         lq_q[0]  <= num_e[QW-1:0];
         ovf_q[0] <= (hi_c >= den_c);
         if (rst) vld_q[0] <= 1'b0;
@@ -58,12 +61,14 @@ module fmt_div #(
     genvar s;
     generate
         for (s = 0; s < QW; s = s + 1) begin : g_stage
-            // append the next numerator bit; subtract den when it fits (no borrow)
-            wire [DEN_W:0]   t    = {rem_q[s], lq_q[s][QW-1]};
-            wire [DEN_W+1:0] d    = {1'b0, t} - {2'b00, den_q[s]};
+            // append the next numerator bit; r >= 0: subtract den, r < 0: add it
+            wire             neg  = rem_q[s][DEN_W];
+            wire [DEN_W+1:0] t    = {rem_q[s], lq_q[s][QW-1]};
+            wire [DEN_W+1:0] dx   = {2'b00, den_q[s]} ^ {(DEN_W+2){!neg}};
+            wire [DEN_W+1:0] d    = t + dx + {{(DEN_W+1){1'b0}}, !neg};
             wire             take = !d[DEN_W+1];
             always @(posedge clk) begin
-                rem_q[s+1] <= take ? d[DEN_W-1:0] : t[DEN_W-1:0];
+                rem_q[s+1] <= d[DEN_W:0];
                 lq_q[s+1]  <= {lq_q[s][QW-2:0], take};
                 den_q[s+1] <= den_q[s];
                 ovf_q[s+1] <= ovf_q[s];
