@@ -87,7 +87,7 @@ module fmt_div #(
     // A shadow pipeline carries each input beside its stage and multiplies the
     // quotient bits decided so far by the divisor, by shift and add (f_prod): in stage s
     // the partial remainder, the numerator bits still to use and that product add up
-    // to the numerator, and the remainder stays below the divisor; at the output this
+    // to the numerator, and the (restoring) remainder stays in [0, den); at the output this
     // says quot * den <= num < (quot + 1) * den.  Overflow: ovf_o == (num >= den * 2^QW).
     localparam FW = NUM_W + QW + DEN_W + 1;          // no sum or shift can overflow
     reg f_past_q = 1'b0;
@@ -116,15 +116,17 @@ module fmt_div #(
                     f_vld  <= rst ? 1'b0 : g_f[fs-1].f_vld;
                 end
             end
-            // numerator bits not yet used, and the remainder, at their weight
-            wire [FW-1:0] rest = ({{(FW-DEN_W){1'b0}}, rem_q[fs]} << (QW - fs))
-                                 + (lq_q[fs] >> fs);
             wire [FW-1:0] n    = {{(FW-NUM_W){1'b0}}, num_q};
             wire [FW-1:0] d    = {{(FW-DEN_W){1'b0}}, den_q[fs]};
+            // the restoring remainder: the signed partial remainder, plus den when < 0
+            wire [FW-1:0] r_sx = {{(FW-DEN_W-1){rem_q[fs][DEN_W]}}, rem_q[fs]};
+            wire [FW-1:0] r_re = rem_q[fs][DEN_W] ? r_sx + d : r_sx;
+            // numerator bits not yet used, and the remainder, at their weight
+            wire [FW-1:0] rest = (r_re << (QW - fs)) + (lq_q[fs] >> fs);
             always @(posedge clk) begin
                 if (f_past_q && full_q) begin
                     assert (ovf_q[fs] == (n >= (d << QW)));
-                    if (!ovf_q[fs]) assert (rest + prod_q == n && rem_q[fs] < den_q[fs]);
+                    if (!ovf_q[fs]) assert (rest + prod_q == n && r_re < d);
                 end
                 if (f_past_q) assert (vld_q[fs] == f_vld);
                 if (f_past_q && $past(rst)) assert (!vld_q[fs]);
