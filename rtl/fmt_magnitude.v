@@ -99,16 +99,15 @@ module fmt_magnitude #(
         for (i = 0; i < ITER; i = i + 1) begin : g_iter
             wire signed [IW-1:0] xs = x_q[i] >>> i;
             wire signed [IW-1:0] ys = y_q[i] >>> i;
-            // y < 0: rotate counter-clockwise (x - ys, y + xs), else clockwise (x + ys,
-            // y - xs): one adder each, the subtrahend inverted with the carry in set
-            // (-v = ~v + 1), so no add / subtract pair and multiplexer
-            wire                 neg = y_q[i][IW-1];
-            wire [IW-1:0]        ys_c = ys ^ {IW{neg}};
-            wire [IW-1:0]        xs_c = xs ^ {IW{~neg}};
             always @(posedge clk) begin
                 if (ce) begin
-                    x_q[i+1] <= x_q[i] + ys_c + {{(IW-1){1'b0}}, neg};
-                    y_q[i+1] <= y_q[i] + xs_c + {{(IW-1){1'b0}}, ~neg};
+                    if (y_q[i][IW-1]) begin        // y < 0: rotate counter-clockwise
+                        x_q[i+1] <= x_q[i] - ys;
+                        y_q[i+1] <= y_q[i] + xs;
+                    end else begin                 // y >= 0: rotate clockwise
+                        x_q[i+1] <= x_q[i] + ys;
+                        y_q[i+1] <= y_q[i] - xs;
+                    end
                     t_q[i+1] <= t_q[i];
                 end
             end
