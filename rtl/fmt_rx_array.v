@@ -471,7 +471,9 @@ module fmt_rx_array #(
     wire [AW-1:0]     mg_addr = mg_tag[TAGW-1 -: AW];
     // the reciprocal ROM (rx_fixed.recip_rom; 256 words whatever M_MAX, MC_W <= 8), read
     // with the row's M beside the sums
-    reg [RW-1:0]      recip_rom [0:255];
+    // in block RAM: rom_q is its read latch, rom2_q its output register (the LUT form
+    // was a 9-level xc5v path from the tag's shift register)
+    (* rom_style = "block", ram_style = "block" *) reg [RW-1:0] recip_rom [0:255];
     reg [RW-1:0]      rom_q, rom2_q;
     reg  [7:0]        a_m8;              // the row's M as an 8-bit ROM address
     always @* begin
