@@ -6,6 +6,8 @@
 // (TW_W bits each, scale 2^(TW_W-2), so +1 and -1 are exact), read from the hex file
 // fmt_fft_twMMMM.hex that sim/fmt/fft_r22sdf.py generates (folder: the macro FMT_ROM_DIR
 // when defined, e.g. -DFMT_ROM_DIR=\"/path/to/rtl/\", else the name alone, as fmt_dds_rom2).
+// ROMs of M >= ROM_BRAM_MIN words are block RAM (rom_style; read latch + output register
+// as below), smaller ones LUTs.
 //
 // Arithmetic: four DW x TW_W products (one multiplier each when DW <= MUL_W, else two:
 // see g_split), each truncated
@@ -33,8 +35,9 @@ module fmt_fft_twiddle #(
     parameter TW_W   = 18,           // twiddle width (signed), scale 2^(TW_W-2)
     parameter SH     = 13,           // right shift after the products (>= 1)
     parameter GUARD  = 3,            // product bits kept below the output LSB (>= 1)
-    parameter MUL_W  = 18            // widest data operand of one multiplier (ECP5
+    parameter MUL_W  = 18,           // widest data operand of one multiplier (ECP5
                                      // MULT18X18D; DSP48E takes 25): wider data is split
+    parameter ROM_BRAM_MIN = 16      // ROMs of this many words or more in block RAM
 ) (
     input  wire              clk,
     input  wire              rst,          // synchronous, active high
@@ -66,18 +69,37 @@ module fmt_fft_twiddle #(
     localparam [31:0] DIG0 = 48 + M % 10;
     localparam [8*18-1:0] TW_NAME = {"fmt_fft_tw", DIG3[7:0], DIG2[7:0], DIG1[7:0], DIG0[7:0], ".hex"};
 
-    reg [2*TW_W-1:0] rom [0:M-1];
-    initial begin
-`ifdef FMT_ROM_DIR
-        $readmemh({`FMT_ROM_DIR, TW_NAME}, rom);
-`else
-        $readmemh(TW_NAME, rom);
-`endif
-    end
-
     // step 0: ROM read register (the next element's twiddle); step 1: ROM output
     // register and data registers (the multiplier operands)
     reg [2*TW_W-1:0]    tw_q, tw2_q;
+    generate
+        if (M >= ROM_BRAM_MIN) begin : g_rom_bram
+            // block RAM (its read latch tw_q and output register tw2_q): no LUTs
+            (* rom_style = "block", ram_style = "block" *) reg [2*TW_W-1:0] rom [0:M-1];
+            initial begin
+`ifdef FMT_ROM_DIR
+                $readmemh({`FMT_ROM_DIR, TW_NAME}, rom);
+`else
+                $readmemh(TW_NAME, rom);
+`endif
+            end
+            always @(posedge clk) begin
+                if (ce) tw_q <= rom[nxt_idx_i[LOG2_M-1:0]];
+            end
+        end else begin : g_rom_lut
+            reg [2*TW_W-1:0] rom [0:M-1];
+            initial begin
+`ifdef FMT_ROM_DIR
+                $readmemh({`FMT_ROM_DIR, TW_NAME}, rom);
+`else
+                $readmemh(TW_NAME, rom);
+`endif
+            end
+            always @(posedge clk) begin
+                if (ce) tw_q <= rom[nxt_idx_i[LOG2_M-1:0]];
+            end
+        end
+    endgenerate
     reg signed [DW-1:0] a_q, b_q;
     reg [LOG2_N-1:0]    idx1_q, idx2_q, idx3_q;
     reg                 v1_q, v2_q, v3_q;
@@ -92,7 +114,6 @@ module fmt_fft_twiddle #(
 
     always @(posedge clk) begin
         if (ce) begin
-            tw_q  <= rom[nxt_idx_i[LOG2_M-1:0]];
             tw2_q <= tw_q;
             a_q   <= in_re_i;
             b_q   <= in_im_i;

@@ -21,7 +21,12 @@
 // entries, LUT RAM); the held bits stay one per row, read by every channel and updated
 // by channel CH-1 (the channels of a bin all see the state before that bin).  out_ch_o
 // names the output's channel.  One split serves the CH column pairs of one
-// time-multiplexed FFT engine.
+// time-multiplexed FFT engine.  HELD_BRAM = 1 (default for CH >= 3): the held memory is
+// block RAM with a registered read (no LUT RAM, no read multiplexer): step 2 its read
+// latch, step 3 its output register (every bin is written back there; the second of a
+// pair writes a dead entry, its held bit is cleared), step 4 the sums: latency 4 ce
+// cycles.  The same {channel, row} is read again only at the mirror bin, >= CH >= 3
+// steps later, after the write.
 // Requires BIN_LO >= 1 and BIN_LO + (ROWS-1)*BIN_STEP < N/2 (checked by params.py), so
 // a bin and its mirror are never the same bin.  BIN_STEP that is not a power of two
 // costs a constant divider on the bin index.
@@ -37,7 +42,9 @@ module fmt_pair_split #(
     parameter TAG_W    = 4,              // side band carried from the second bin to the output
     parameter ROW_W    = (ROWS > 1) ? $clog2(ROWS) : 1, // row index width
     parameter CH       = 1,              // interleaved channels (column pairs)
-    parameter CH_W     = (CH > 1) ? $clog2(CH) : 1      // channel index width
+    parameter CH_W     = (CH > 1) ? $clog2(CH) : 1,     // channel index width
+    parameter HELD_BRAM = (CH >= 3) ? 1 : 0             // 1: the held memory in block RAM
+                                                        // (registered read, LAT 4; needs CH >= 3)
 ) (
     input  wire                 clk,
     input  wire                 rst,       // synchronous, active high
@@ -110,50 +117,127 @@ module fmt_pair_split #(
         end
     end
 
-    // ---- step 2: held first-of-pair memory, per {channel, row}; sums ----
+    // ---- held first-of-pair memory, per {channel, row}; sums ----
     localparam AW = (CH > 1) ? CH_W + ROW_W : ROW_W;
     localparam MD = (CH > 1) ? (1 << AW) : ROWS;
     localparam integer CHM1 = CH - 1;
     localparam [CH_W-1:0] CH_LAST = CHM1[CH_W-1:0];
-    wire [ROW_W-1:0] row = d_row_q;
-    wire          hit_q = d_m_q;           // the current bin is the mirror (q = Z[N-k])
-    wire [AW-1:0] addr;                    // held memory address {channel, row}
-    wire          upd;                     // the last channel of this bin: update held_q
+    wire [AW-1:0] d_addr;                  // held memory address {channel, row} of the decode register
     generate
         if (CH > 1) begin : g_ch
-            assign addr = {d_ch_q, row};
-            assign upd  = (d_ch_q == CH_LAST);
+            assign d_addr = {d_ch_q, d_row_q};
         end else begin : g_one
-            assign addr = row;
-            assign upd  = 1'b1;
+            assign d_addr = d_row_q;
         end
     endgenerate
 
-    reg [2*W:0]    mem [0:MD-1];           // {is_mirror, re, im}
+    // the step that pairs: its bin, the held entry of its {channel, row}
+    wire                s_hit;             // a comb bin or its mirror
+    wire                hit_q;             // it is the mirror (q = Z[N-k])
+    wire [ROW_W-1:0]    row;
+    wire [CH_W-1:0]     s_ch;
+    wire signed [W-1:0] s_re, s_im;
+    wire [TAG_W-1:0]    s_tag;
+    wire [2*W:0]        rd;                // held entry {is_mirror, re, im}
+    wire                second;            // the second arrival of a pair: the other member is held
+
+    generate
+        if (HELD_BRAM != 0 && CH < 3) begin : g_check_bram
+            // the block-RAM form reads an entry again >= CH steps after writing it at step 3
+            fmt_pair_split_HELD_BRAM_needs_CH_ge_3 u_bad ();
+        end
+    endgenerate
+
+    generate
+        if (HELD_BRAM != 0) begin : g_bram
+            // block RAM, registered read: step 2 the read latch (address from the decode
+            // register), step 3 the block-RAM output register, step 4 the sums.  Every
+            // bin is written back at step 3 (the second of a pair too: it clears held,
+            // so the entry is dead); the same {channel, row} is read again at the
+            // mirror bin, >= CH >= 3 steps later, after that write
+            (* ram_style = "block" *) reg [2*W:0] mem [0:MD-1];
+            reg [2*W:0]         h_lat_q, h_out_q;
+            reg                 e_hit_q, e_m_q, f_hit_q, f_m_q;
+            reg [ROW_W-1:0]     e_row_q, f_row_q;
+            reg [CH_W-1:0]      e_ch_q, f_ch_q;
+            reg signed [W-1:0]  e_re_q, e_im_q, f_re_q, f_im_q;
+            reg [TAG_W-1:0]     e_tag_q, f_tag_q;
+            wire [AW-1:0]       e_addr;
+            if (CH > 1) begin : g_ea
+                assign e_addr = {e_ch_q, e_row_q};
+            end else begin : g_ea1
+                assign e_addr = e_row_q;
+            end
+            always @(posedge clk) begin
+                if (ce) begin
+                    h_lat_q <= mem[d_addr];
+                    h_out_q <= h_lat_q;
+                    if (e_hit_q) mem[e_addr] <= {e_m_q, e_re_q, e_im_q};
+                end
+            end
+            always @(posedge clk) begin
+                if (rst) begin
+                    e_hit_q <= 1'b0;
+                    f_hit_q <= 1'b0;
+                end else if (ce) begin
+                    e_hit_q <= d_hit_q;
+                    f_hit_q <= e_hit_q;
+                end
+            end
+            always @(posedge clk) begin
+                if (ce) begin
+                    e_m_q <= d_m_q;     f_m_q <= e_m_q;
+                    e_row_q <= d_row_q; f_row_q <= e_row_q;
+                    e_ch_q <= d_ch_q;   f_ch_q <= e_ch_q;
+                    e_re_q <= d_re_q;   f_re_q <= e_re_q;
+                    e_im_q <= d_im_q;   f_im_q <= e_im_q;
+                    e_tag_q <= d_tag_q; f_tag_q <= e_tag_q;
+                end
+            end
+            assign s_hit = f_hit_q;
+            assign hit_q = f_m_q;
+            assign row   = f_row_q;
+            assign s_ch  = f_ch_q;
+            assign s_re  = f_re_q;
+            assign s_im  = f_im_q;
+            assign s_tag = f_tag_q;
+            assign rd    = h_out_q;
+        end else begin : g_lutram
+            // LUT RAM, read asynchronously in step 2; only a first arrival is written
+            reg [2*W:0] mem [0:MD-1];
+            always @(posedge clk) begin
+                if (ce && d_hit_q && !second) begin
+                    mem[d_addr] <= {d_m_q, d_re_q, d_im_q};
+                end
+            end
+            assign s_hit = d_hit_q;
+            assign hit_q = d_m_q;
+            assign row   = d_row_q;
+            assign s_ch  = d_ch_q;
+            assign s_re  = d_re_q;
+            assign s_im  = d_im_q;
+            assign s_tag = d_tag_q;
+            assign rd    = mem[d_addr];
+        end
+    endgenerate
+
+    wire          upd = (CH > 1) ? (s_ch == CH_LAST) : 1'b1;   // the last channel of this bin: update held_q
     reg [ROWS-1:0] held_q;                 // per row, shared by the channels
 
-    wire [2*W:0]        rd       = mem[addr];
     wire                held     = held_q[row];
     wire signed [W-1:0] h_re     = rd[2*W-1:W];
     wire signed [W-1:0] h_im     = rd[W-1:0];
     wire signed [W:0]   hx_re    = {h_re[W-1], h_re};
     wire signed [W:0]   hx_im    = {h_im[W-1], h_im};
-    wire signed [W:0]   cx_re    = {d_re_q[W-1], d_re_q};
-    wire signed [W:0]   cx_im    = {d_im_q[W-1], d_im_q};
+    wire signed [W:0]   cx_re    = {s_re[W-1], s_re};
+    wire signed [W:0]   cx_im    = {s_im[W-1], s_im};
     // p = Z[k], q = Z[N-k]: the current bin is q when it is the mirror
     wire signed [W:0]   p_re     = hit_q ? hx_re : cx_re;
     wire signed [W:0]   p_im     = hit_q ? hx_im : cx_im;
     wire signed [W:0]   q_re     = hit_q ? cx_re : hx_re;
     wire signed [W:0]   q_im     = hit_q ? cx_im : hx_im;
 
-    // the second arrival of a pair: the other member is held
-    wire                second   = held && (rd[2*W] != hit_q);
-
-    always @(posedge clk) begin
-        if (ce && d_hit_q && !second) begin
-            mem[addr] <= {hit_q, d_re_q, d_im_q};
-        end
-    end
+    assign              second   = held && (rd[2*W] != hit_q);
 
     always @(posedge clk) begin
         if (rst) begin
@@ -161,7 +245,7 @@ module fmt_pair_split #(
             out_valid_o <= 1'b0;
         end else if (ce) begin
             out_valid_o <= 1'b0;
-            if (d_hit_q) begin
+            if (s_hit) begin
                 // the second arrival must be the other member of the pair
                 if (second) begin
                     if (upd) held_q[row] <= 1'b0;
@@ -182,8 +266,8 @@ module fmt_pair_split #(
             b_re_o    <= hx_im + cx_im;        // p_im + q_im
             a_im_o    <= p_im - q_im;
             b_im_o    <= q_re - p_re;
-            out_tag_o <= d_tag_q;
-            out_ch_o  <= d_ch_q;
+            out_tag_o <= s_tag;
+            out_ch_o  <= s_ch;
         end
     end
 

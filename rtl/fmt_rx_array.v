@@ -52,18 +52,22 @@
 // split output (the last pair's, FFT_CH > 1) is registered at step a_r: FFT_CH = 1,
 // LATENCY0 + slot_r + 2 ce cycles later with POST_CLK = 0, 1 clk after LATENCY0 + slot_r
 // + 1 ce cycles with POST_CLK = 1 (the split's second stage runs on clk); FFT_CH = G with
-// ce every G clk, clk G + LATENCY0 + G slot_r + 1 (the FFT's register stages step on
-// clk cycles: rx_array.rx_split_clk); the row is queued at a_r + 1, loaded at L_r >= a_r + 2, and its
-// beat is at step L_r + P + MAG_ITER + 12 (P unit input steps, cell multiplexer register,
-// MAG_ITER + 3 magnitude stages, accumulator read and its output register, sum, rounding
-// add, reciprocal partial products, their middle sum, the full product, shift +
-// saturate, row register); the same for every M (counted from the frame's last window).
-// N = 256, 30 x 40: at 3 x fs (K = 4) 815 clk = 271.7 fs cycles with FFT_CH = 3 (859 clk
-// with FFT_CH = 1), hm_eof_o 1 step later (tb/fmt_rx_array measures them,
-// rx_array.rx_row_beats predicts).
-// Pipeline rule: every block-RAM read (accumulator, reciprocal ROM) has its output
-// register, every product its operand and product registers (the 2T+1-bit t R as four
-// 17 x 17-bit partial products, then one adder per step).
+// ce every G clk, clk G + LATENCY0 + G slot_r + 3 (the FFT's register stages step on
+// clk cycles; the split's held memory is block RAM with a registered read at G >= 3:
+// rx_array.rx_split_clk, split_lat); the row is queued at a_r + 1, loaded at L_r >= a_r + 2,
+// and its beat is at step L_r + P + MAG_ITER + 12 + RD_LAT (P unit input steps, with
+// FFT_CH > 1 the result memories' block-RAM read latch and output register (RD_LAT = 2;
+// 0 with FFT_CH = 1), cell multiplexer register, MAG_ITER + 3 magnitude stages,
+// accumulator read and its output register, sum, rounding add, reciprocal partial
+// products, their middle sum, the full product, shift + saturate, row register); the
+// same for every M (counted from the frame's last window).
+// N = 256, 30 x 40: at 3 x fs (K = 4) 819 clk = 273.0 fs cycles with FFT_CH = 3 (859 clk
+// with FFT_CH = 1; 815 before the result and held memories moved to block RAM), hm_eof_o
+// 1 step later (tb/fmt_rx_array measures them, rx_array.rx_row_beats predicts).
+// Pipeline rule: every block-RAM read (accumulator, reciprocal ROM, FFT_CH > 1: the
+// pairs' result memories) has its output register, every product its operand and
+// product registers (the 2T+1-bit t R as four 17 x 17-bit partial products, then one
+// adder per step).
 // Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
 // heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
 // before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
@@ -174,6 +178,7 @@ module fmt_rx_array #(
     wire                    chk_v;       // a row's result memories start to be rewritten
     wire [ROW_W-1:0]        chk_row;
     wire                    seq_ovf;     // a time-multiplexed engine missed a sample
+    wire [COLS-1:0]         col_en;      // FFT_CH > 1: column c's result register loads (its step)
     wire                    fft_ovf_any;
 
     generate
@@ -249,7 +254,8 @@ module fmt_rx_array #(
                     .rx_sign_i(rx_sign_i), .m_i(m_i),
                     .ps_valid_o(g_valid[p]), .ps_ch_o(g_ch[p*GCH_W +: GCH_W]),
                     .ps_row_o(g_row[p*ROW_W +: ROW_W]), .ps_tag_o(g_tag[p*(MC_W+2) +: MC_W+2]),
-                    .rd_row_i(row_q), .rd_data_o(cells[p*GC*2*CW +: NPG*2*CW]),
+                    .rd_row_i(row_q), .rd_en_i(col_en[p*GC*2 +: NPG*2]),
+                    .rd_data_o(cells[p*GC*2*CW +: NPG*2*CW]),
                     .fft_ovf_o(g_ovf[p]), .seq_ovf_o(g_seq[p]));
             end
             assign push_v      = g_valid[0] && (g_ch[GCH_W-1:0] == GCH_LAST);
@@ -340,8 +346,57 @@ module fmt_rx_array #(
     // synthesis translate_on
 
     // ---- shared magnitude units: unit u takes cell g*K + u ----
-    // the cell multiplexer (result memories' read data, group g_q) is registered in
-    // front of the units, with the valid bit and the tag
+    // the cell multiplexer (result memories' read data, group g) is registered in front
+    // of the units, with the valid bit and the tag.  FFT_CH > 1: the result memories are
+    // block RAM read at row_q into their read latch and output register, so the group,
+    // the valid bit and the tag reach the multiplexer RD_LAT = 2 steps after the engine
+    // named them; FFT_CH = 1: LUT RAM, read at once (RD_LAT = 0)
+    localparam RD_LAT = (GC > 1) ? 2 : 0;
+    wire            mx_v;                // the engine is feeding (delayed by RD_LAT)
+    wire [TAGW-1:0] mx_tag;              // {row, g, M, first, last} (delayed by RD_LAT)
+    genvar cc;
+    generate
+        if (RD_LAT > 0) begin : g_rd_dly
+            // rv1 / rt1: the step between the read latch and the output register; oh1_q:
+            // one-hot of that step's group: column c's half of its pair's output register
+            // loads only in its group's step (else it clears), so the cell "multiplexer"
+            // is an OR of the P cells of a unit
+            reg             rv1_q, rv2_q;
+            reg [TAGW-1:0]  rt1_q, rt2_q;
+            reg [P-1:0]     oh1_q;
+            integer gi;
+            always @(posedge clk) begin
+                if (rst) begin
+                    rv1_q <= 1'b0;
+                    rv2_q <= 1'b0;
+                    oh1_q <= {P{1'b0}};
+                end else if (post_ce) begin
+                    rv1_q <= busy_q;
+                    rv2_q <= rv1_q;
+                    for (gi = 0; gi < P; gi = gi + 1)
+                        oh1_q[gi] <= busy_q && (g_q == gi[G_W-1:0]);
+                end
+            end
+            always @(posedge clk) begin
+                if (post_ce) begin
+                    rt1_q <= {row_q, g_q, etag_q};
+                    rt2_q <= rt1_q;
+                end
+            end
+            for (cc = 0; cc < COLS; cc = cc + 1) begin : g_col_en
+                assign col_en[cc] = oh1_q[cc / K];
+            end
+            assign mx_v   = rv2_q;
+            assign mx_tag = rt2_q;
+        end else begin : g_rd_now
+            assign col_en = {COLS{1'b0}};   // LUT-RAM result memories: no load enables
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire unused_col_en = &{1'b0, col_en};
+            /* verilator lint_on UNUSEDSIGNAL */
+            assign mx_v   = busy_q;
+            assign mx_tag = {row_q, g_q, etag_q};
+        end
+    endgenerate
     wire [K*MW-1:0] mags;
     wire            mg_valid;
     wire [TAGW-1:0] mg_tag;
@@ -351,10 +406,10 @@ module fmt_rx_array #(
         if (rst)
             sel_v_q <= 1'b0;
         else if (post_ce)
-            sel_v_q <= busy_q;
+            sel_v_q <= mx_v;
     end
     always @(posedge clk) begin
-        if (post_ce) sel_tag_q <= {row_q, g_q, etag_q};
+        if (post_ce) sel_tag_q <= mx_tag;
     end
     genvar u;
     generate
@@ -366,8 +421,23 @@ module fmt_rx_array #(
                 assign lane[gl*CW +: CW] = cells[(gl*K+u)*CW +: CW];
             end
             reg [CW-1:0] sel_q;
-            always @(posedge clk) begin
-                if (post_ce) sel_q <= lane[g_q*CW +: CW];
+            if (RD_LAT > 0) begin : g_or
+                // only the cell of this step is non-zero (col_en): OR the P cells
+                reg [CW-1:0] any;
+                integer go;
+                always @* begin
+                    any = {CW{1'b0}};
+                    for (go = 0; go < P; go = go + 1)
+                        any = any | lane[go*CW +: CW];
+                end
+                always @(posedge clk) begin
+                    if (post_ce) sel_q <= any;
+                end
+            end else begin : g_mux
+                wire [G_W-1:0] mx_g = mx_tag[MC_W+2 +: G_W];
+                always @(posedge clk) begin
+                    if (post_ce) sel_q <= lane[mx_g*CW +: CW];
+                end
             end
             if (u == 0) begin : g_lead
                 fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag (
@@ -401,7 +471,9 @@ module fmt_rx_array #(
     wire [AW-1:0]     mg_addr = mg_tag[TAGW-1 -: AW];
     // the reciprocal ROM (rx_fixed.recip_rom; 256 words whatever M_MAX, MC_W <= 8), read
     // with the row's M beside the sums
-    reg [RW-1:0]      recip_rom [0:255];
+    // in block RAM: rom_q is its read latch, rom2_q its output register (the LUT form
+    // was a 9-level xc5v path from the tag's shift register)
+    (* rom_style = "block", ram_style = "block" *) reg [RW-1:0] recip_rom [0:255];
     reg [RW-1:0]      rom_q, rom2_q;
     reg  [7:0]        a_m8;              // the row's M as an 8-bit ROM address
     always @* begin

@@ -19,9 +19,12 @@
 // Timing: channel c of ADC sample j enters the FFT input register on the edge c + 1
 // clk after sample j's ce edge (step j G + c); its window's slot s leaves the FFT on step
 // t_c + LATENCY0 + s G (fmt_fft_r22sdf), the split decodes it on that step's edge and
-// registers the pair's output one clk later (fmt_pair_split, 2 stages on every clk);
+// registers the pair's output three clk later (fmt_pair_split, 4 stages on every clk:
+// its held memory is block RAM with a registered read at G >= 3, else 2 stages);
 // ps_* show it from the next clk (ps_ch_o = c); the result memory of pair c is written
-// on the next edge (rd_data_o shows it from then on, asynchronous read: LUT RAM).  With
+// on the next edge.  The result memories are block RAM with a registered read:
+// rd_data_o = the row rd_row_i named two clk earlier (read latch, output register),
+// each column's half zero unless its rd_en_i bit was set one clk earlier.  With
 // ce every G clk (the 3 x fs build) the steps are consecutive clk cycles, so pair c's
 // row r leaves c clk after pair 0's, LATENCY0 + slot_r samples after the window minus
 // LATENCY0 (G - 1) clk (the register stages count clk cycles, not samples).
@@ -43,7 +46,9 @@ module fmt_rx_group_front #(
     parameter NP         = G,              // pairs actually connected, 1..G
     parameter ROW_W      = (ROWS > 1) ? $clog2(ROWS) : 1,      // row index width
     parameter MC_W       = $clog2(M_MAX + 1), // width of m_i
-    parameter CH_W       = (G > 1) ? $clog2(G) : 1              // channel index width
+    parameter CH_W       = (G > 1) ? $clog2(G) : 1,             // channel index width
+    parameter FFT_BRAM_MIN = 48            // FFT delay lines this long or longer in block RAM
+                                           // (N = 256, G = 3: 384, 192, 96 and 48 deep)
 ) (
     input  wire                       clk,
     input  wire                       rst,        // synchronous, active high
@@ -55,7 +60,9 @@ module fmt_rx_group_front #(
     output wire [CH_W-1:0]            ps_ch_o,    // its pair within the group (channel)
     output wire [ROW_W-1:0]           ps_row_o,   // its row index
     output wire [MC_W+1:0]            ps_tag_o,   // {M, first window, last window}
-    input  wire [ROW_W-1:0]           rd_row_i,   // result memory read address (row)
+    input  wire [ROW_W-1:0]           rd_row_i,   // result memory read address (row), read 2 clk later
+    input  wire [2*NP-1:0]            rd_en_i,    // per column (pair j: a at 2j, b at 2j+1): its half of
+                                                  // the output register takes the read latch, else clears
     output wire [NP*(4*FFT_OUT_W+4)-1:0] rd_data_o, // pair j: {2 Im B, 2 Re B, 2 Im A, 2 Re A} at [j*4*(W+1)]
     output wire                       fft_ovf_o,  // sticky FFT saturation
     output reg                        seq_ovf_o   // sticky: ce came before the G steps were done
@@ -126,7 +133,8 @@ module fmt_rx_group_front #(
     wire [CH_W-1:0]     f_ch;
     wire signed [W-1:0] f_re, f_im;
     fmt_fft_r22sdf #(
-        .LOG2_N(LOG2_N), .IN_W(XW), .OUT_W(W), .CH(G), .CH_W(CH_W)
+        .LOG2_N(LOG2_N), .IN_W(XW), .OUT_W(W), .CH(G), .CH_W(CH_W),
+        .BRAM_MIN(FFT_BRAM_MIN)
     ) u_fft (
         .clk(clk), .rst(rst), .ce(run_q), .in_re_i(xa), .in_im_i(xb),
         .out_valid_o(f_valid), .out_slot_o(f_slot), .out_bin_o(f_bin),
@@ -153,16 +161,30 @@ module fmt_rx_group_front #(
         .a_re_o(s_ar), .a_im_o(s_ai), .b_re_o(s_br), .b_im_o(s_bi), .out_tag_o(ps_tag_o),
         .out_ch_o(ps_ch_o));
 
-    // ---- result memories, one per pair (read all at once by the shared magnitude units)
+    // ---- result memories, one per pair, in block RAM (read by the shared magnitude
+    // units): the read latch takes res_mem[rd_row_i] on every clk; one clk later each
+    // column's half of the output register (rd_data_o) takes the latch when its
+    // rd_en_i bit is set, else clears (its flip-flops' synchronous reset): a column is
+    // non-zero only in the step the units take it, so fmt_rx_array selects a cell with an
+    // OR instead of a multiplexer
     genvar p;
     generate
         for (p = 0; p < NP; p = p + 1) begin : g_res
-            reg [4*MW-1:0] res_mem [0:ROWS-1];
+            (* ram_style = "block" *) reg [4*MW-1:0] res_mem [0:ROWS-1];
+            reg [4*MW-1:0] rd_lat_q;
+            reg [2*MW-1:0] rd_a_q, rd_b_q;         // block-RAM output register, per column
             always @(posedge clk) begin
                 if (ps_valid_o && ps_ch_o == p[CH_W-1:0])
                     res_mem[ps_row_o] <= {s_bi, s_br, s_ai, s_ar};
+                rd_lat_q <= res_mem[rd_row_i];
             end
-            assign rd_data_o[p*4*MW +: 4*MW] = res_mem[rd_row_i];
+            always @(posedge clk) begin
+                if (rd_en_i[2*p]) rd_a_q <= rd_lat_q[2*MW-1:0];
+                else              rd_a_q <= {(2*MW){1'b0}};
+                if (rd_en_i[2*p+1]) rd_b_q <= rd_lat_q[4*MW-1:2*MW];
+                else                rd_b_q <= {(2*MW){1'b0}};
+            end
+            assign rd_data_o[p*4*MW +: 4*MW] = {rd_b_q, rd_a_q};
         end
     endgenerate
 

@@ -317,6 +317,9 @@ RX_SHARE_BACK = MAG_ITER + 12  # steps from a row's last unit input to its beat,
 #                                accumulator read and its output register, sum, rounding
 #                                add, reciprocal partial products, their middle sum, the
 #                                full product, shift + saturate, row register
+RX_RES_RD = 2  # FFT_CH > 1: the result memories are block RAM (read latch + output
+#                register) between the engine's row / group and the cell multiplexer
+#                (FFT_CH = 1: LUT RAM read at once, 0)
 
 
 def rx_share_schedule(cfg, units: int, step_per_slot: int):
@@ -374,6 +377,14 @@ def rx_fft_ch_default(post_clk: int = 1, cps=None) -> int:
 SPLIT_LAT = 2   # fmt_pair_split: steps from a pair's second bin to its output register
 #                 (decode register, held memory + sums); its steps are clk cycles when the
 #                 split runs on every clk (POST_CLK = 1, FFT_CH > 1), else ce cycles
+SPLIT_LAT_BRAM = 4   # the same with its held memory in block RAM (CH >= 3, HELD_BRAM):
+#                 decode register, read latch, block-RAM output register, sums
+
+
+def split_lat(fft_ch: int) -> int:
+    """fmt_pair_split's latency in steps for the channels of one engine (FFT_CH = 1:
+    fmt_rx_pair_front's split, CH = 1)."""
+    return SPLIT_LAT_BRAM if fft_ch >= 3 else SPLIT_LAT
 
 
 def rx_split_clk(latency0: int, slot: int, every: int, fft_ch: int, ch: int,
@@ -387,7 +398,7 @@ def rx_split_clk(latency0: int, slot: int, every: int, fft_ch: int, ch: int,
     c enters on the clk c + 1 after the ce edge (step j G + c for sample j); slot s leaves
     the FFT on step t_c + latency0 + s G; step j G + q runs on clk j every + 1 + q (the
     engine steps on the G clk cycles after each ce, ce every ``every`` >= G clk)."""
-    extra = (SPLIT_LAT - 1) * (1 if post_clk else every)
+    extra = (split_lat(fft_ch) - 1) * (1 if post_clk else every)
     if fft_ch <= 1:
         return (latency0 + 1 + slot) * every + extra
     if every < fft_ch:
@@ -418,7 +429,8 @@ def rx_row_beats(cfg, latency0: int, every: int = 1, post_clk: int = 1, cps=None
         raise ValueError(f"{units} magnitude units do not keep up at {steps_run} steps per slot")
     # split of slot 0 (the queue push), clk; the schedule counts from there
     base = rx_split_clk(latency0, 0, every, fft_ch, fft_ch - 1, post_clk)
-    return {r: base + (lo + p + RX_SHARE_BACK) * step_clk for r, (a, lo) in sched.items()}
+    back = RX_SHARE_BACK + (RX_RES_RD if fft_ch > 1 else 0)
+    return {r: base + (lo + p + back) * step_clk for r, (a, lo) in sched.items()}
 
 
 # ---- floating-point receiver (the chain's float path, fmt.chain) -------------------

@@ -314,7 +314,7 @@ def test_split_clk_step_map(fft_ch, every):
     after each ce) against an enumeration of the engine's step cycles: channel c of the
     window's last sample K is step K G + c, slot s leaves latency0 + s G steps later."""
     lat0, kk = 22, 300
-    ex = R.SPLIT_LAT - 1                     # the split's own steps (clk here)
+    ex = R.split_lat(fft_ch) - 1             # the split's own steps (clk here)
     if fft_ch == 1:
         for s in (0, 5, 251):
             assert R.rx_split_clk(lat0, s, every, 1, 0) == (lat0 + 1 + s) * every + ex
@@ -333,11 +333,13 @@ def test_split_clk_step_map(fft_ch, every):
 
 def test_row_beats_shared_engine_default():
     """30 x 40 at 3 x fs: the shared FFT engines (FFT_CH = 3, the default) move the last
-    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (859 clk)."""
+    heat-map row LATENCY0 (G - 1) = 44 clk earlier than one engine per pair (859 clk),
+    less the 2 + 2 clk of their block-RAM result memories' and pair split's held memory's
+    registered reads (RX_RES_RD, SPLIT_LAT_BRAM - SPLIT_LAT)."""
     from fmt import fft_r22sdf as F
     cfg = params.DEFAULT
     lat0 = F.latency0(cfg.log2_n, cfg.adc_bits + 1, R.fft_out_w(cfg))
     one = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1, fft_ch=1).values())
     shared = max(R.rx_row_beats(cfg, lat0, every=3, post_clk=1).values())
     assert R.rx_fft_ch_default(1, 3) == 3 and R.rx_fft_ch_default(0, 1) == 1
-    assert one == 859 and shared == one - lat0 * 2
+    assert one == 859 and shared == one - lat0 * 2 + R.RX_RES_RD + R.SPLIT_LAT_BRAM - R.SPLIT_LAT

@@ -21,7 +21,9 @@ from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt import rx_array as R
 
-LAT = 2     # ce cycles from the second bin of a pair to its (2A, 2B) (decode, memory + sums)
+LAT = R.split_lat(env_int("CH", 1))   # ce cycles from the second bin of a pair to its (2A, 2B):
+#       2 (decode, LUT-RAM held memory + sums), 4 with CH >= 3 (decode, block-RAM read
+#       latch and output register, sums)
 
 
 class TB(ClockedTB):
