@@ -43,10 +43,11 @@
 // snapshot RAM (one row per heat-map beat) and SNAP_STATUS becomes {1, 0, 14'b0,
 // frame}.  Other block addresses read 0.
 //
-// UART event stream: events leaving the parallel port are offered to the control port
-// (STREAM command); an event arriving while the port is busy sending is not sent (the
-// UART is a monitor; REPORT_PERIOD decimates).  Event payload: sim/fmt/protocol.py
-// pack_event (24 bytes).
+// UART event stream: events leaving the parallel port (STREAM command on) go through
+// fmt_report_fifo (2^STREAM_AW events) to the control port: a frame's events are sent
+// all together or, if they do not fit while the UART is still sending, not at all
+// (STREAM_DROP_COUNT).  The UART is a monitor (REPORT_PERIOD decimates; 2.7 ms per event
+// at 115200 baud).  Event payload: sim/fmt/protocol.py pack_event (24 bytes).
 //
 // Status: STATUS bits (w1c) are set by the blocks' sticky flags (bit 0 flattening
 // saturation, 1 receiver FFT/cell overflow, 2 event-port drop, 3 latency saturation,
@@ -78,6 +79,7 @@ module fmt_core #(
                                                   // turns it on); 0: left out, ~11k LUT6 less
     parameter UART_DIV       = 1085,              // clk cycles per UART bit (125 MHz: 115200 baud)
     parameter UART_TIMEOUT   = 40,                // control-port inter-byte timeout, bit times
+    parameter STREAM_AW      = 5,                 // UART report FIFO: 2^STREAM_AW events (whole reports)
     parameter REGMAP_ID      = `FMT_REGMAP_ID,    // register-map id reported by INFO (generated)
     parameter ROW_W          = (ROWS > 1) ? $clog2(ROWS) : 1,   // row index width
     parameter COL_W          = (COLS > 1) ? $clog2(COLS) : 1    // column index width
@@ -460,7 +462,18 @@ module fmt_core #(
     wire [191:0] evs_data = {ev_frame, ev_time_o, ev_id_o, ev_last, 5'd0, ev_type, ev_x_o, ev_y_o,
                              {{(32 - HM_W){1'b0}}, ev_strength_o}, ev_axis_major_o,
                              ev_axis_minor_o, ev_angle_o, ev_flags_o, 16'd0};
-    /* verilator lint_off PINCONNECTEMPTY */  // evs_ready_o: the UART stream is a monitor tap
+    // The UART stream is a monitor tap of the event port's handshake: a report FIFO holds
+    // each admitted frame's events until the port has sent them, and drops a frame whole
+    // (STREAM_DROP_COUNT) when it does not fit, so the host never gets half a report.
+    wire         evs_valid, evs_ready;
+    wire [191:0] evs_q;
+    wire [15:0]  stream_drop_cnt;
+    /* verilator lint_off PINCONNECTEMPTY */  // drop_o: the count is what the host reads
+    fmt_report_fifo #(.W(192), .AW(STREAM_AW)) u_stream (
+        .clk(clk), .rst(rst), .en_i(stream_en), .in_valid_i(ev_fire), .in_data_i(evs_data),
+        .in_last_i(ev_last), .out_valid_o(evs_valid), .out_data_o(evs_q), .out_ready_i(evs_ready),
+        .drop_o(), .drop_count_o(stream_drop_cnt));
+    /* verilator lint_on PINCONNECTEMPTY */
     fmt_ctrl_port #(
         .DIV(UART_DIV), .TIMEOUT_BITS(UART_TIMEOUT), .BLK_LAT(3), .EV_BYTES(24),
         .REGMAP_ID(REGMAP_ID), .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .HM_W(HM_W),
@@ -469,10 +482,9 @@ module fmt_core #(
         .clk(clk), .rst(rst), .rxd_i(uart_rx_i), .txd_o(uart_tx_o),
         .reg_we_o(u_we), .reg_re_o(u_re), .reg_addr_o(u_addr), .reg_wdata_o(u_wdata),
         .reg_rdata_i(reg_rdata), .blk_req_o(blk_req), .blk_addr_o(blk_addr),
-        .blk_rdata_i(blk_rdata_q), .evs_valid_i(ev_fire), .evs_data_i(evs_data),
-        .evs_ready_o(), .stream_en_o(stream_en), .err_count_o(err_count),
+        .blk_rdata_i(blk_rdata_q), .evs_valid_i(evs_valid), .evs_data_i(evs_q),
+        .evs_ready_o(evs_ready), .stream_en_o(stream_en), .err_count_o(err_count),
         .err_last_o(err_last), .err_pulse_o(err_pulse));
-    /* verilator lint_on PINCONNECTEMPTY */
 
     /* verilator lint_off PINCONNECTEMPTY */  // rw registers the core does not use
     fmt_regfile u_regs (
@@ -498,7 +510,7 @@ module fmt_core #(
         .ctrl_errors_i(err_count), .ctrl_last_err_i(err_last),
         .ev_drop_count_i(ev_drop_cnt), .ev_skip_count_i(ev_skip_cnt),
         .flat_sat_count_i(flat_sat_cnt), .lm_drop_count_i(lm_drop_cnt),
-        .sat_clear_we_o(sat_clr_we), .sat_clear_wdata_o(sat_clr_wd),
+        .stream_drop_count_i(stream_drop_cnt), .sat_clear_we_o(sat_clr_we), .sat_clear_wdata_o(sat_clr_wd),
         .lat_first_last_i(lf_last), .lat_first_min_i(lf_min), .lat_first_max_i(lf_max),
         .lat_first_count_i(lf_count),
         .lat_last_last_i(ll_last), .lat_last_min_i(ll_min), .lat_last_max_i(ll_max),

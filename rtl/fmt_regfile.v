@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0x5A15.
+// Register map id 0x45F6.
 `default_nettype none
 
 module fmt_regfile (
@@ -65,6 +65,7 @@ module fmt_regfile (
     input  wire [15:0] lm_drop_count_i,             // LM_DROP_COUNT (ro): Localmax: candidates dropped by the contact limit
     output wire sat_clear_we_o,                     // SAT_CLEAR (strobe): Write 1: clear the flattening saturation monitor (sat_clr_i)
     output wire sat_clear_wdata_o,                  // SAT_CLEAR: write data
+    input  wire [15:0] stream_drop_count_i,         // STREAM_DROP_COUNT (ro): UART event stream: reports dropped whole, saturating (the report FIFO of 2^STREAM_AW events was full: raise REPORT_PERIOD or the baud rate)
     input  wire [15:0] lat_first_last_i,            // LAT_FIRST_LAST (ro): Latency, window end -> first event of the frame, last value (cycles)
     input  wire [15:0] lat_first_min_i,             // LAT_FIRST_MIN (ro): Latency to the first event, minimum since clear
     input  wire [15:0] lat_first_max_i,             // LAT_FIRST_MAX (ro): Latency to the first event, maximum since clear
@@ -122,6 +123,7 @@ module fmt_regfile (
     localparam [15:0] A_FLAT_SAT_COUNT = 16'h0086;
     localparam [15:0] A_LM_DROP_COUNT = 16'h0087;
     localparam [15:0] A_SAT_CLEAR = 16'h0088;
+    localparam [15:0] A_STREAM_DROP_COUNT = 16'h0089;
     localparam [15:0] A_LAT_FIRST_LAST = 16'h0090;
     localparam [15:0] A_LAT_FIRST_MIN = 16'h0091;
     localparam [15:0] A_LAT_FIRST_MAX = 16'h0092;
@@ -280,6 +282,7 @@ module fmt_regfile (
                 A_FLAT_SAT_COUNT: reg_rdata_o <= {16'h0, flat_sat_count_i};
                 A_LM_DROP_COUNT: reg_rdata_o <= {16'h0, lm_drop_count_i};
                 A_SAT_CLEAR: reg_rdata_o <= 32'h0;
+                A_STREAM_DROP_COUNT: reg_rdata_o <= {16'h0, stream_drop_count_i};
                 A_LAT_FIRST_LAST: reg_rdata_o <= {16'h0, lat_first_last_i};
                 A_LAT_FIRST_MIN: reg_rdata_o <= {16'h0, lat_first_min_i};
                 A_LAT_FIRST_MAX: reg_rdata_o <= {16'h0, lat_first_max_i};

@@ -7,3 +7,4 @@ rtl/fmt_latency.v
 -f rtl/filelists/fmt_rx_array.f
 -f rtl/filelists/fmt_touch.f
 -f rtl/filelists/fmt_ctrl_port.f
+rtl/fmt_report_fifo.v

@@ -28,7 +28,9 @@ A. small.json with both contacts lifting before frame 10 (no event after the tra
      SNAP_STATUS names, and that frame ended after the SNAP_REQ write.
 B. small.json (a finger stays: events every frame), ``--serve-once``: fmtctl touches
    --count 5; each streamed event equals the logged event of the same frame and ID
-   (every field, time stamp included); serving ends when the client disconnects.
+   (every field, time stamp included), and every frame but the last streamed one comes
+   whole (all its logged events, in order: the report FIFO); serving ends when the
+   client disconnects.
 C. ``--serve-seconds 1`` and no client: serving ends by itself; with
    ``--serve-log-frames 5`` the loggers stop after about 5 frames of serving.
 Verilator only (a C++ Verilator harness).
@@ -308,6 +310,14 @@ def test_fmt_core_serve(sim, tmp_path):
         assert {k: s[k] for k in exp} == exp, (s, e)
         assert round(s["angle_rad"] * 256 / np.pi) == e["angle"], (s, e)
     assert [s["frame"] for s in streamed] == sorted(s["frame"] for s in streamed)
+    # whole reports (fmt_report_fifo): every frame before the last one streamed arrives
+    # with all its logged events, in the port's order, and its last one flagged
+    frames = sorted({s["frame"] for s in streamed})
+    assert len(frames) >= 2, frames
+    for f in frames[:-1]:
+        got_f = [(s["id"], s["last"]) for s in streamed if s["frame"] == f]
+        exp_f = [(e["id"], bool(e["last"])) for e in evs if e["frame"] == f]
+        assert got_f == exp_f, (f, got_f, exp_f)
     summary["events"] = [(s["frame"], s["id"]) for s in streamed]
 
     # ---- run C: the wall-clock limit ends serving with no client at all; the loggers

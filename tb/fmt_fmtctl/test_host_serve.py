@@ -6,8 +6,7 @@ turn, then Ctrl-C:
 * fmtctl tuio (--hold-frames 0) sends 6 reports to a python-osc receiver in the test;
   every received bundle's session IDs and positions are the core's own events of that
   frame (ev.log of the bench's loggers: new/move events, normalised to the sensor), and
-  both fingers arrive.  The UART drops an event that arrives while it is busy, so a
-  report holds a subset of its frame's events.
+  every bundle holds both fingers (the UART sends whole reports: fmt_report_fifo).
 * fmtctl view --png-dir --frames 3: three PNG frames, a red finger disc where the core's
   event of the snapshot's frame puts the still finger.
 * fmtctl record --snapshots 8 --events 10: every snapshot equals the logged heat map of
@@ -81,13 +80,13 @@ def test_host_tools_on_the_simulated_core(sim, tmp_path):
             assert sorted(cur) == sorted(alive)
             got[args[1]] = cur
     assert len(got) == 6, got
-    # the UART drops an event that arrives while it is sending (docs/blocks/ctrl_port.md):
-    # a report holds a subset of its frame's events, each exactly as the core made it
+    # the UART sends whole reports (fmt_report_fifo; a frame that does not fit is dropped
+    # whole): every bundle holds all its frame's fingers, each exactly as the core made it
     for f, d in got.items():
-        assert f in logged and d and set(d) <= set(logged[f]), (f, d, logged.get(f))
+        assert f in logged and set(d) == set(logged[f]), (f, d, logged.get(f))
         for i, xy in d.items():
             assert xy == pytest.approx(logged[f][i], abs=1e-6), (f, i)
-    assert set().union(*got.values()) == set().union(*(set(d) for d in logged.values()))  # both fingers
+    assert all(len(d) == 2 for d in got.values()), got   # both fingers, in every bundle
 
     # ---- view: red finger discs where the core's events put the fingers (both are near
     # still while serving: a disc within 6 px of an ID's mean position)
