@@ -608,7 +608,8 @@ module fmt_blob #(
     wire [EF_W-1:0]      l0_f  = l0_e_q[F_FL +: EF_W];    // L0, L1 use the first flag only
     wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
-    wire             new_wait;                // a NEW waits for a free label (testbench)
+    wire             new_wait /* verilator public_flat_rd */;   // a NEW waits for a free label
+                                              // (read by tb/fmt_blob under both simulators)
     /* verilator lint_on UNUSEDSIGNAL */
     reg [LBL_W-1:0]      l2_y_q;              // the P label under the event (if hy)
     reg [COLS-1:0]       l2_m_q;              // the C run's columns (run events)
