@@ -45,8 +45,8 @@
 //
 // UART event stream: events leaving the parallel port (STREAM command on) go through
 // fmt_report_fifo (2^STREAM_AW events) to the control port: a frame's events are sent
-// all together or, if they do not fit while the UART is still sending, not at all
-// (STREAM_DROP_COUNT).  The UART is a monitor (REPORT_PERIOD decimates; 2.7 ms per event
+// all together, or not at all when the previous report is still waiting or the frame
+// has more than 2^STREAM_AW events (STREAM_DROP_COUNT).  The UART is a monitor (REPORT_PERIOD decimates; 2.7 ms per event
 // at 115200 baud).  Event payload: sim/fmt/protocol.py pack_event (24 bytes).
 //
 // Status: STATUS bits (w1c) are set by the blocks' sticky flags (bit 0 flattening
@@ -463,8 +463,9 @@ module fmt_core #(
                              {{(32 - HM_W){1'b0}}, ev_strength_o}, ev_axis_major_o,
                              ev_axis_minor_o, ev_angle_o, ev_flags_o, 16'd0};
     // The UART stream is a monitor tap of the event port's handshake: a report FIFO holds
-    // each admitted frame's events until the port has sent them, and drops a frame whole
-    // (STREAM_DROP_COUNT) when it does not fit, so the host never gets half a report.
+    // an admitted frame's events until the port has sent them, and drops a frame whole
+    // (STREAM_DROP_COUNT) while a report waits or when it does not fit, so the host gets
+    // neither half a report nor a stale one.
     wire         evs_valid, evs_ready;
     wire [191:0] evs_q;
     wire [15:0]  stream_drop_cnt;

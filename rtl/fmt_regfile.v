@@ -65,7 +65,7 @@ module fmt_regfile (
     input  wire [15:0] lm_drop_count_i,             // LM_DROP_COUNT (ro): Localmax: candidates dropped by the contact limit
     output wire sat_clear_we_o,                     // SAT_CLEAR (strobe): Write 1: clear the flattening saturation monitor (sat_clr_i)
     output wire sat_clear_wdata_o,                  // SAT_CLEAR: write data
-    input  wire [15:0] stream_drop_count_i,         // STREAM_DROP_COUNT (ro): UART event stream: reports dropped whole, saturating (the report FIFO of 2^STREAM_AW events was full: raise REPORT_PERIOD or the baud rate)
+    input  wire [15:0] stream_drop_count_i,         // STREAM_DROP_COUNT (ro): UART event stream: reports dropped whole, saturating (the previous report was still being sent, or the frame had more than 2^STREAM_AW events)
     input  wire [15:0] lat_first_last_i,            // LAT_FIRST_LAST (ro): Latency, window end -> first event of the frame, last value (cycles)
     input  wire [15:0] lat_first_min_i,             // LAT_FIRST_MIN (ro): Latency to the first event, minimum since clear
     input  wire [15:0] lat_first_max_i,             // LAT_FIRST_MAX (ro): Latency to the first event, maximum since clear

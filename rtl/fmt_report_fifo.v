@@ -1,16 +1,20 @@
-// fmt_report_fifo -- whole reports for the UART event stream: a FIFO of events that
+// fmt_report_fifo -- whole, fresh reports for the UART event stream: a FIFO of events that
 // admits a frame's events all together or not at all.
 //
 // Rule: events (in_valid_i, one per cycle at most, never back-pressured: this is a tap of
 // the event port's handshake) are written as they come; the read side sees them only
-// once the frame's last event (in_last_i) has been written.  A frame whose events do not
-// all fit (the FIFO is full when one arrives) is taken back out (the write pointer returns
-// to the last complete frame), its remaining events are ignored, drop_o pulses and
-// drop_count_o counts it (saturating).  So the host gets each report complete, with the
-// 'last' flag that ends it, or not at all (frame numbers show the gap).  While en_i is low
-// (STREAM off) the FIFO is empty and takes nothing; after it rises the first frame
-// admitted is the first one that starts afterwards (a frame in progress is skipped, not
-// counted as a drop).  A frame of more than 2^AW events can never be admitted.
+// once the frame's last event (in_last_i) has been written.  A frame is admitted only if
+// the FIFO is empty when its first event arrives (the previous report has been handed to
+// the consumer, all but the event it is sending): the host gets the newest whole report,
+// never one that waited behind others (at most one report plus the event in flight of
+// lag).  A frame that arrives while a report is still waiting, or whose events do not
+// all fit (the FIFO is full when one arrives: it is taken back out, the write pointer
+// returns to the frame's start), is dropped whole: drop_o pulses and drop_count_o counts
+// it (saturating).  So the host gets each report complete, with the 'last' flag that ends
+// it, or not at all (frame numbers show the gap).  While en_i is low (STREAM off) the
+// FIFO is empty and takes nothing; after it rises the first frame admitted is the first
+// one that starts afterwards (a frame in progress is skipped, not counted as a drop).
+// A frame of more than 2^AW events can never be admitted.
 //
 // Storage: 2^AW words of W bits, written synchronously and read asynchronously
 // (distributed RAM; 192 x 32 = 128 LUT6 as RAM32M on Virtex-5).  Pointers are AW+1 bits.
@@ -55,8 +59,9 @@ module fmt_report_fifo #(
 
     wire full = (wp_q[AW] != rp_q[AW]) && (wp_q[AW-1:0] == rp_q[AW-1:0]);
     wire pop  = out_valid_o && out_ready_i;
-    wire wr   = in_valid_i && en_i && !skip_q && !full;
-    wire ovf  = in_valid_i && en_i && !skip_q && full;
+    wire busy = !mid_q && (wp_q != rp_q);  // a frame starts while a report still waits
+    wire ovf  = in_valid_i && en_i && !skip_q && (full || busy);
+    wire wr   = in_valid_i && en_i && !skip_q && !ovf;
 
     assign out_valid_o = (rp_q != cp_q);
     assign out_data_o  = mem[rp_q[AW-1:0]];
@@ -104,7 +109,8 @@ module fmt_report_fifo #(
     // Formal properties (SymbiYosys, formal/fmt_report_fifo.sby at W = 4, AW = 2; never
     // seen by synthesis).  The promise: a consumer that has taken the first event of a
     // frame finds the rest of it waiting, cycle after cycle, until its last one (unless
-    // the stream is switched off); the read side never sees a frame being written.
+    // the stream is switched off); the read side never sees a frame being written; a
+    // frame is written only while nothing committed waits.
     localparam D = 1 << AW;
     reg f_rstd_q = 1'b0;                       // a reset has been applied
     always @(posedge clk) f_rstd_q <= f_rstd_q | rst;
@@ -133,6 +139,9 @@ module fmt_report_fifo #(
                 if (fi < f_tent) assert (!f_last_q[f_k[AW-1:0]]);
             end
             if (skip_q) assert (f_tent == 0);
+            // fresh reports: a frame is written only into an empty FIFO
+            if (f_tent != 0) assert (f_comm == 0 && mid_q);
+            if (mid_q && !skip_q) assert (f_tent != 0);
             // whole frames: inside a frame, its next event is committed and waiting
             if (f_mid_q) assert (out_valid_o);
         end

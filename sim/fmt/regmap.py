@@ -158,8 +158,8 @@ REGISTERS: list[Reg] = [
     R("LM_DROP_COUNT", 0x087, 16, "ro", 0, "Localmax: candidates dropped by the contact limit."),
     R("SAT_CLEAR", 0x088, 1, "strobe", 0, "Write 1: clear the flattening saturation monitor (sat_clr_i)."),
     R("STREAM_DROP_COUNT", 0x089, 16, "ro", 0,
-      "UART event stream: reports dropped whole, saturating (the report FIFO of 2^STREAM_AW events "
-      "was full: raise REPORT_PERIOD or the baud rate)."),
+      "UART event stream: reports dropped whole, saturating (the previous report was still being "
+      "sent, or the frame had more than 2^STREAM_AW events)."),
     R("LAT_FIRST_LAST", 0x090, 16, "ro", 0, "Latency, window end -> first event of the frame, last value (cycles)."),
     R("LAT_FIRST_MIN", 0x091, 16, "ro", 0, "Latency to the first event, minimum since clear."),
     R("LAT_FIRST_MAX", 0x092, 16, "ro", 0, "Latency to the first event, maximum since clear."),

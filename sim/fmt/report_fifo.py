@@ -1,5 +1,6 @@
 """Cycle twin of rtl/fmt_report_fifo.v: the UART event stream's FIFO that admits a
-frame's events all together or not at all (the host gets whole reports).
+frame's events all together or not at all, and only when no earlier report still waits
+(the host gets whole, fresh reports).
 
 ``step`` is one clock: it takes the inputs of the cycle, returns the outputs seen during
 it (out_valid, out_data, drop, drop_count: the combinational ones from the state before
@@ -31,8 +32,9 @@ class ReportFifo:
         out_valid = self.rp != self.cp
         out = (out_valid, self.mem[self.rp % self.depth], self.drop, self.drop_count)
         full = self._full()
-        wr = in_valid and en and not self.skip and not full
-        ovf = in_valid and en and not self.skip and full
+        busy = not self.mid and self.wp != self.rp     # a frame starts, a report still waits
+        ovf = in_valid and en and not self.skip and (full or busy)
+        wr = in_valid and en and not self.skip and not ovf
         if wr:
             self.mem[self.wp % self.depth] = data
         mid_next = (not last) if in_valid else self.mid

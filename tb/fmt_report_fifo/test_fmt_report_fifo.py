@@ -1,13 +1,15 @@
 """cocotb testbench of rtl/fmt_report_fifo.v against its cycle twin sim/fmt/report_fifo.py.
 
 Random streams of frames (1..2^AW + 2 events each, gaps of 0..3 cycles, so frames that
-cannot fit and frames that overflow a partly drained FIFO both occur), a consumer that
+cannot fit, frames that start while a report still waits and frames admitted into an
+empty FIFO all occur), a consumer that
 takes events at random (slow and fast phases, like a UART that is busy for a while), the
 stream switched off and on in the middle of frames.  Every output is compared with the
 model on every cycle.  On top of the model comparison the test checks what the block
 promises by itself: the consumer receives only whole frames (each run of events ends with
 a 'last' one and carries one frame number), in order, and every frame offered while on is
-either received whole or counted as a drop.
+either received whole or counted as a drop.  (That a frame is admitted only into an empty
+FIFO, the freshness rule, is the model's; the formal proof checks the rest.)
 """
 from __future__ import annotations
 
@@ -114,7 +116,7 @@ async def random_frames_match_model(dut):
     assert len(got) + drops == len(frames), f"{len(got)} received + {drops} dropped != {len(frames)} offered"
     big = [f for f, ev in frames.items() if len(ev) > depth]
     assert big and not set(big) & set(got), "frames longer than the FIFO are never admitted"
-    assert drops > len(big) and len(got) > len(frames) // 3, "stimulus too easy or too hard"
+    assert drops > len(big) and len(got) >= 40, f"stimulus too easy or too hard: {len(got)} received, {drops} dropped"
 
 
 @cocotb.test()
