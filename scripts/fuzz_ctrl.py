@@ -68,13 +68,20 @@ from fmt import params                      # noqa: E402
 from fmt import protocol as P               # noqa: E402
 from fmt import regmap                      # noqa: E402
 
-# The model's CRC in C (binascii.crc_hqx is CRC-16 poly 0x1021, MSB first, no final
-# XOR: with init 0xFFFF it is CRC-16/CCITT-FALSE); checked against the model's own.
-_crc16_py = P.crc16
-P.crc16 = lambda data, crc=0xFFFF: binascii.crc_hqx(bytes(data), crc)
-assert P.crc16(b"123456789") == _crc16_py(b"123456789") == 0x29B1
-assert all(P.crc16(bytes([i, 255 - i, i * 7 & 255])) == _crc16_py(bytes([i, 255 - i, i * 7 & 255]))
-           for i in range(256))
+
+def fast_crc() -> None:
+    """The model's CRC in C for this process (binascii.crc_hqx is CRC-16 poly 0x1021, MSB
+    first, no final XOR: with init 0xFFFF it is CRC-16/CCITT-FALSE), checked against the
+    model's own first."""
+    slow = P.crc16
+    fast = lambda data, crc=0xFFFF: binascii.crc_hqx(bytes(data), crc)   # noqa: E731
+    assert fast(b"123456789") == slow(b"123456789") == 0x29B1
+    r = random.Random(0)
+    for n in range(1, 80):
+        x = bytes(r.randrange(256) for _ in range(n))
+        assert fast(x) == slow(x), x
+    P.crc16 = fast
+
 
 CFG = params.SMALL
 REGMAP_ID = regmap.regmap_id()
@@ -82,6 +89,8 @@ PAYLOAD_MAX = P.DEFAULT_PAYLOAD_MAX         # fmt_core's fmt_ctrl_port: the defa
 BYTE_CLK = 10 * 4                           # 8N1 at UART_DIV 4 (run_sim_rtl.sim_parameters)
 FIFO_BYTES = 128 + 1                        # 2^FIFO_AW RAM bytes + the head register
 BACKLOG_MAX = 110                           # ordinary bursts stay below this backlog
+TIMEOUT_CLK = 20 * 4                        # fmt_core_sim_top: UART_TIMEOUT 20 bit times
+LATE_MAX = 200                              # clk a reply may end after the timing model's end
 DISCARD_TAIL = 5                            # bytes after a LEN > PAYLOAD_MAX header
 
 # Registers the fuzzer must never write, and why.  Every other address may be written:
@@ -138,8 +147,7 @@ class Model(P.CtrlPortModel):
 
     def __init__(self, shadow: dict, err_count: int, err_last: int, status_err: bool):
         super().__init__(self._execute, PAYLOAD_MAX)
-        self.shadow = dict(shadow)          # committed: WRITEs whose ACK came back
-        self.pending = dict(shadow)         # as the model executes the current burst
+        self.regs = dict(shadow)            # rw registers as the WRITEs executed so far leave them
         self.err_count = err_count
         self._last = err_last
         self.status_err = status_err
@@ -147,8 +155,8 @@ class Model(P.CtrlPortModel):
         self.masks: list[bytes] = []        # one per good reply of the current burst
 
     def clone(self) -> "Model":
-        m = Model(self.pending, self.err_count, self._last, self.status_err)
-        m.shadow, m.errors = self.shadow, self.errors
+        m = Model(self.regs, self.err_count, self._last, self.status_err)
+        m.errors = self.errors
         return m
 
     # every error sets err_last (CtrlPortModel._err and the junk-before-a-frame count)
@@ -168,7 +176,7 @@ class Model(P.CtrlPortModel):
         if r is None:
             return 0, 0xFFFFFFFF                    # unmapped: reads 0
         if r.access == "rw":
-            return self.pending[a], 0xFFFFFFFF
+            return self.regs[a], 0xFFFFFFFF
         if r.access == "const":
             return r.reset, 0xFFFFFFFF
         if r.access == "strobe":
@@ -179,7 +187,8 @@ class Model(P.CtrlPortModel):
             return self._last, 0xFFFFFFFF
         if a == A_STATUS:
             return (STATUS_CTRL_BIT if self.status_err else 0), STATUS_CTRL_BIT | 0xFFFFFF00
-        return 0, 0                                 # ro / window: the core's state
+        return 0, 0xFFFFFFFF ^ ((1 << r.width) - 1)   # ro / window: the core's state; bits above
+        #                                             the width read 0
 
     def _execute(self, seq, cmd, p):
         if cmd == P.CMD_INFO:
@@ -201,7 +210,7 @@ class Model(P.CtrlPortModel):
                 v = struct.unpack(">I", p[2 + 4 * i:6 + 4 * i])[0]
                 r = REGS.get(a)
                 if r is not None and r.access == "rw":
-                    self.pending[a] = v & ((1 << r.width) - 1)
+                    self.regs[a] = v & ((1 << r.width) - 1)
                 elif a == A_STATUS and v & STATUS_CTRL_BIT:
                     self.status_err = False
             out = mask = b""
@@ -256,23 +265,32 @@ def scan(data: bytes, payload_max: int = PAYLOAD_MAX):
     return out
 
 
-def timeline(data: bytes, replies: list[bytes], where) -> list[int]:
-    """The receive backlog (bytes waiting in the FIFO) at the end of each reply, by a
-    timing model of the port: host bytes enter the FIFO every BYTE_CLK (plus the
-    receiver's latency), the parser takes one byte per clk when it is not replying, a
-    reply of L bytes keeps it busy for L * BYTE_CLK (plus a few clk; a WRITE first
-    writes for LEN clk).  Replies after the idle timeout: 0 (nothing follows them)."""
-    t, k, out = 0.0, 0, []
+def timeline(data: bytes, replies: list[bytes], where):
+    """A timing model of the port: (backlog, end) per reply.  backlog: bytes waiting
+    in the receive FIFO when the reply has gone out; end: clk from the start bit of the
+    burst's first byte to the end of the reply.  Host bytes enter the FIFO every
+    BYTE_CLK (plus the receiver's latency), the parser takes one byte per clk when it
+    is not replying, a reply of L bytes keeps it busy for L * BYTE_CLK (plus a few clk;
+    a WRITE first writes for LEN clk).  A reply after the idle timeout (TIMEOUT, JUNK)
+    has nothing after it: backlog 0."""
+    arrive = lambda k: BYTE_CLK * (k + 1) + 8
+    t, k, backlog, ends = 0.0, 0, [], []
     for (trig, _s, kind), rep in zip(where, replies):
         if trig is None:
-            out.append(0)
+            while k < len(data):
+                t = max(t + 1, arrive(k))
+                k += 1
+            t += TIMEOUT_CLK + 2 + BYTE_CLK * len(rep) + 6
+            backlog.append(0)
+            ends.append(t)
             continue
         while k <= trig:
-            t = max(t + 1, BYTE_CLK * (k + 1) + 8)
+            t = max(t + 1, arrive(k))
             k += 1
         t += (kind[1] if isinstance(kind, tuple) else 2) + BYTE_CLK * len(rep) + 6
-        out.append(min(len(data), int((t - 8) // BYTE_CLK)) - (trig + 1))
-    return out
+        backlog.append(min(len(data), int((t - 8) // BYTE_CLK)) - (trig + 1))
+        ends.append(t)
+    return backlog, ends
 
 
 # ---- the burst generator -------------------------------------------------------------------
@@ -391,6 +409,16 @@ class Gen:
                 f[i] = self.r.randrange(256)
         return bytes(f)
 
+    def storm(self) -> bytes:
+        """Many errors in few bytes (one junk byte, then an unknown command with LEN 0:
+        a JUNK count and a CMD error per 8 bytes): CTRL_ERRORS reaches its saturation
+        at 0xFFFF within a 10^6-byte run."""
+        out = bytearray()
+        for _ in range(self.r.randrange(10, 80)):
+            out.append(self.r.choice([0x00, 0x5A, 0xFF, 0x13]))
+            out += P.encode(self.s(), self.r.choice([0x00, 0x06, 0x40, 0x7E]))
+        return bytes(out)
+
     def run_of_valid(self) -> bytes:
         return b"".join(self.valid() for _ in range(self.r.randrange(2, 12)))
 
@@ -416,8 +444,10 @@ class Gen:
             return self.bad_cmd()
         if r < 0.78:
             return self.junk()
-        if r < 0.92:
+        if r < 0.90:
             return self.mutated()
+        if r < 0.95:
+            return self.storm()
         return self.run_of_valid()
 
     def ending(self) -> bytes:
@@ -469,10 +499,10 @@ def fit_burst(model: "Model", data: bytes):
         replies = after.burst(data)
         if len(replies) != len(where):
             raise Fail(f"scan/model disagree: {len(where)} against {len(replies)} replies", data)
-        backlog = timeline(data, replies, where)
+        backlog, ends = timeline(data, replies, where)
         over = [j for j, b in enumerate(backlog) if b > BACKLOG_MAX]
         if not over:
-            return data, where, replies, max(backlog, default=0), after
+            return data, where, replies, max(backlog, default=0), ends, after
         data = data[:where[over[0]][1]]     # cut before the frame whose reply overflows
         if not data:
             return None
@@ -548,11 +578,14 @@ class Link:
         self.s = socket.create_connection((host, port), timeout=30)
         self.s.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.buf = bytearray()
-        self.sent = 0
+        self.sent = 0                       # bytes of the fuzzing (after the start)
+        self.total_sent = 0                 # every host byte on the line
+        self.total_read = 0                 # every reply byte taken
 
     def send(self, data: bytes):
         self.s.sendall(data)
         self.sent += len(data)
+        self.total_sent += len(data)
 
     def read(self, n: int, wall_s: float) -> bytes:
         t_end = time.monotonic() + wall_s
@@ -570,6 +603,7 @@ class Link:
             self.buf += chunk
         out = bytes(self.buf[:n])
         del self.buf[:n]
+        self.total_read += len(out)
         return out
 
     def quiet(self, wall_s: float) -> bytes:
@@ -611,9 +645,11 @@ class Burst:
     """A burst ready to send: bytes, expected replies with their masks, the request
     behind each reply, the model after it."""
 
-    def __init__(self, data, replies, masks, requests, model, overflow=False, backlog=0):
+    def __init__(self, data, replies, masks, requests, model, overflow=False, backlog=0, ends=()):
         self.data, self.requests, self.model = data, requests, model
-        self.overflow, self.backlog = overflow, backlog
+        self.overflow, self.backlog, self.ends = overflow, backlog, list(ends)
+        self.trigs: list = []               # byte index behind each reply (None: after the timeout)
+        self.h0 = self.d0 = 0               # index of its first host byte / reply byte on the line
         it = iter(masks)
         self.expected = [(r, b"\xff\xff" if r[4] == P.CMD_ERROR else next(it)) for r in replies]
 
@@ -631,6 +667,7 @@ class Fuzzer:
                       "error_replies": 0, "max_backlog": 0}
         self.model: Model | None = None
         self.burst_no = 0
+        self.done: list[Burst] = []         # the bursts sent, for the timing check
 
     def start(self):
         """Read every rw register, STATUS and the error counters: the shadow's start."""
@@ -647,6 +684,7 @@ class Fuzzer:
             raise Fail(f"initial READ of STATUS..CTRL_LAST_ERR: {fr.hex()}", P.req_read(0, A_STATUS, 3))
         st, cnt, last = struct.unpack(">III", fr[5:17])
         self.model = Model(shadow, cnt, last, bool(st & STATUS_CTRL_BIT))
+        self.shadow = dict(shadow)
         self.initial = {"ctrl_errors": cnt, "last_err": last}
         self.link.sent = 0
 
@@ -660,7 +698,10 @@ class Fuzzer:
                 replies = after.burst(head)
                 assert len(replies) == 1 and replies[0][4] != P.CMD_ERROR
                 after._err(replies, 0, P.ERR_OVERFLOW, 0)
-                b = Burst(head + fill, replies, after.masks, [head, head + fill], after, overflow=True)
+                e1 = BYTE_CLK * len(head) + 8 + 2 + BYTE_CLK * len(replies[0]) + 6
+                b = Burst(head + fill, replies, after.masks, [head, head + fill], after, overflow=True,
+                          ends=[e1, e1 + 2 + BYTE_CLK * len(replies[1]) + 6])
+                b.trigs = [len(head) - 1, None]
             else:
                 data = g.burst(g.r.choice([20, 200, 600, 1500, 3000, 3000]))
                 try:
@@ -669,16 +710,19 @@ class Fuzzer:
                     continue
                 if fit is None:
                     continue
-                data, where, replies, backlog, after = fit
+                data, where, replies, backlog, ends, after = fit
                 requests = [data[w[1]:(w[0] + 1 if w[0] is not None else len(data))] for w in where]
-                b = Burst(data, replies, after.masks, requests, after, backlog=backlog)
+                b = Burst(data, replies, after.masks, requests, after, backlog=backlog, ends=ends)
+                b.trigs = [w[0] for w in where]
             after.masks = []
             self.model = after                  # the model runs one burst ahead of the checks
             return b
 
     def check(self, b: Burst):
         check_replies(self.link, b.expected, self.wall, b.requests)
-        b.model.shadow = dict(b.model.pending)  # this burst's WRITEs were acknowledged
+        # every reply came back in order, so each WRITE's ACK was checked before the
+        # replies after it: the shadow takes this burst's WRITEs
+        self.shadow = dict(b.model.regs)
         st = self.stats
         st["overflow_bursts" if b.overflow else "bursts"] += 1
         st["replies"] += len(b.expected)
@@ -691,6 +735,8 @@ class Fuzzer:
         while True:
             cur = nxt
             self.burst_no += 1
+            cur.h0, cur.d0 = self.link.total_sent, self.link.total_read
+            self.done.append(cur)
             self.link.send(cur.data)
             last = self.link.sent >= nbytes
             if not last:
@@ -709,12 +755,51 @@ class Fuzzer:
         replies = after.burst(data)
         self.model = after
         self.burst_no += 1
-        b = Burst(data, replies, after.masks, [data[w[1]:w[0] + 1] for w in where], after)
+        b = Burst(data, replies, after.masks, [data[w[1]:w[0] + 1] for w in where], after,
+                  ends=timeline(data, replies, where)[1])
+        b.h0, b.d0 = self.link.total_sent, self.link.total_read
+        self.done.append(b)
         self.link.send(data)
         self.check(b)
         extra = self.link.quiet(1.0)
         if extra:
             raise Fail(f"{len(extra)} bytes after the last reply: {extra[:64].hex()}")
+
+
+def check_timing(log: Path, bursts: list[Burst]) -> dict:
+    """"Never hangs", in clk: serve.log has the cycle of every host byte (H, at the end
+    of its stop bit) and every reply byte (D, decoded at the middle of its stop bit).
+    Each reply must end by the timing model's end (relative to its burst's first start
+    bit) + LATE_MAX clk.  Returns the largest lateness and the longest time from a
+    burst's last host byte to its last reply byte."""
+    h, d = [], []
+    with open(log) as f:
+        for line in f:
+            if line[0] == "H":
+                h.append(int(line.split()[1]))
+            elif line[0] == "D":
+                d.append(int(line.split()[1]))
+    import bisect
+    late, drain, backlog = -10 ** 9, 0, 0
+    for bno, b in enumerate(bursts, 1):
+        t0 = h[b.h0] - BYTE_CLK
+        last_h = h[b.h0 + len(b.data) - 1]
+        pos = b.d0
+        for j, ((rep, _m), end) in enumerate(zip(b.expected, b.ends)):
+            pos += len(rep)
+            got = d[pos - 1] - t0
+            if got > end + LATE_MAX:
+                raise Fail(f"burst {bno} reply {j + 1}: ended {got} clk after the burst's start, "
+                           f"the timing model says {end:.0f} (+{LATE_MAX})", b.requests[j])
+            late = max(late, got - end)
+            if not b.overflow and j < len(b.trigs) and b.trigs[j] is not None:
+                # host bytes on the line by the reply's end, not yet parsed (an upper bound)
+                backlog = max(backlog, bisect.bisect_right(h, d[pos - 1]) - (b.h0 + b.trigs[j] + 1))
+        drain = max(drain, d[pos - 1] - last_h)
+    if backlog >= FIFO_BYTES:
+        raise Fail(f"a receive backlog of {backlog} bytes: the ordinary bursts overflowed the FIFO")
+    return {"latest_vs_model_clk": round(late), "max_drain_clk": drain, "max_backlog_logged": backlog, "host_bytes_logged": len(h),
+            "reply_bytes_logged": len(d)}
 
 
 def main(argv=None) -> int:
@@ -731,6 +816,7 @@ def main(argv=None) -> int:
                     help="wall-time bound per burst's replies (s): longer is a hang")
     ap.add_argument("--json", action="store_true", help="print the summary as one JSON line")
     a = ap.parse_args(argv)
+    fast_crc()
     if a.bytes < 1:
         print("fuzz_ctrl: --bytes must be >= 1", file=sys.stderr)
         return 2
@@ -775,6 +861,12 @@ def main(argv=None) -> int:
             if rc != 0 or "golden mismatches 0" not in text:
                 print(f"fuzz_ctrl: FAIL seed={a.seed}: the simulation ended with {rc}: {text[-1500:]}",
                       file=sys.stderr)
+                return 1
+            from bench.core import run_sim_rtl as rsr
+            try:
+                st.update(check_timing(rsr.job_dir(CFG, 3, a.tag) / "serve.log", fz.done))
+            except Fail as f:
+                print(f"fuzz_ctrl: FAIL seed={a.seed}: {f.msg}; frame {f.frame.hex() or '-'}", file=sys.stderr)
                 return 1
         if a.json:
             print(json.dumps(st))
