@@ -635,8 +635,8 @@ def check_replies(link: Link, expected: list[tuple[bytes, bytes]], wall_s: float
         for i in range(pl):
             if (got[5 + i] ^ exp[5 + i]) & mask[i]:
                 w = i // 4
-                raise Fail(f"{what}: payload word {w} = {got[5 + 4 * w:9 + 4 * w].hex()}, expected "
-                           f"{exp[5 + 4 * w:9 + 4 * w].hex()} (mask {mask[4 * w:4 * w + 4].hex()})", requests[j])
+                raise Fail(f"{what}: payload byte {i} (word {w}) differs: reply {got.hex()}, expected "
+                           f"{exp.hex()} (checked bits of the word {mask[4 * w:4 * w + 4].hex()})", requests[j])
         if P.crc16(got[1:5 + pl]) != struct.unpack(">H", got[5 + pl:])[0]:
             raise Fail(f"{what}: bad CRC in reply {got.hex()}", requests[j])
 
