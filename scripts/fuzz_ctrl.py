@@ -2,42 +2,51 @@
 """Control-port fuzzing through the RTL (issue #15, item 2).
 
 Random and mutated bytes go to the UART of the whole small core (``fmt_core``, 4 x 6,
-UART_DIV 4) in the C++ Verilator harness in serve mode (``python -m
-bench.core.run_sim_rtl --scene sim/scenes/small.json --serve 0 --serve-once``); every
-reply byte is checked against the protocol model (``fmt.protocol.CtrlPortModel``, the
-twin of ``rtl/fmt_ctrl_port.v``) and a shadow of the registers:
+UART_DIV 4: 40 clk per byte, timeout 20 bit times) in the C++ Verilator harness in
+serve mode (``python -m bench.core.run_sim_rtl --scene sim/scenes/small.json --serve 0
+--serve-once``); every reply byte is checked against the protocol model
+(``fmt.protocol.CtrlPortModel``, the twin of ``rtl/fmt_ctrl_port.v``) and a shadow of
+the registers:
 
 * the stream is cut into bursts (bytes back to back on the line, then an idle line):
   valid INFO / READ / WRITE / BLKREAD / STREAM(off) requests, frames with a flipped bit
   (bad CRC), a deleted, inserted or repeated byte, a wrong LEN or COUNT for the command
-  (good CRC), unknown commands, junk (also with stray SYNC bytes), long runs of valid
-  frames; a burst may end in a truncated frame (TIMEOUT), junk (JUNK) or a LEN above
-  PAYLOAD_MAX (LEN, then discarded until idle);
+  (good CRC), unknown commands, junk (also with stray SYNC bytes), runs of valid frames,
+  error storms (a junk byte and an unknown command, 8 bytes for 2 errors); a burst may
+  end in a truncated frame (TIMEOUT), junk (JUNK) or a LEN above PAYLOAD_MAX (LEN
+  replied at once, the rest discarded until the line is idle);
 * every reply must arrive, byte for byte as the model says, in order, with nothing
-  else on the line (a missing reply within the wall-time bound is a hang); every
-  malformed frame gets its one ERROR reply; a valid frame after garbage is answered
+  else on the line; a reply missing after --wall seconds is a hang.  Every malformed
+  frame gets its one ERROR reply; a valid frame after garbage is answered
   (resynchronisation);
 * READ replies are checked against a shadow of the registers: every rw register
-  (initial values read once at the start), updated only by WRITEs whose ACK came back;
-  const registers, unmapped addresses (0) and strobes (0); CTRL_ERRORS (saturating at
-  0xFFFF) and CTRL_LAST_ERR equal the model's error count and last code, STATUS bit 4
-  (control-port error, sticky, cleared by writing 0x10) its sticky flag.  Not
-  checked: the other ro registers, windows and STATUS bits (the core's own state);
-* the receive FIFO (128 bytes) must hold whatever arrives while the port replies: the
-  ordinary bursts are kept below 110 bytes of backlog by a timing model of the port
-  (input and output both 40 clk per byte); any burst longer than the FIFO is fine while
-  the port is not replying.  Overflow bursts check the documented overflow: a request
-  with a long reply (>= 180 bytes), then >= 140 bytes more while it goes out: the
-  reply, one ERROR OVERFLOW (SEQ 0, request CMD 0), the rest discarded until the line
-  is idle -- none of the WRITEs in it may reach a register.
+  (initial values read once at the start), changed only by WRITEs whose ACK came back
+  (replies are checked in order, so a READ after a WRITE is compared only once the
+  WRITE's ACK has been); const registers, unmapped addresses (0) and strobes (0);
+  CTRL_ERRORS (saturating at 0xFFFF: the error storms reach it within 10^6 bytes) and
+  CTRL_LAST_ERR equal the model's count and last code, STATUS bit 4 (control-port
+  error, sticky, cleared by writing 0x10) its sticky flag.  Of the other ro registers,
+  windows and STATUS bits (the core's own state) only the bits above the width (0);
+* the receive FIFO (128 bytes + the head register) must hold what arrives while the
+  port replies: the ordinary bursts are kept below BACKLOG_MAX bytes of backlog by a
+  timing model of the port (:func:`timeline`: host and reply bytes both 40 clk); a
+  burst longer than the FIFO is fine while the port is not replying.  Overflow bursts
+  check the documented overflow: a request with a long reply (>= 187 bytes), then
+  >= 140 bytes more while it goes out: the reply, one ERROR OVERFLOW (SEQ 0, request
+  CMD 0), the rest discarded until the line is idle (none of its WRITEs may land);
+* "never hangs" in clk (:func:`check_timing`, from the harness's serve.log): every
+  reply ends by the timing model's time + LATE_MAX clk, and the logged receive backlog
+  stays below the FIFO's size.
 
-Registers the fuzzer never writes: :data:`NEVER_WRITE` (with the reason).  UART
-framing errors (a low stop bit) cannot be sent through the harness's socket bridge.
+Registers the fuzzer never writes: :data:`NEVER_WRITE` (with the reason).  Not sent:
+UART framing errors (the harness's socket bridge always sends a good stop bit) and
+STREAM on (event frames would interleave with the replies and fill the FIFO).
 
 Deterministic: the bytes depend only on --seed (never on timing).  Exit 0 and one
 summary line (``--json``: a JSON object) when every check passed; exit 1 with one line
-``fuzz_ctrl: FAIL seed=S burst=B ...: <what>; frame <hex>`` naming the offending
-request; exit 2 on bad arguments or when the simulation cannot start.
+``fuzz_ctrl: FAIL seed=S burst=B after N bytes: <what>; frame <hex>`` naming the
+request behind the reply that failed; exit 2 on bad arguments or when the simulation
+does not start.
 
     python scripts/fuzz_ctrl.py [--bytes 1000000] [--seed 1] [--port socket://127.0.0.1:P]
 """
@@ -871,10 +880,13 @@ def main(argv=None) -> int:
         if a.json:
             print(json.dumps(st))
         else:
+            timing = (f", {st['sim_clk']} clk, replies at most {st['latest_vs_model_clk']} clk after the "
+                      f"timing model, receive backlog at most {st['max_backlog_logged']} bytes (logged)"
+                      if "latest_vs_model_clk" in st else "")
             print(f"fuzz_ctrl: seed {a.seed}: {st['bytes']} bytes in {st['bursts']} bursts + "
                   f"{st['overflow_bursts']} overflow bursts, {st['replies']} replies ({st['frames_valid']} "
                   f"to valid requests, {st['error_replies']} ERROR), {st['errors']} errors counted "
-                  f"(CTRL_ERRORS {st['ctrl_errors']}), max backlog {st['max_backlog']} bytes, "
+                  f"(CTRL_ERRORS {st['ctrl_errors']}){timing}, "
                   f"{st['fuzz_wall_s']} s fuzzing, {st['total_wall_s']} s in all: pass")
         return 0
     finally:
