@@ -793,6 +793,9 @@ def check_timing(log: Path, bursts: list[Burst]) -> dict:
     for bno, b in enumerate(bursts, 1):
         t0 = h[b.h0] - BYTE_CLK
         last_h = h[b.h0 + len(b.data) - 1]
+        if last_h - h[b.h0] != BYTE_CLK * (len(b.data) - 1):    # the timing model's premise
+            raise Fail(f"burst {bno}: the harness did not send its {len(b.data)} bytes back to back "
+                       f"({last_h - h[b.h0]} clk from the first to the last)", b.data)
         pos = b.d0
         for j, ((rep, _m), end) in enumerate(zip(b.expected, b.ends)):
             pos += len(rep)
