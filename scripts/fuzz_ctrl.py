@@ -849,7 +849,11 @@ def main(argv=None) -> int:
                 print(f"fuzz_ctrl: {exc}", file=sys.stderr)
                 return 2
         t_serve = time.monotonic()
-        link = Link(host, port)
+        try:
+            link = Link(host, port)
+        except OSError as exc:
+            print(f"fuzz_ctrl: cannot connect to {host}:{port}: {exc}", file=sys.stderr)
+            return 2
         fz = Fuzzer(link, a.seed, a.wall)
         try:
             fz.start()
