@@ -479,7 +479,7 @@ class Gen:
         return bytes(out + self.ending())
 
     def overflow_burst(self) -> bytes:
-        """A request with a reply of >= 180 bytes, then filler while it goes out."""
+        """A request with a reply of >= 187 bytes, then filler while it goes out."""
         if self.r.random() < 0.5:
             n = self.r.randrange(45, 64)
             head = P.req_read(self.s(), self.r.randrange(0, MAP_END), n)
@@ -495,10 +495,12 @@ class Gen:
 
 
 def fit_burst(model: "Model", data: bytes):
-    """Cut a burst so that it is predictable: the backlog stays below BACKLOG_MAX and a
-    LEN > PAYLOAD_MAX discard ends before its ERROR reply does.  Returns (data, where,
-    replies, backlog, the model after the burst); model itself is not changed."""
-    for _ in range(100):
+    """Make a burst predictable: the backlog must stay below BACKLOG_MAX (junk bytes go
+    in before a request whose reply would exceed it, so that the parser catches up, or
+    the burst ends with a request whose reply is long) and a LEN > PAYLOAD_MAX discard
+    must end before its ERROR reply does.  Returns (data, where, replies, max backlog,
+    reply ends, the model after the burst); model itself is not changed."""
+    for it in range(1000):
         where = scan(data)
         dis = [w for w in where if w[2] == "discard"]
         if dis and len(data) - dis[0][0] - 1 > DISCARD_TAIL:
@@ -512,10 +514,18 @@ def fit_burst(model: "Model", data: bytes):
         over = [j for j, b in enumerate(backlog) if b > BACKLOG_MAX]
         if not over:
             return data, where, replies, max(backlog, default=0), ends, after
-        data = data[:where[over[0]][1]]     # cut before the frame whose reply overflows
-        if not data:
-            return None
+        trig, start, _kind = where[over[0]]
+        if it >= 200:
+            data = data[:start]             # (never seen: many fixes) cut before the request
+        elif len(replies[over[0]]) > BACKLOG_MAX // 2:
+            data = data[:trig + 1]          # a long reply: the burst ends with its request
+        else:                               # junk before the request lets the parser catch up
+            data = data[:start] + bytes(junk_rng.choice(JUNK_BYTES) for _ in range(backlog[over[0]])) + data[start:]
     raise Fail("could not fit a burst", data)
+
+
+JUNK_BYTES = bytes(b for b in range(256) if b != P.SYNC)
+junk_rng = random.Random()                  # seeded by Fuzzer (the bytes depend on --seed only)
 
 
 # ---- the simulation and the socket ------------------------------------------------------------
@@ -671,6 +681,7 @@ class Fuzzer:
         self.link = link
         self.seed = seed
         self.gen = Gen(random.Random(seed))
+        junk_rng.seed(seed + 1)
         self.wall = wall_per_burst
         self.stats = {"bursts": 0, "overflow_bursts": 0, "frames_valid": 0, "replies": 0,
                       "error_replies": 0, "max_backlog": 0}
@@ -700,7 +711,7 @@ class Fuzzer:
     def prepare(self) -> Burst:
         g = self.gen
         while True:
-            if g.r.random() < 0.04:
+            if g.r.random() < 0.1:
                 head, fill = g.overflow_burst()
                 after = self.model.clone()
                 after.masks = []
@@ -712,12 +723,12 @@ class Fuzzer:
                           ends=[e1, e1 + 2 + BYTE_CLK * len(replies[1]) + 6])
                 b.trigs = [len(head) - 1, None]
             else:
-                data = g.burst(g.r.choice([20, 200, 600, 1500, 3000, 3000]))
+                data = g.burst(g.r.choice([20, 200, 1000, 3000, 6000, 6000]))
                 try:
                     fit = fit_burst(self.model, data)
                 except Unsafe:
                     continue
-                if fit is None:
+                if not fit[0]:
                     continue
                 data, where, replies, backlog, ends, after = fit
                 requests = [data[w[1]:(w[0] + 1 if w[0] is not None else len(data))] for w in where]
@@ -740,19 +751,18 @@ class Fuzzer:
         st["max_backlog"] = max(st["max_backlog"], b.backlog)
 
     def run(self, nbytes: int):
-        nxt = self.prepare()
-        while True:
-            cur = nxt
+        """Up to two bursts are prepared ahead, while the simulation answers the one
+        sent, so that a long preparation after a short burst leaves no idle line."""
+        ahead = [self.prepare()]
+        while ahead:
+            cur = ahead.pop(0)
             self.burst_no += 1
             cur.h0, cur.d0 = self.link.total_sent, self.link.total_read
             self.done.append(cur)
             self.link.send(cur.data)
-            last = self.link.sent >= nbytes
-            if not last:
-                nxt = self.prepare()
+            while len(ahead) < 2 and self.link.sent + sum(len(b.data) for b in ahead) < nbytes:
+                ahead.append(self.prepare())
             self.check(cur)
-            if last:
-                break
         self.finish()
 
     def finish(self):
@@ -760,7 +770,7 @@ class Fuzzer:
         data = b"".join(P.req_read(0x40 + i, a, 1) for i, a in enumerate(RW_ADDRS))
         data += P.req_read(0x7F, A_STATUS, 3)
         where = scan(data)
-        after = self.model.clone()
+        after = self.done[-1].model.clone()    # = self.model: nothing prepared is left unsent
         replies = after.burst(data)
         self.model = after
         self.burst_no += 1
