@@ -28,9 +28,11 @@ the registers:
   error, sticky, cleared by writing 0x10) its sticky flag.  Of the other ro registers,
   windows and STATUS bits (the core's own state) only the bits above the width (0);
 * the receive FIFO (128 bytes + the head register) must hold what arrives while the
-  port replies: the ordinary bursts are kept below BACKLOG_MAX bytes of backlog by a
-  timing model of the port (:func:`timeline`: host and reply bytes both 40 clk); a
-  burst longer than the FIFO is fine while the port is not replying.  Overflow bursts
+  port replies: the ordinary bursts (up to ~7 kB) are kept below BACKLOG_MAX bytes of
+  backlog by a timing model of the port (:func:`timeline`: host and reply bytes both
+  40 clk; :func:`fit_burst` puts junk before a request that would exceed it, so that
+  the parser catches up); a burst longer than the FIFO is fine while the port is not
+  replying.  Overflow bursts
   check the documented overflow: a request with a long reply (>= 187 bytes), then
   >= 140 bytes more while it goes out: the reply, one ERROR OVERFLOW (SEQ 0, request
   CMD 0), the rest discarded until the line is idle (none of its WRITEs may land);
