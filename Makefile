@@ -3,6 +3,7 @@
 #                (the bench in bench/core: python -m bench.core.run_sim_rtl)
 #   make sim-serve  make sim, then serve the core's UART to scripts/fmtctl (PORT=5555)
 #   make sim-model  the scene through the floating-point model only
+#   make fuzz    control-port fuzzing through the small core's UART (10^6 bytes, SEED=1)
 #   make test    the whole suite (model tests + cocotb under Icarus and Verilator)
 #   make lint    verilator --lint-only -Wall and an Icarus parse of every RTL file, the
 #                source lists (rtl/filelists), latches (Yosys), generated files current
@@ -31,10 +32,12 @@ export CCACHE_DIR := $(abspath build/ccache)
 JOBS         ?= 2
 SCENE        ?= sim/scenes/default.json
 PORT         ?= 5555
+SEED         ?= 1
+FUZZ_BYTES   ?= 1000000
 SIM          ?=
 export SIM
 
-.PHONY: board-xc5v all setup sim sim-serve sim-model test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -71,6 +74,12 @@ sim: setup
 # The scene through the floating-point model only (seconds).
 sim-model: setup
 	$(VPY) -m fmt.run_sim --scene $(SCENE)
+
+# Random and mutated bytes into the UART of the small fmt_core (C++ Verilator harness,
+# serve mode), every reply checked against the protocol model and a register shadow
+# (scripts/fuzz_ctrl.py, docs/reliability.md); 10^5 bytes of it run in make test.
+fuzz: setup
+	$(VPY) scripts/fuzz_ctrl.py --bytes $(FUZZ_BYTES) --seed $(SEED)
 
 # ---- tests ---------------------------------------------------------------------
 test: setup lint formal
