@@ -328,6 +328,29 @@ module fmt_blob #(
     end
 
     // ---- E: event extraction, one event per cycle (lowest remaining event start) -------
+    // at most one bit of x set, as groups of 4 (each group: non-zero, at most one) and
+    // then at most one non-zero group: a shallow tree (the x & (x - 1) form puts a
+    // 40-bit carry and a 40-input NOR in series: 10 xc5v levels in fmt_touch)
+    localparam AMO_G = (COLS + 3) / 4;
+    function amo;
+        input [COLS-1:0] x;
+        integer g, k;
+        reg [3:0] q;
+        reg       ok, any, many;
+        begin
+            ok = 1'b1; any = 1'b0; many = 1'b0;
+            for (g = 0; g < AMO_G; g = g + 1) begin
+                q = 4'd0;
+                for (k = 0; k < 4; k = k + 1)
+                    if (4 * g + k < COLS) q[k] = x[4 * g + k];
+                ok   = ok & ((q & (q - 4'd1)) == 4'd0);
+                many = many | (any & (|q));
+                any  = any | (|q);
+            end
+            amo = ok & ~many;
+        end
+    endfunction
+
     reg                  e1_v_q, e1_first_q;
     reg  [ROW_IDX_W-1:0] e1_row_q;
     reg  [RW-1:0]        e1_z_q;
@@ -1061,7 +1084,7 @@ module fmt_blob #(
             e1_rem_q <= e1_remr;
             e1_b_q   <= e1_remr & e1_neg;
             e1_ge_q  <= e1_remr | e1_neg;
-            e1_last_q <= ((e1_remr & ~e1_neg) == {COLS{1'b0}});
+            e1_last_q <= amo(e1_remr);              // = ((e1_remr & ~e1_neg) == 0)
             e1_first_q <= 1'b0;
         end
         x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
