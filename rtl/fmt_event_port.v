@@ -94,6 +94,8 @@ module fmt_event_port #(
     localparam integer DEPTH_I = DEPTH;
     localparam [AW:0]  ROOM    = ROOM_I[AW:0];      // count <= ROOM: a whole frame fits
     localparam [AW:0]  FULL    = DEPTH_I[AW:0];
+    localparam integer FULL_M1_I = DEPTH_I - 1;
+    localparam [AW:0]  FULL_M1 = FULL_M1_I[AW:0];
     localparam [TIME_W:0] NEED_EXTRA = 4;           // fixed latency 5 = NEED_EXTRA + 1
     localparam RW = FRAME_W + TIME_W + ID_W + 2 + 16 + 16 + HM_W + 16 + 16 + 8 + 8 + 1;
     localparam TLSB = RW - FRAME_W - TIME_W;        // time stamp field: [TLSB +: TIME_W]
@@ -138,7 +140,15 @@ module fmt_event_port #(
     wire              p_le1     = (report_period_i <= {{(TIME_W-1){1'b0}}, 1'b1});
     wire              dok_d     = admit_now ? p_le1
                                             : (p_zero || !have_admit_q || (since_p1 >= report_period_i));
-    wire [AW:0]       count_d   = count_q + {{AW{1'b0}}, wr} - {{AW{1'b0}}, pop};
+    // the count after this cycle's pop, then + wr; the room and not-full flags are decided
+    // for both values of wr and picked by it (wr comes last: in fmt_touch it is the end
+    // of the emission mux, and a compare after the add made 9 xc5v levels there)
+    wire [AW:0]       count_p   = count_q - {{AW{1'b0}}, pop};
+    wire [AW:0]       count_d   = count_p + {{AW{1'b0}}, wr};
+    wire              room_w    = (count_p <  ROOM);        // count_p + 1 <= ROOM
+    wire              room_nw   = (count_p <= ROOM);
+    wire              nfull_w   = (count_p <  FULL_M1);     // count_p + 1 < FULL
+    wire              nfull_nw  = (count_p <  FULL);
     wire [RW-1:0]     din       = {in_frame_i, now_q, in_id_i, in_type_i, in_x_i, in_y_i,
                                    in_strength_i, in_axis_major_i, in_axis_minor_i,
                                    in_angle_i, in_flags_i, in_last_i};
@@ -210,8 +220,8 @@ module fmt_event_port #(
             if (issue)
                 rd_ptr_q <= rd_ptr_q + 1'b1;
             count_q    <= count_d;
-            room_q     <= (count_d <= ROOM);
-            not_full_q <= (count_d < FULL);
+            room_q     <= wr ? room_w : room_nw;            // = (count_d <= ROOM)
+            not_full_q <= wr ? nfull_w : nfull_nw;          // = (count_d < FULL)
             q_v_q      <= issue || q_hold;
             head_v_q   <= keep_h || next_v_q;
             next_v_q   <= n_hold || q_v_q;
