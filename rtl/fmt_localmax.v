@@ -152,7 +152,17 @@ module fmt_localmax #(
     // arr0_q in every cycle; updated below with arr0_q / arr1_q)
     reg  [ROWS-1:0] arrp_q;
     wire [ROWS-1:0] arr_p = arrp_q;
-    wire [ROWS-1:0] hm_1h = {{(ROWS-1){1'b0}}, hm_valid_i} << hm_row_i;   // the row arriving
+    // the row arriving, one-hot: decoded bit by bit and gated by hm_valid_i, so an
+    // undefined hm_row_i between beats (a datapath register upstream without reset is X
+    // under Icarus) gives 0 and not X (a shift by an X amount would give all X bits)
+    wire [ROWS-1:0] hm_1h;
+    genvar gh;
+    generate
+        for (gh = 0; gh < ROWS; gh = gh + 1) begin : g_hm_1h
+            localparam [ROW_IDX_W-1:0] RI = gh;
+            assign hm_1h[gh] = hm_valid_i && (hm_row_i == RI);
+        end
+    endgenerate
 
     // ---- sweep scheduler ------------------------------------------------------------------
     // A step reads one row x of the processing buffer into the window.  The comparators
