@@ -6,7 +6,8 @@ end-of-frame record (count, found, overflow) and frame number must equal the mod
 many ties, random row orders, beats on consecutive cycles and with gaps, back-to-back
 frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges and
 corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
-neighbourhoods, a reset in the middle of a frame.  The latency from the last row beat
+neighbourhoods, a reset in the middle of a frame, undefined row, data and frame inputs
+(X under Icarus, garbage under Verilator) between beats.  The latency from the last row beat
 (and from hm_eof) to the last candidate is measured and bounded: 14 + n + m for n
 candidates and m maxima in the rows completed by the last beat (rtl/fmt_localmax.v).
 """
@@ -19,6 +20,7 @@ import cocotb
 import numpy as np
 import pytest
 from cocotb.triggers import RisingEdge
+from cocotb.types import LogicArray
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import run_cocotb, sources
@@ -42,9 +44,22 @@ class TB(ClockedTB):
         self.k = env_int("MAX_TOUCHES", self.cfg.max_touches)
         self.frames = []           # records from the candidate stream
         self.set(threshold=1, moore=True, limit=self.k)
-        for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i"):
+        for s in ("hm_valid_i", "hm_eof_i"):
             getattr(dut, s).value = 0
+        # between beats the row, data and frame inputs are undefined, as in the core
+        # (fmt_flatten's datapath registers have no reset): X under Icarus, garbage under
+        # Verilator (no X there)
+        self.icarus = cocotb.SIM_NAME.lower().startswith("icarus")
+        self.idle_rng = random.Random(99)
+        dut.hm_row_i.value, dut.hm_data_i.value, dut.hm_frame_i.value = self.idle()
         self.mon = None
+
+    def idle(self):
+        """Values of hm_row_i, hm_data_i, hm_frame_i without a beat: X or garbage."""
+        ws = [len(self.dut.hm_row_i), len(self.dut.hm_data_i), len(self.dut.hm_frame_i)]
+        if self.icarus:
+            return tuple(LogicArray("X" * w) for w in ws)
+        return tuple(self.idle_rng.getrandbits(w) for w in ws)
 
     CAND_FIELDS = ("row", "col", "z", "missing", "frame")
     EOF_FIELDS = ("frame", "count", "found", "overflow", "incomplete")
@@ -91,7 +106,7 @@ class TB(ClockedTB):
     async def drive(self, sched):
         """Drive the schedule (tb/common/hm_stream.py); returns (last row beat, hm_eof)
         monitor cycles per frame."""
-        return await drive_hm_schedule(self, sched)
+        return await drive_hm_schedule(self, sched, idle=self.idle)
 
     async def drain(self, n_frames, timeout=2000):
         for _ in range(timeout):
