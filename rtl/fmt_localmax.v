@@ -29,9 +29,10 @@
 //        neighbours) and P's final mask (its partial AND its later neighbours in N).
 //        The window shifts (w2 <- w1 <- w0 <- N): w2, w1, w0 = rows P - 1, P, P + 1.
 //   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
-//        a row with k maxima holds the window k cycles; the stall enable is a register,
-//        computed a cycle early from the serialiser's next mask, in copies per column
-//        group, so no clock enable of the window fans out from logic)
+//        a row with k maxima holds the window k cycles, a row with none but a
+//        non-empty partial mask one cycle; the stall enable is a register, computed a
+//        cycle early from the partial mask and the serialiser's mask, in copies per
+//        column group: no comparator and no logic before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
 //        the rows outside the sensor, registered)
@@ -45,20 +46,21 @@
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
-// candidate <= 14 + n + m for n candidates and m maxima in the rows completed by the
-// last beat (its row and the rows next to it): the sweep starts over (up to 5 reads:
-// rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one cycle,
-// the last one is captured (2 registers) and inserted, and the finish test is
-// registered, before the emission starts.  30 x 40, FFT row order: 12 + n without
-// maxima in those rows (3..5 candidates: 15..17); 20 maxima in the last row, 16
-// candidates: 50 (= 14 + n + m).  hm_eof -> last candidate is one cycle less; cand_eof
-// follows the last candidate.
+// candidate <= 14 + n + m + e for n candidates, m maxima in the rows completed by the
+// last beat (its row and the rows next to it) and e (<= 3) of those rows with a partial
+// mask but no maximum: the sweep starts over (up to 5 reads: rows r - 2 .. r + 2) on
+// one-cycle-old ready flags, each maximum holds it one cycle (a row with a partial
+// mask and no maximum one cycle), the last one is captured (2 registers) and
+// inserted, and the finish test is registered, before the emission starts.  30 x 40,
+// FFT row order: 12 + n + e without maxima in those rows (3..5 candidates: 15, 16, 15,
+// 18); 20 maxima in the last row, 16 candidates: 50 (= 14 + n + m).  hm_eof -> last
+// candidate is one cycle less; cand_eof follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
-// per row in a run) plus the virtual step (121), one cycle per maximum (at most 600:
-// Von Neumann checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of
-// emission (19): 750 < 768.  (The registered stall enable and rules take every step in
-// the same cycle as the combinational ones did: no latency or cycle count moved.)
+// per row in a run) plus the virtual step (121), one cycle per maximum and at least one
+// per row with a partial mask (at most COLS / 2 = 20 per row, 600: Von Neumann
+// checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of emission (19):
+// 750 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
@@ -180,9 +182,11 @@ module fmt_localmax #(
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] jx_q;                  // the row to read to start there
     reg                 rule_c_q;              // rule c (below), registered
-    // The step pipeline advances when no maximum is being serialised (rem_q = 0).  The
-    // enable is a register, computed a cycle early from rem_q's next value (adv_d
-    // below), in copies: the window's 1,960 flip-flops, the frame-store read register
+    // The step pipeline advances when no maximum is being serialised (rem_q = 0) and
+    // not in the cycle after a step that finished a row with a non-empty partial mask
+    // (conservative: the mask's test against the row below, a comparator bank, is not
+    // waited for).  The enable is a register, computed a cycle early (adv_d below), in
+    // copies: the window's 1,960 flip-flops, the frame-store read register
     // and output register, the step pipeline and the serialiser each take their own, so
     // no enable net fans out from logic to thousands of flip-flops.
     localparam NWC = (COLS >= 5) ? COLS / 5 : 1;    // window-shift enable copies
@@ -307,8 +311,10 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_low = rem_q & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_q & rem_m1;    // the others
     wire [COLS-1:0] mask_n  = part_q & down_n;   // P's maxima (final mask)
-    // adv's next value (rem_q's next value is 0)
-    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|mask_n)) : !(|rem_nx));
+    // adv's next value: rem_q's next value is 0, and no finishing step with a partial
+    // mask (a superset of its final mask: the stall for a row whose maxima the row below
+    // all removes is one cycle, with rem_q = 0 and no capture)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_q)) : !(|rem_nx));
     // the window shifts next cycle: adv then, and a step in s2 then
     wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
 
@@ -642,9 +648,9 @@ module fmt_localmax #(
             end
 
             // ---- serialiser ----
-            if (!advs_q) begin                 // rem_q != 0
+            if (!advs_q) begin                 // rem_q != 0, or one stall cycle with rem_q = 0
                 rem_q <= rem_nx;
-                iv_q  <= 1'b1;
+                iv_q  <= |rem_q;
             end else begin
                 iv_q  <= 1'b0;
                 if (v2_q && f2_q) rem_q <= mask_n;
