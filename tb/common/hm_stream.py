@@ -48,15 +48,24 @@ def frame_schedule(rng, hms, n_rows: int, min_cycles, first_frame: int = 0,
     return sched
 
 
-async def drive_hm_schedule(tb, sched):
+async def drive_hm_schedule(tb, sched, idle=None):
     """Drive the schedule; returns (cycle of the last row beat, cycle of hm_eof) per
-    frame, in the TB's monitor cycle numbers."""
+    frame, in the TB's monitor cycle numbers.  ``idle``: if given, a function returning
+    the (hm_row_i, hm_data_i, hm_frame_i) values to drive in every cycle without a row
+    beat (hm_frame_i: without a row beat or hm_eof), e.g. X or garbage: the block must
+    ignore them while hm_valid_i and hm_eof_i are low."""
     d = tb.dut
     marks, last_row = [], None
     for item in sched:
         await tb.writable()
         d.hm_valid_i.value = 0
         d.hm_eof_i.value = 0
+        if idle is not None and (item is None or item[0] != "row"):
+            row, data, frame = idle()
+            d.hm_row_i.value = row
+            d.hm_data_i.value = data
+            if item is None:
+                d.hm_frame_i.value = frame
         if item is not None and item[0] == "row":
             d.hm_valid_i.value = 1
             d.hm_row_i.value = item[1]
@@ -69,4 +78,6 @@ async def drive_hm_schedule(tb, sched):
     await tb.writable()
     d.hm_valid_i.value = 0
     d.hm_eof_i.value = 0
+    if idle is not None:
+        d.hm_row_i.value, d.hm_data_i.value, d.hm_frame_i.value = idle()
     return marks

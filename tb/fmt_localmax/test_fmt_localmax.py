@@ -6,9 +6,11 @@ end-of-frame record (count, found, overflow) and frame number must equal the mod
 many ties, random row orders, beats on consecutive cycles and with gaps, back-to-back
 frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges and
 corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
-neighbourhoods, a reset in the middle of a frame.  The latency from the last row beat
-(and from hm_eof) to the last candidate is measured and bounded: 14 + n + m for n
-candidates and m maxima in the rows completed by the last beat (rtl/fmt_localmax.v).
+neighbourhoods, a reset in the middle of a frame, undefined row, data and frame inputs
+(X under Icarus, garbage under Verilator) between beats.  The latency from the last row beat
+(and from hm_eof) to the last candidate is measured and bounded: 14 + n + m + e for n
+candidates, m maxima in the rows completed by the last beat and e of those rows with a
+partial mask but no maximum (rtl/fmt_localmax.v).
 """
 from __future__ import annotations
 
@@ -19,18 +21,35 @@ import cocotb
 import numpy as np
 import pytest
 from cocotb.triggers import RisingEdge
+from cocotb.types import LogicArray
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
 from common.runner import run_cocotb, sources
 from common.streams import StreamMonitor
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
-from fmt.localmax import local_maxima_fixed, maxima_mask
+from fmt.localmax import local_maxima_fixed, maxima_mask, offsets
 
 
-# latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m
-# for n candidates and m maxima in the rows completed by the last beat
+# latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m + e
+# for n candidates, m maxima in the rows completed by the last beat and e of those rows
+# with a partial mask (every test but the row below) and no maximum (one stall cycle each)
 LAT_C = 14
+
+
+def partial_mask(hm, threshold: int, neighbourhood: str) -> np.ndarray:
+    """The RTL's partial mask: the maxima test without the row below."""
+    z = np.asarray(hm, dtype=np.int64)
+    rows, cols = z.shape
+    pad = np.full((rows + 2, cols + 2), -1, dtype=np.int64)
+    pad[1:-1, 1:-1] = z
+    ok = z >= threshold
+    for dy, dx in offsets(neighbourhood):
+        if dy > 0:
+            continue
+        q = pad[1 + dy:1 + dy + rows, 1 + dx:1 + dx + cols]
+        ok &= (z > q) if (dy < 0 or dx < 0) else (z >= q)
+    return ok
 
 
 class TB(ClockedTB):
@@ -42,9 +61,22 @@ class TB(ClockedTB):
         self.k = env_int("MAX_TOUCHES", self.cfg.max_touches)
         self.frames = []           # records from the candidate stream
         self.set(threshold=1, moore=True, limit=self.k)
-        for s in ("hm_valid_i", "hm_row_i", "hm_frame_i", "hm_data_i", "hm_eof_i"):
+        for s in ("hm_valid_i", "hm_eof_i"):
             getattr(dut, s).value = 0
+        # between beats the row, data and frame inputs are undefined, as in the core
+        # (fmt_flatten's datapath registers have no reset): X under Icarus, garbage under
+        # Verilator (no X there)
+        self.icarus = cocotb.SIM_NAME.lower().startswith("icarus")
+        self.idle_rng = random.Random(99)
+        dut.hm_row_i.value, dut.hm_data_i.value, dut.hm_frame_i.value = self.idle()
         self.mon = None
+
+    def idle(self):
+        """Values of hm_row_i, hm_data_i, hm_frame_i without a beat: X or garbage."""
+        ws = [len(self.dut.hm_row_i), len(self.dut.hm_data_i), len(self.dut.hm_frame_i)]
+        if self.icarus:
+            return tuple(LogicArray("X" * w) for w in ws)
+        return tuple(self.idle_rng.getrandbits(w) for w in ws)
 
     CAND_FIELDS = ("row", "col", "z", "missing", "frame")
     EOF_FIELDS = ("frame", "count", "found", "overflow", "incomplete")
@@ -91,7 +123,7 @@ class TB(ClockedTB):
     async def drive(self, sched):
         """Drive the schedule (tb/common/hm_stream.py); returns (last row beat, hm_eof)
         monitor cycles per frame."""
-        return await drive_hm_schedule(self, sched)
+        return await drive_hm_schedule(self, sched, idle=self.idle)
 
     async def drain(self, n_frames, timeout=2000):
         for _ in range(timeout):
@@ -279,8 +311,11 @@ async def latency(dut):
     lastr = order[-1]
 
     def late(hm):
-        """Maxima in the rows the last beat completes (its row and the rows next to it)."""
-        return int(maxima_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2].sum())
+        """Maxima in the rows the last beat completes (its row and the rows next to it),
+        plus those of these rows with a partial mask and no maximum (a stall cycle each)."""
+        mm = maxima_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
+        pm = partial_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
+        return int(mm.sum()) + int((pm.any(axis=1) & ~mm.any(axis=1)).sum())
 
     hms = [random_hm(nrng, tb.rows, tb.cols, "fingers") for _ in range(4)]
     lat = await tb.run_frames(rng, hms, 100, order=order)
@@ -288,7 +323,8 @@ async def latency(dut):
         m = late(hm)
         dut._log.info(f"latency: last row -> last candidate {from_row} cycles, "
                       f"hm_eof -> last candidate {from_eof} cycles, {n} candidates, "
-                      f"{m} maxima in the rows completed by the last beat")
+                      f"m + e = {m} (maxima, and rows with a partial mask only, in the rows "
+                      f"completed by the last beat)")
         assert from_row <= LAT_C + n + m, "latency bound"
     # worst case for the model: all 16 candidates in the last rows
     z = np.zeros((tb.rows, tb.cols), dtype=np.int64)
