@@ -328,26 +328,38 @@ module fmt_blob #(
     end
 
     // ---- E: event extraction, one event per cycle (lowest remaining event start) -------
-    // at most one bit of x set, as groups of 4 (each group: non-zero, at most one) and
-    // then at most one non-zero group: a shallow tree (the x & (x - 1) form puts a
-    // 40-bit carry and a 40-input NOR in series: 10 xc5v levels in fmt_touch)
-    localparam AMO_G = (COLS + 3) / 4;
-    function amo;
+    // at most two bits of x set: saturating unary counts {>= 3, >= 2, >= 1} of 4-bit
+    // groups, combined in threes, then the last few, by AND / OR only (an adder or the
+    // form "r & (r - 1) == 0" becomes a carry chain between LUTs: 10-11 xc5v levels in
+    // fmt_touch); a shallow tree from registers
+    localparam LE_G = (COLS + 3) / 4;         // 4-bit groups
+    localparam LE_S = (LE_G + 2) / 3;         // groups of three groups
+    function [2:0] ucomb;                     // saturating sum of two unary counts
+        input [2:0] a, b;
+        ucomb = {a[2] | b[2] | (a[1] & b[0]) | (a[0] & b[1]), a[1] | b[1] | (a[0] & b[0]), a[0] | b[0]};
+    endfunction
+    function le2;
         input [COLS-1:0] x;
-        integer g, k;
-        reg [3:0] q;
-        reg       ok, any, many;
+        integer g, k, s2;
+        reg [3*LE_G-1:0] cg;
+        reg [3*LE_S-1:0] cs;
+        reg [2:0]        u;
         begin
-            ok = 1'b1; any = 1'b0; many = 1'b0;
-            for (g = 0; g < AMO_G; g = g + 1) begin
-                q = 4'd0;
+            for (g = 0; g < LE_G; g = g + 1) begin
+                u = 3'b000;
                 for (k = 0; k < 4; k = k + 1)
-                    if (4 * g + k < COLS) q[k] = x[4 * g + k];
-                ok   = ok & ((q & (q - 4'd1)) == 4'd0);
-                many = many | (any & (|q));
-                any  = any | (|q);
+                    if (4 * g + k < COLS) u = ucomb(u, {2'b00, x[4 * g + k]});
+                cg[3 * g +: 3] = u;
             end
-            amo = ok & ~many;
+            for (s2 = 0; s2 < LE_S; s2 = s2 + 1) begin
+                u = 3'b000;
+                for (k = 0; k < 3; k = k + 1)
+                    if (3 * s2 + k < LE_G) u = ucomb(u, cg[3 * (3 * s2 + k) +: 3]);
+                cs[3 * s2 +: 3] = u;
+            end
+            u = 3'b000;
+            for (s2 = 0; s2 < LE_S; s2 = s2 + 1) u = ucomb(u, cs[3 * s2 +: 3]);
+            le2 = !u[2];
         end
     endfunction
 
@@ -1084,7 +1096,7 @@ module fmt_blob #(
             e1_rem_q <= e1_remr;
             e1_b_q   <= e1_remr & e1_neg;
             e1_ge_q  <= e1_remr | e1_neg;
-            e1_last_q <= amo(e1_remr);              // = ((e1_remr & ~e1_neg) == 0)
+            e1_last_q <= le2(e1_rem_q);             // = ((e1_remr & ~e1_neg) == 0): b is in rem
             e1_first_q <= 1'b0;
         end
         x1_f_q   <= {e1_row_q == LAST_ROW, e1_first_q, ev_last, 1'b0, ev_run};
