@@ -746,7 +746,10 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
         return rep
     from common.runner import run_cocotb
     t0 = time.perf_counter()
-    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag="" if sim == "verilator" else sim)
+    # the job folder: one per simulator, and per tag when a caller gives one (tests that
+    # run at the same time under pytest-xdist must not share job.json and the logs)
+    jtag = ("" if sim == "verilator" else sim) + ("" if tag == "cpp" else f"_{tag}")
+    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag=jtag.lstrip("_"))
     t1 = time.perf_counter()
     env = {"FMT_CORE_JOB": str(d / "job.json"), "FMT_QUIET": int(quiet)}
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=sim_sources(),

@@ -272,7 +272,8 @@ def test_effect_through_core_icarus(tmp_path, name):
     r0 = rsr.model_reference(base, g0, ups, rsr.check_scene(base), sc.frames, rsr.TouchSettings(), None)
     r1 = rsr.model_reference(sc, g0, ups, rsr.check_scene(sc), sc.frames, rsr.TouchSettings(), None)
     assert not np.array_equal(r0.heatmaps, r1.heatmaps), f"{name} does not change the heat maps"
-    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True)
+    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag=f"fx_{name}")        # its own job folder: the effects run side by side under xdist
     assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
 
@@ -285,7 +286,8 @@ def test_pn_chip_len_through_core_icarus(tmp_path, cps, chip_len):
     sc = _scene.small_scene()
     sc = sc.replace(frames=4, effects={**sc.effects, "pn": {"enable": True, "chip_len": chip_len}})
     assert rsr.pn_chip_first(sc, cps) == -(-(2 + rsr.REG_LAT) // cps)
-    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=cps, sim="icarus", engine="cocotb", plot=False, quiet=True)
+    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=cps, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag=f"pn_c{cps}")
     assert rep["frames_dropped"] == 0 and rep["golden_mismatches"] == 0, rep["golden_detail"]
 
 

@@ -17,6 +17,7 @@ full size; the build takes minutes).
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 
@@ -45,10 +46,13 @@ def _run(sim, scene, cps, uart, settings, model_settings=None, extra_params=None
     """Run the scene on the sim top; the reference uses model_settings (default: the
     settings the registers are written with)."""
     cfg = scene.cfg
+    # a job folder per test (pytest-xdist runs tests of one simulator and cps side by side:
+    # a shared folder let one test read the other's logs)
+    node = os.environ.get("PYTEST_CURRENT_TEST", "").rsplit(" (", 1)[0]
+    jtag = f"tb_{sim}{tag}_{hashlib.sha1(node.encode()).hexdigest()[:8]}"
     if model_settings is not None:     # the same scene, noise and plan: only the settings differ
-        _d, ref_m, _cal, _n = rsr.prepare(scene, scene.frames, cps, model_settings, cal=None,
-                                          tag=f"tb_{sim}{tag}")
-    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None, tag=f"tb_{sim}{tag}")
+        _d, ref_m, _cal, _n = rsr.prepare(scene, scene.frames, cps, model_settings, cal=None, tag=jtag)
+    d, ref, cal, n_upd = rsr.prepare(scene, scene.frames, cps, settings, cal=None, tag=jtag)
     if model_settings is not None:
         ref = ref_m
     # slack after the last frame for the UART phase
