@@ -329,37 +329,34 @@ module fmt_blob #(
 
     // ---- E: event extraction, one event per cycle (lowest remaining event start) -------
     // at most two bits of x set: saturating unary counts {>= 3, >= 2, >= 1} of 4-bit
-    // groups, combined in threes, then the last few, by AND / OR only (an adder or the
-    // form "r & (r - 1) == 0" becomes a carry chain between LUTs: 10-11 xc5v levels in
-    // fmt_touch); a shallow tree from registers
-    localparam LE_G = (COLS + 3) / 4;         // 4-bit groups
-    localparam LE_S = (LE_G + 2) / 3;         // groups of three groups
+    // groups (each a function of its 4 bits), then a balanced pairwise tree of ucomb, by
+    // AND / OR only (an adder or the form "r & (r - 1) == 0" becomes a carry chain
+    // between LUTs, and a linear fold a LUT chain: 9-11 xc5v levels)
+    localparam LE_G = (COLS + 3) / 4;                    // 4-bit groups
+    localparam LE_P = (LE_G > 1) ? (1 << $clog2(LE_G)) : 1;   // leaves of the tree
     function [2:0] ucomb;                     // saturating sum of two unary counts
         input [2:0] a, b;
         ucomb = {a[2] | b[2] | (a[1] & b[0]) | (a[0] & b[1]), a[1] | b[1] | (a[0] & b[0]), a[0] | b[0]};
     endfunction
     function le2;
         input [COLS-1:0] x;
-        integer g, k, s2;
-        reg [3*LE_G-1:0] cg;
-        reg [3*LE_S-1:0] cs;
-        reg [2:0]        u;
+        integer g, k, w;
+        reg [3:0]        q;
+        reg [3*LE_P-1:0] v;
         begin
+            v = {3*LE_P{1'b0}};
             for (g = 0; g < LE_G; g = g + 1) begin
-                u = 3'b000;
+                q = 4'd0;
                 for (k = 0; k < 4; k = k + 1)
-                    if (4 * g + k < COLS) u = ucomb(u, {2'b00, x[4 * g + k]});
-                cg[3 * g +: 3] = u;
+                    if (4 * g + k < COLS) q[k] = x[4 * g + k];
+                v[3 * g +: 3] = {(q[0] & q[1] & q[2]) | (q[0] & q[1] & q[3]) | (q[0] & q[2] & q[3]) | (q[1] & q[2] & q[3]),
+                                 (q[0] & q[1]) | (q[0] & q[2]) | (q[0] & q[3]) | (q[1] & q[2]) | (q[1] & q[3]) | (q[2] & q[3]),
+                                 |q};
             end
-            for (s2 = 0; s2 < LE_S; s2 = s2 + 1) begin
-                u = 3'b000;
-                for (k = 0; k < 3; k = k + 1)
-                    if (3 * s2 + k < LE_G) u = ucomb(u, cg[3 * (3 * s2 + k) +: 3]);
-                cs[3 * s2 +: 3] = u;
-            end
-            u = 3'b000;
-            for (s2 = 0; s2 < LE_S; s2 = s2 + 1) u = ucomb(u, cs[3 * s2 +: 3]);
-            le2 = !u[2];
+            for (w = LE_P / 2; w >= 1; w = w / 2)
+                for (k = 0; k < w; k = k + 1)
+                    v[3 * k +: 3] = ucomb(v[3 * (2 * k) +: 3], v[3 * (2 * k + 1) +: 3]);
+            le2 = !v[2];
         end
     endfunction
 
