@@ -57,16 +57,11 @@ from __future__ import annotations
 import argparse
 import binascii
 import json
-import os
-import queue
 import random
 import re
-import signal
 import socket
 import struct
-import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -75,6 +70,7 @@ for _p in (str(ROOT), str(ROOT / "sim")):
     if _p not in sys.path:
         sys.path.insert(0, _p)
 
+from bench.core.serve_proc import ServeFailed, ServeProc   # noqa: E402
 from fmt import params                      # noqa: E402
 from fmt import protocol as P               # noqa: E402
 from fmt import regmap                      # noqa: E402
@@ -531,65 +527,12 @@ junk_rng = random.Random()                  # seeded by Fuzzer (the bytes depend
 
 
 # ---- the simulation and the socket ------------------------------------------------------------
-class Server:
+def start_server(out_dir: Path, tag: str, cflags: str, frames: int) -> ServeProc:
     """run_sim_rtl in serve mode (--serve 0 --serve-once) in its own session."""
-
-    def __init__(self, out_dir: Path, tag: str, cflags: str, frames: int):
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-            [str(ROOT), str(ROOT / "sim"), str(ROOT / "tb"), os.environ.get("PYTHONPATH", "")]))
-        out_dir.mkdir(parents=True, exist_ok=True)
-        self.err = open(out_dir / "serve_stderr.txt", "w+")
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "bench.core.run_sim_rtl", "--scene", str(ROOT / "sim" / "scenes" / "small.json"),
-             "--frames", str(frames), "--serve", "0", "--serve-once", "--serve-seconds", "3600",
-             "--serve-log-frames", "0", "--no-plot", "--quiet", "--tag", tag, f"--cflags={cflags}",
-             "--out", str(out_dir)],
-            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=self.err, text=True, start_new_session=True)
-        self.lines: queue.Queue = queue.Queue()
-        self.out: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.proc.stdout:
-            self.lines.put(line)
-        self.lines.put(None)
-
-    def wait_serving(self, wall_s: float = 1200.0) -> tuple[str, int]:
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < wall_s:
-            try:
-                line = self.lines.get(timeout=1.0)
-            except queue.Empty:
-                continue
-            if line is None:
-                break
-            self.out.append(line)
-            m = re.match(r"serving the RTL UART on socket://(127\.0\.0\.1):(\d+)$", line.strip())
-            if m:
-                return m.group(1), int(m.group(2))
-        self.kill()
-        self.err.seek(0)
-        raise RuntimeError(f"the simulation did not start serving: {''.join(self.out)[-2000:]} "
-                           f"{self.err.read()[-2000:]}")
-
-    def finish(self, wall_s: float = 300.0) -> tuple[int, str]:
-        try:
-            rc = self.proc.wait(timeout=wall_s)
-        except subprocess.TimeoutExpired:
-            self.kill()
-            return -1, "the serving simulation did not end"
-        while True:
-            line = self.lines.get(timeout=10)
-            if line is None:
-                break
-            self.out.append(line)
-        self.err.seek(0)
-        return rc, "".join(self.out) + self.err.read()
-
-    def kill(self):
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait()
+    return ServeProc(out_dir, [
+        "--scene", str(ROOT / "sim" / "scenes" / "small.json"), "--frames", str(frames), "--serve", "0",
+        "--serve-once", "--serve-seconds", "3600", "--serve-log-frames", "0", "--no-plot", "--quiet",
+        "--tag", tag, f"--cflags={cflags}", "--out", str(out_dir)])
 
 
 class Link:
@@ -854,10 +797,11 @@ def main(argv=None) -> int:
                 return 2
             host, port = m.group(1), int(m.group(2))
         else:
-            srv = Server(Path(a.out), a.tag, a.cflags, frames=4)
+            srv = start_server(Path(a.out), a.tag, a.cflags, frames=4)
             try:
-                host, port = srv.wait_serving()
-            except RuntimeError as exc:
+                m = srv.wait_serving(wall_s=1200.0)
+                host, port = m.group(2), int(m.group(3))
+            except ServeFailed as exc:
                 print(f"fuzz_ctrl: {exc}", file=sys.stderr)
                 return 2
         t_serve = time.monotonic()
@@ -882,7 +826,10 @@ def main(argv=None) -> int:
                   ctrl_errors=m.err_count, fuzz_wall_s=round(t_end - t_serve, 1),
                   total_wall_s=round(t_end - t0, 1))
         if srv is not None:
-            rc, text = srv.finish()
+            try:
+                rc, text = srv.finish(wall_s=300.0)
+            except ServeFailed as exc:
+                rc, text = -1, str(exc)
             srv = None
             mm = re.search(r"served the UART for (\d+) clk", text)
             st["sim_clk"] = int(mm.group(1)) if mm else None

@@ -38,13 +38,9 @@ Verilator only (a C++ Verilator harness).
 from __future__ import annotations
 
 import json
-import os
-import queue
 import re
-import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -52,6 +48,7 @@ import numpy as np
 import pytest
 
 from bench.core import run_sim_rtl as rsr
+from bench.core.serve_proc import ServeProc
 from fmt import params
 from fmt import protocol as P
 from fmt import regmap
@@ -67,67 +64,19 @@ QUIET_FRAME = 400   # run A: no event after this frame (the lifts' hold-off ends
 SLACK = 16          # clk: register pipeline between an event leaving and its counters
 
 
-class Server:
-    """python -m bench.core.run_sim_rtl --serve 0 in its own session; stdout read by a thread."""
+class Server(ServeProc):
+    """python -m bench.core.run_sim_rtl --serve 0 at the small sensor (the test's -O0 build
+    and tag) in its own session; ``extra`` arguments after the defaults."""
 
     def __init__(self, out_dir: Path, *extra: str):
-        path = [str(ROOT), str(ROOT / "sim"), str(ROOT / "tb")]
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join(path + [os.environ.get("PYTHONPATH", "")]))
-        self.err = open(out_dir / "serve_stderr.txt", "w+")
-        self.proc = subprocess.Popen(
-            [sys.executable, "-m", "bench.core.run_sim_rtl", "--scene", str(SCENE), "--frames", str(FRAMES),
-             "--cps", str(CPS), "--serve", "0", "--serve-log-frames", "-1", "--no-plot", "--quiet",
-             "--cflags=-O0", "--tag", TAG, "--out", str(out_dir), *extra],
-            cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=self.err, text=True, start_new_session=True)
-        self.lines: queue.Queue = queue.Queue()
-        self.out: list[str] = []
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self):
-        for line in self.proc.stdout:
-            self.lines.put(line)
-        self.lines.put(None)
+        super().__init__(out_dir, [
+            "--scene", str(SCENE), "--frames", str(FRAMES), "--cps", str(CPS), "--serve", "0",
+            "--serve-log-frames", "-1", "--no-plot", "--quiet", "--cflags=-O0", "--tag", TAG,
+            "--out", str(out_dir), *extra])
 
     def wait_serving(self, wall_s: float = 240.0) -> str:
-        t0 = time.monotonic()
-        while time.monotonic() - t0 < wall_s:
-            try:
-                line = self.lines.get(timeout=1.0)
-            except queue.Empty:
-                continue
-            if line is None:
-                break
-            self.out.append(line)
-            m = re.match(r"serving the RTL UART on (socket://127\.0\.0\.1:\d+)$", line.strip())
-            if m:
-                return m.group(1)
-        self.kill()
-        self.err.seek(0)
-        raise AssertionError(f"no serving line: {''.join(self.out)} {self.err.read()[-3000:]}")
-
-    def finish(self, wall_s: float = 120.0) -> tuple[int, str]:
-        try:
-            rc = self.proc.wait(timeout=wall_s)
-        except subprocess.TimeoutExpired:
-            self.kill()
-            raise AssertionError("the serving simulation did not end") from None
-        while True:
-            line = self.lines.get(timeout=10)
-            if line is None:
-                break
-            self.out.append(line)
-        self.err.seek(0)
-        text = "".join(self.out) + self.err.read()
-        self.err.close()
-        return rc, text
-
-    def interrupt(self):                    # Ctrl-C: SIGINT to the whole process group
-        os.killpg(self.proc.pid, signal.SIGINT)
-
-    def kill(self):
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait()
+        """socket://127.0.0.1:PORT"""
+        return super().wait_serving(wall_s).group(1)
 
 
 def fmtctl(port: str, *args: str) -> str:
