@@ -32,7 +32,7 @@
 //        a row with k maxima holds the window k cycles, a row with none but a
 //        non-empty partial mask one cycle; the stall enable is a register, computed a
 //        cycle early from the partial mask and the serialiser's mask, in copies per
-//        column group: no comparator and no logic before the window's clock enables)
+//        column group: no comparator and no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
 //        the rows outside the sensor, registered)
@@ -188,7 +188,7 @@ module fmt_localmax #(
     // waited for).  The enable is a register, computed a cycle early (adv_d below), in
     // copies: the window's 1,960 flip-flops, the frame-store read register
     // and output register, the step pipeline and the serialiser each take their own, so
-    // no enable net fans out from logic to thousands of flip-flops.
+    // no enable net fans out from gates to thousands of flip-flops.
     localparam NWC = (COLS >= 5) ? COLS / 5 : 1;    // window-shift enable copies
     localparam NOC = (COLS >= 10) ? COLS / 10 : 1;  // output-register enable copies
     reg                 advc_q;                // adv: the step pipeline and the rules
