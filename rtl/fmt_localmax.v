@@ -270,12 +270,17 @@ module fmt_localmax #(
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
-    wire [COLS:0]   gtl;                       // N[c] > N[c-1]
+    // Only registers follow them (taken when the window shifts, with N into w0_q): per
+    // column N > N left (cl_q), N >= threshold (ct_q), N above its earlier neighbours in P
+    // (cu_q) and P's later neighbours in N below P (dm_q: P's "down" mask).  N's partial
+    // mask is a function of these registers in the next cycles (part_c), and P's maxima
+    // are its partial mask AND dm_q, applied in the serialiser (no comparator before it).
+    wire [COLS-1:0] gtl;                       // N[c] > N[c-1]
     wire [COLS-1:0] gtv;                       // N[c] > P[c]
     wire [COLS:0]   gd1;                       // N[c] > P[c-1]
     wire [COLS:0]   gd2;                       // N[c] > P[c+1] at [c+1]
-    wire [COLS-1:0] part_n, down_n;
-    assign gtl[0] = 1'b1;  assign gtl[COLS] = 1'b0;
+    wire [COLS-1:0] thr_n, up_n, down_n;
+    assign gtl[0] = 1'b1;
     assign gd1[0] = 1'b1;  assign gd1[COLS] = 1'b0;
     assign gd2[0] = 1'b0;  assign gd2[COLS] = 1'b1;
     genvar c;
@@ -291,30 +296,45 @@ module fmt_localmax #(
             if (c < COLS - 1) begin : g_r
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
-            wire thr_ok = (n >= threshold_i);
-            // N's earlier neighbours: left (strict), above, above-left, above-right (strict)
-            wire up_ok  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
-            assign part_n[c] = thr_ok && gtl[c] && !gtl[c+1] && (t2_q || up_ok);
+            assign thr_n[c] = (n >= threshold_i);
+            // N's earlier neighbours in P: above, above-left, above-right (strict)
+            assign up_n[c]  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
             // P's later neighbours in N: below, below-left, below-right (P >= them)
-            wire dn_ok  = !gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c]));
-            assign down_n[c] = x2_q || dn_ok;
+            assign down_n[c] = x2_q || (!gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c])));
         end
     endgenerate
+    reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
+    reg [COLS-1:0]  ct_q, cu_q;                // thr_n, up_n of w0_q's row
+    reg [COLS-1:0]  dm_q;                      // down_n: w1_q's row >= its later neighbours
+    reg             t3_q;                      // w0_q's row is row 0
+    wire [COLS:0]   cl = {1'b0, cl_q};
+    // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
+    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu_q | {COLS{t3_q}});
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
-    reg [COLS-1:0]      part_q;                // partial mask of w0_q
-    reg [COLS-1:0]      rem_q;                 // maxima of w1_q not yet taken
+    reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     reg                 mtop_q, mbot_q;        // w1_q is the first / last row
-    wire [COLS-1:0] rem_m1  = rem_q - 1'b1;
-    wire [COLS-1:0] rem_low = rem_q & ~rem_m1;   // its lowest maximum, one-hot
-    wire [COLS-1:0] rem_nx  = rem_q & rem_m1;    // the others
-    wire [COLS-1:0] mask_n  = part_q & down_n;   // P's maxima (final mask)
+    // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
+    // shifts it into w1_q) AND its test against the row below (dm_q, loaded then too)
+    wire [COLS-1:0] rem_e   = rem_q & dm_q;
+    // lowest set bit by prefix ORs (rem_bl[i]: a maximum left of column i), each its own
+    // balanced OR: no carry chain, no chain of ORs
+    wire [COLS-1:0] rem_bl;
+    assign rem_bl[0] = 1'b0;
+    genvar gb;
+    generate
+        for (gb = 1; gb < COLS; gb = gb + 1) begin : g_bl
+            assign rem_bl[gb] = |rem_e[gb-1:0];
+        end
+    endgenerate
+    wire [COLS-1:0] rem_low = rem_e & ~rem_bl;   // its lowest maximum, one-hot
+    wire [COLS-1:0] rem_nx  = rem_e & rem_bl;    // the others
     // adv's next value: rem_q's next value is 0, and no finishing step with a partial
     // mask (a superset of its final mask: the stall for a row whose maxima the row below
-    // all removes is one cycle, with rem_q = 0 and no capture)
-    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_q)) : !(|rem_nx));
+    // all removes is one cycle, with no capture)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !(|rem_nx));
     // the window shifts next cycle: adv then, and a step in s2 then
     wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
 
@@ -342,7 +362,10 @@ module fmt_localmax #(
                     w0_q[gk*HM_W +: HM_W] <= do_q[gk*HM_W +: HM_W];
                     w1_q[gk*HM_W +: HM_W] <= w0_q[gk*HM_W +: HM_W];
                     w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
-                    part_q[gk]            <= part_n[gk];
+                    cl_q[gk]              <= gtl[gk];
+                    ct_q[gk]              <= thr_n[gk];
+                    cu_q[gk]              <= up_n[gk];
+                    dm_q[gk]              <= down_n[gk];
                 end
             end
         end
@@ -386,10 +409,14 @@ module fmt_localmax #(
     reg                 iv_q;                  // a maximum to capture
     (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
     reg [COL_IDX_W-1:0] icol_q;
-    (* fsm_encoding = "none" *)
-    reg [QI_W-1:0]      iq_q;                  // icol_q / 3
-    (* fsm_encoding = "none" *)
-    reg [QI_W-1:0]      ig0_q, ig1_q;          // the cells of groups 0 and 1 (q or q + 1)
+    // the capture selects, one copy per window row (a: w2_q, b: w1_q, c: w0_q; keep:
+    // not merged by synthesis), each driving the selects of one row only
+    (* fsm_encoding = "none", keep *)
+    reg [QI_W-1:0]      iqa_q, iqb_q, iqc_q;   // icol_q / 3
+    (* fsm_encoding = "none", keep *)
+    reg [QI_W-1:0]      ig0a_q, ig0b_q, ig0c_q;// the cell of group 0 (q or q + 1)
+    (* fsm_encoding = "none", keep *)
+    reg [QI_W-1:0]      ig1a_q, ig1b_q, ig1c_q;// the cell of group 1 (q or q + 1)
     (* fsm_encoding = "none" *)
     reg [1:0]           im_q;                  // icol_q mod 3
 
@@ -439,9 +466,9 @@ module fmt_localmax #(
     endgenerate
     // first capture register: the three cells of each row (group order), then the
     // rotation by m and the rows outside the sensor
-    wire [HM_W-1:0] sa0 = ga0[ig0_q], sa1 = ga1[ig1_q], sa2 = ga2[iq_q];
-    wire [HM_W-1:0] sb0 = gb0[ig0_q], sb1 = gb1[ig1_q], sb2 = gb2[iq_q];
-    wire [HM_W-1:0] sc0 = gc0[ig0_q], sc1 = gc1[ig1_q], sc2 = gc2[iq_q];
+    wire [HM_W-1:0] sa0 = ga0[ig0a_q], sa1 = ga1[ig1a_q], sa2 = ga2[iqa_q];
+    wire [HM_W-1:0] sb0 = gb0[ig0b_q], sb1 = gb1[ig1b_q], sb2 = gb2[iqb_q];
+    wire [HM_W-1:0] sc0 = gc0[ig0c_q], sc1 = gc1[ig1c_q], sc2 = gc2[iqc_q];
     reg             pv_q;                      // pre-capture valid
     reg [Z9_W-1:0]  pz_q;                      // the nine cells, group order
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
@@ -535,7 +562,8 @@ module fmt_localmax #(
             f0_q <= rule_a;
             r1_q <= r0_q;  t1_q <= t0_q;  x1_q <= x0_q;  f1_q <= f0_q;
             r2_q <= r1_q;  t2_q <= t1_q;  x2_q <= x1_q;  f2_q <= f1_q;
-            if (v2_q) begin
+            if (v2_q) begin                    // the window shifts
+                t3_q   <= t2_q;
                 mrow_q <= r2_q;
                 mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
                 mbot_q <= x2_q;
@@ -543,9 +571,9 @@ module fmt_localmax #(
         end
         if (!advs_q) begin
             icol_q <= lo_col;
-            iq_q   <= lo_q;
-            ig0_q  <= lo_g0;
-            ig1_q  <= lo_g1;
+            iqa_q  <= lo_q;   iqb_q  <= lo_q;   iqc_q  <= lo_q;
+            ig0a_q <= lo_g0;  ig0b_q <= lo_g0;  ig0c_q <= lo_g0;
+            ig1a_q <= lo_g1;  ig1b_q <= lo_g1;  ig1c_q <= lo_g1;
             im_q   <= lo_m;
         end
         pz_q      <= {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
@@ -648,12 +676,12 @@ module fmt_localmax #(
             end
 
             // ---- serialiser ----
-            if (!advs_q) begin                 // rem_q != 0, or one stall cycle with rem_q = 0
+            if (!advs_q) begin                 // rem_e != 0, or one stall cycle with rem_e = 0
                 rem_q <= rem_nx;
-                iv_q  <= |rem_q;
+                iv_q  <= |rem_e;
             end else begin
                 iv_q  <= 1'b0;
-                if (v2_q && f2_q) rem_q <= mask_n;
+                if (v2_q && f2_q) rem_q <= part_c;   // rem_q = 0 here (advs_q): a new row
             end
             pv_q    <= iv_q;
             cap_v_q <= pv_q;
