@@ -319,18 +319,9 @@ module fmt_localmax #(
     // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
     // shifts it into w1_q) AND its test against the row below (dm_q, loaded then too)
     wire [COLS-1:0] rem_e   = rem_q & dm_q;
-    // lowest set bit by prefix ORs (rem_bl[i]: a maximum left of column i), each its own
-    // balanced OR: no carry chain, no chain of ORs
-    wire [COLS-1:0] rem_bl;
-    assign rem_bl[0] = 1'b0;
-    genvar gb;
-    generate
-        for (gb = 1; gb < COLS; gb = gb + 1) begin : g_bl
-            assign rem_bl[gb] = |rem_e[gb-1:0];
-        end
-    endgenerate
-    wire [COLS-1:0] rem_low = rem_e & ~rem_bl;   // its lowest maximum, one-hot
-    wire [COLS-1:0] rem_nx  = rem_e & rem_bl;    // the others
+    wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
+    wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
+    wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
     // adv's next value: rem_q's next value is 0, and no finishing step with a partial
     // mask (a superset of its final mask: the stall for a row whose maxima the row below
     // all removes is one cycle, with no capture)
