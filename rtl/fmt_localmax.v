@@ -494,10 +494,13 @@ module fmt_localmax #(
     wire [K*SLOT_W-1:0] l_slot;                // 3x3 store slot of entry i
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
+    // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
+    // and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1)) u_list (
+                      .HAS_POP(1), .EARLY(1)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
+        .nxt_key_i(z9[4*HM_W +: HM_W]), .nxt_tie_i(pidx_q),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -527,21 +530,29 @@ module fmt_localmax #(
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
     end
 
+    // the limit and the counts of the finish, registered: limit_i two cycles old, found_q
+    // one (it does not change in the cycle before finish: fin_pre_q waits for no capture)
     wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
-    wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_eff};
-    wire             over     = (found_q > lim_ext);
-    wire [LIM_W-1:0] n_emit   = over ? lim_eff : found_q[LIM_W-1:0];
+    reg  [LIM_W-1:0] lim_q;
+    wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_q};
+    wire             over_d   = (found_q > lim_ext);
+    reg              over_q;                   // found_q > the limit
+    reg  [LIM_W-1:0] n_emit_q;                 // candidates to emit
+    reg  [FOUND_W-1:0] dropped_q;              // found_q - n_emit_q
     wire             complete = (arr_p == {ROWS{1'b1}});
     // finish: the frame's eof seen, no row ready, nothing in flight -- registered (one
     // cycle old: nothing can start in between, as no row was ready)
     reg              fin_pre_q;
     wire             finish   = run && fin_pre_q;
-    wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
-    wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
+    wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped_q};
 
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
+        lim_q     <= lim_eff;
+        over_q    <= over_d;
+        n_emit_q  <= over_d ? lim_q : found_q[LIM_W-1:0];
+        dropped_q <= over_d ? found_q - lim_ext : {FOUND_W{1'b0}};
         jx_q     <= jx_d;
         jx1h_q   <= jx1h_d;
         jx0_q    <= rdy_low[0] | rdy_low[1];
@@ -684,12 +695,12 @@ module fmt_localmax #(
             if (finish) begin
                 state_q    <= S_EMIT;
                 em_frame_q <= pb_q ? frm1_q : frm0_q;
-                left_q     <= complete ? n_emit : {LIM_W{1'b0}};
-                cand_count_o      <= complete ? n_emit : {LIM_W{1'b0}};
+                left_q     <= complete ? n_emit_q : {LIM_W{1'b0}};
+                cand_count_o      <= complete ? n_emit_q : {LIM_W{1'b0}};
                 cand_found_o      <= complete ? found_q : {FOUND_W{1'b0}};
-                cand_overflow_o   <= complete && over;
+                cand_overflow_o   <= complete && over_q;
                 cand_incomplete_o <= !complete;
-                if (complete && over) begin
+                if (complete && over_q) begin
                     overflow_flag_o <= 1'b1;
                     drop_count_o    <= drop_sum[CNT_W] ? {CNT_W{1'b1}} : drop_sum[CNT_W-1:0];
                 end
