@@ -400,14 +400,17 @@ module fmt_localmax #(
     reg                 iv_q;                  // a maximum to capture
     (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
     reg [COL_IDX_W-1:0] icol_q;
-    // the capture selects, one copy per window row (a: w2_q, b: w1_q, c: w0_q; keep:
-    // not merged by synthesis), each driving the selects of one row only
-    (* fsm_encoding = "none", keep *)
-    reg [QI_W-1:0]      iqa_q, iqb_q, iqc_q;   // icol_q / 3
-    (* fsm_encoding = "none", keep *)
-    reg [QI_W-1:0]      ig0a_q, ig0b_q, ig0c_q;// the cell of group 0 (q or q + 1)
-    (* fsm_encoding = "none", keep *)
-    reg [QI_W-1:0]      ig1a_q, ig1b_q, ig1c_q;// the cell of group 1 (q or q + 1)
+    // The capture selects a cell of each group in two registered steps: the low LO_W
+    // bits of its number pick one cell in each quarter of the group (NQ quarters of NL
+    // cells: a select local to the quarter's columns, with its own copy of the select
+    // bits per quarter and window row: keep, not merged by synthesis), then the high
+    // HI_W bits pick the quarter.
+    localparam LO_W = (QI_W > 2) ? 2 : 1;
+    localparam HI_W = QI_W - LO_W;
+    localparam NL   = 1 << LO_W;
+    localparam NQ   = 1 << HI_W;
+    (* fsm_encoding = "none" *)
+    reg [HI_W-1:0]      ih0_q, ih1_q, ih2_q;   // high bits: group 0, 1 cells and icol_q / 3
     (* fsm_encoding = "none" *)
     reg [1:0]           im_q;                  // icol_q mod 3
 
@@ -455,11 +458,52 @@ module fmt_localmax #(
             end
         end
     endgenerate
-    // first capture register: the three cells of each row (group order), then the
-    // rotation by m and the rows outside the sensor
-    wire [HM_W-1:0] sa0 = ga0[ig0a_q], sa1 = ga1[ig1a_q], sa2 = ga2[iqa_q];
-    wire [HM_W-1:0] sb0 = gb0[ig0b_q], sb1 = gb1[ig1b_q], sb2 = gb2[iqb_q];
-    wire [HM_W-1:0] sc0 = gc0[ig0c_q], sc1 = gc1[ig1c_q], sc2 = gc2[iqc_q];
+    // capture step 1: per quarter, the cells of the nine groups (rows a, b, c; groups 0,
+    // 1, 2) at the low select bits, registered (s1_q, quarter h at [h*Z9_W +: Z9_W],
+    // group order as pz_q)
+    wire [NQ*Z9_W-1:0] s1_q;
+    genvar gq;
+    generate
+        for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
+            (* fsm_encoding = "none", keep *)
+            reg [LO_W-1:0] l0a_q, l1a_q, l2a_q;    // row a: group 0, 1, 2 cell, low bits
+            (* fsm_encoding = "none", keep *)
+            reg [LO_W-1:0] l0b_q, l1b_q, l2b_q;    // row b
+            (* fsm_encoding = "none", keep *)
+            reg [LO_W-1:0] l0c_q, l1c_q, l2c_q;    // row c
+            reg [Z9_W-1:0] s_q;
+            always @(posedge clk) begin
+                if (!advs_q) begin
+                    l0a_q <= lo_g0[LO_W-1:0];  l1a_q <= lo_g1[LO_W-1:0];  l2a_q <= lo_q[LO_W-1:0];
+                    l0b_q <= lo_g0[LO_W-1:0];  l1b_q <= lo_g1[LO_W-1:0];  l2b_q <= lo_q[LO_W-1:0];
+                    l0c_q <= lo_g0[LO_W-1:0];  l1c_q <= lo_g1[LO_W-1:0];  l2c_q <= lo_q[LO_W-1:0];
+                end
+                s_q <= {gc2[gq*NL + l2c_q], gc1[gq*NL + l1c_q], gc0[gq*NL + l0c_q],
+                        gb2[gq*NL + l2b_q], gb1[gq*NL + l1b_q], gb0[gq*NL + l0b_q],
+                        ga2[gq*NL + l2a_q], ga1[gq*NL + l1a_q], ga0[gq*NL + l0a_q]};
+            end
+            assign s1_q[gq*Z9_W +: Z9_W] = s_q;
+        end
+    endgenerate
+    reg             p1v_q;                     // capture step 1 valid
+    reg [HI_W-1:0]  p1h0_q, p1h1_q, p1h2_q;    // the quarters of groups 0, 1, 2
+    reg [1:0]       p1m_q;
+    reg             p1top_q, p1bot_q;
+    reg [IDX_W-1:0] p1idx_q;
+    // capture step 2: the quarter of each group
+    reg [Z9_W-1:0]  s2;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_s2
+        integer h, r;
+        s2 = {Z9_W{1'b0}};
+        for (h = 0; h < NQ; h = h + 1)
+            for (r = 0; r < 3; r = r + 1) begin
+                if (p1h0_q == h[HI_W-1:0]) s2[(3*r+0)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+0)*HM_W +: HM_W];
+                if (p1h1_q == h[HI_W-1:0]) s2[(3*r+1)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+1)*HM_W +: HM_W];
+                if (p1h2_q == h[HI_W-1:0]) s2[(3*r+2)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+2)*HM_W +: HM_W];
+            end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
     reg             pv_q;                      // pre-capture valid
     reg [Z9_W-1:0]  pz_q;                      // the nine cells, group order
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
@@ -573,16 +617,23 @@ module fmt_localmax #(
         end
         if (!advs_q) begin
             icol_q <= lo_col;
-            iqa_q  <= lo_q;   iqb_q  <= lo_q;   iqc_q  <= lo_q;
-            ig0a_q <= lo_g0;  ig0b_q <= lo_g0;  ig0c_q <= lo_g0;
-            ig1a_q <= lo_g1;  ig1b_q <= lo_g1;  ig1c_q <= lo_g1;
+            ih0_q  <= lo_g0[QI_W-1:LO_W];
+            ih1_q  <= lo_g1[QI_W-1:LO_W];
+            ih2_q  <= lo_q[QI_W-1:LO_W];
             im_q   <= lo_m;
         end
-        pz_q      <= {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
-        pm_q      <= im_q;
-        ptop_q    <= mtop_q;
-        pbot_q    <= mbot_q;
-        pidx_q    <= {mrow_q, icol_q};
+        p1h0_q    <= ih0_q;
+        p1h1_q    <= ih1_q;
+        p1h2_q    <= ih2_q;
+        p1m_q     <= im_q;
+        p1top_q   <= mtop_q;
+        p1bot_q   <= mbot_q;
+        p1idx_q   <= {mrow_q, icol_q};
+        pz_q      <= s2;
+        pm_q      <= p1m_q;
+        ptop_q    <= p1top_q;
+        pbot_q    <= p1bot_q;
+        pidx_q    <= p1idx_q;
         cap_z_q   <= z9;
         cap_idx_q <= pidx_q;
         cand_z_o       <= z9_rd_q;
@@ -612,6 +663,7 @@ module fmt_localmax #(
             rem_q    <= {COLS{1'b0}};
             iv_q     <= 1'b0;
             cap_v_q  <= 1'b0;
+            p1v_q    <= 1'b0;
             pv_q     <= 1'b0;
             fin_pre_q <= 1'b0;
             found_q  <= {FOUND_W{1'b0}};
@@ -685,13 +737,14 @@ module fmt_localmax #(
                 iv_q  <= 1'b0;
                 if (v2_q && f2_q) rem_q <= part_c;   // rem_q = 0 here (advs_q): a new row
             end
-            pv_q    <= iv_q;
+            p1v_q   <= iv_q;
+            pv_q    <= p1v_q;
             cap_v_q <= pv_q;
             if (cap_v_q) found_q <= found_q + 1'b1;
 
             // ---- finish and emit ----
             fin_pre_q <= run && eofs_q[pb_q] && !(|ready) && !v0_q && !v1_q && !v2_q && adv
-                      && !iv_q && !pv_q && !cap_v_q;
+                      && !iv_q && !p1v_q && !pv_q && !cap_v_q;
             if (finish) begin
                 state_q    <= S_EMIT;
                 em_frame_q <= pb_q ? frm1_q : frm0_q;

@@ -34,7 +34,7 @@ from fmt.localmax import local_maxima_fixed, maxima_mask, offsets
 # latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m + e
 # for n candidates, m maxima in the rows completed by the last beat and e of those rows
 # with a partial mask (every test but the row below) and no maximum (one stall cycle each)
-LAT_C = 14
+LAT_C = 15
 
 
 def partial_mask(hm, threshold: int, neighbourhood: str) -> np.ndarray:
