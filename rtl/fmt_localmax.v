@@ -38,7 +38,7 @@
 //        no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
-//        each quarter of a group (select copies per quarter and row), then the quarter;
+//        each quarter of a group (select copies per quarter), then the quarter;
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
@@ -408,8 +408,9 @@ module fmt_localmax #(
     // The capture selects a cell of each group in two registered steps: the low LO_W
     // bits of its number pick one cell in each quarter of the group (NQ quarters of NL
     // cells: a select local to the quarter's columns, with its own copy of the select
-    // bits per quarter and window row: keep, not merged by synthesis), then the high
-    // HI_W bits pick the quarter.
+    // bits per quarter: keep, not merged by synthesis; one copy per quarter and window
+    // row routed at 84.1 MHz, the decode's fan-out to the 36 copies critical), then
+    // the high HI_W bits pick the quarter.
     localparam LO_W = (QI_W > 2) ? 2 : 1;
     localparam HI_W = QI_W - LO_W;
     localparam NL   = 1 << LO_W;
@@ -471,21 +472,15 @@ module fmt_localmax #(
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
             (* fsm_encoding = "none", keep *)
-            reg [LO_W-1:0] l0a_q, l1a_q, l2a_q;    // row a: group 0, 1, 2 cell, low bits
-            (* fsm_encoding = "none", keep *)
-            reg [LO_W-1:0] l0b_q, l1b_q, l2b_q;    // row b
-            (* fsm_encoding = "none", keep *)
-            reg [LO_W-1:0] l0c_q, l1c_q, l2c_q;    // row c
+            reg [LO_W-1:0] l0_q, l1_q, l2_q;       // group 0, 1, 2 cell, low bits
             reg [Z9_W-1:0] s_q;
             always @(posedge clk) begin
                 if (!advs_q) begin
-                    l0a_q <= lo_g0[LO_W-1:0];  l1a_q <= lo_g1[LO_W-1:0];  l2a_q <= lo_q[LO_W-1:0];
-                    l0b_q <= lo_g0[LO_W-1:0];  l1b_q <= lo_g1[LO_W-1:0];  l2b_q <= lo_q[LO_W-1:0];
-                    l0c_q <= lo_g0[LO_W-1:0];  l1c_q <= lo_g1[LO_W-1:0];  l2c_q <= lo_q[LO_W-1:0];
+                    l0_q <= lo_g0[LO_W-1:0];  l1_q <= lo_g1[LO_W-1:0];  l2_q <= lo_q[LO_W-1:0];
                 end
-                s_q <= {gc2[gq*NL + l2c_q], gc1[gq*NL + l1c_q], gc0[gq*NL + l0c_q],
-                        gb2[gq*NL + l2b_q], gb1[gq*NL + l1b_q], gb0[gq*NL + l0b_q],
-                        ga2[gq*NL + l2a_q], ga1[gq*NL + l1a_q], ga0[gq*NL + l0a_q]};
+                s_q <= {gc2[gq*NL + l2_q], gc1[gq*NL + l1_q], gc0[gq*NL + l0_q],
+                        gb2[gq*NL + l2_q], gb1[gq*NL + l1_q], gb0[gq*NL + l0_q],
+                        ga2[gq*NL + l2_q], ga1[gq*NL + l1_q], ga0[gq*NL + l0_q]};
             end
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
