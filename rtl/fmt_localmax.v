@@ -25,42 +25,47 @@
 //   SW3  one comparator bank against the previous step's row P = N's row - 1 (the
 //        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
 //        (5 x COLS comparators; each pair of cells is compared once: P's "below" tests
-//        are the negations of N's "above" tests) -> N's partial mask (earlier
-//        neighbours) and P's final mask (its partial AND its later neighbours in N).
-//        The window shifts (w2 <- w1 <- w0 <- N): w2, w1, w0 = rows P - 1, P, P + 1.
-//   SW4  serialise P's maxima, lowest column first, one per cycle (the sweep waits:
-//        a row with k maxima holds the window k cycles, a row with none but a
-//        non-empty partial mask one cycle; the stall enable is a register, computed a
-//        cycle early from the partial mask and the serialiser's mask, in copies per
-//        column group: no comparator and no gate before the window's clock enables)
+//        are the negations of N's "above" tests), registered when the window shifts
+//        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1): per column N's left,
+//        threshold and above tests (N's partial mask, earlier neighbours, is a function
+//        of these registers) and P's down mask (its later neighbours in N).  No logic
+//        follows a comparator but the one LUT of these tests.
+//   SW4  serialise P's maxima, lowest column first, one per cycle: P's partial mask
+//        (loaded at the shift) AND its down mask (the sweep waits: a row with k maxima
+//        holds the window k cycles, a row with none but a non-empty partial mask one
+//        cycle; the stall enable is a register, computed a cycle early from the partial
+//        mask and the serialiser's mask, in copies per column group: no comparator and
+//        no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
-//        ceil((COLS+2)/3):1 selects per row, registered, then a rotation per row and
-//        the rows outside the sensor, registered)
+//        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
+//        each quarter of a group (select copies per quarter), then the quarter;
+//        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
-//        descending, ties by raster index ascending; fmt_sorted_list); the 3x3 goes to
-//        a (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
+//        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
+//        early); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
+//        list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
 // then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
-// between frames.
+// between frames (limit_i is registered: it takes effect two cycles later).
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
-// candidate <= 14 + n + m + e for n candidates, m maxima in the rows completed by the
+// candidate <= 15 + n + m + e for n candidates, m maxima in the rows completed by the
 // last beat (its row and the rows next to it) and e (<= 3) of those rows with a partial
 // mask but no maximum: the sweep starts over (up to 5 reads: rows r - 2 .. r + 2) on
 // one-cycle-old ready flags, each maximum holds it one cycle (a row with a partial
-// mask and no maximum one cycle), the last one is captured (2 registers) and
+// mask and no maximum one cycle), the last one is captured (3 registers) and
 // inserted, and the finish test is registered, before the emission starts.  30 x 40,
 // FFT row order: 12 + n + e without maxima in those rows (3..5 candidates: 15, 16, 15,
-// 18); 20 maxima in the last row, 16 candidates: 50 (= 14 + n + m).  hm_eof -> last
+// 18); 20 maxima in the last row, 16 candidates: 51 (= 15 + n + m).  hm_eof -> last
 // candidate is one cycle less; cand_eof follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
 // per row in a run) plus the virtual step (121), one cycle per maximum and at least one
 // per row with a partial mask (at most COLS / 2 = 20 per row, 600: Von Neumann
-// checkerboard; Moore at most 300), 10 of pipeline and finish, n + 3 of emission (19):
-// 750 < 768.
+// checkerboard; Moore at most 300), 11 of pipeline and finish, n + 3 of emission (19):
+// 751 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
@@ -270,12 +275,17 @@ module fmt_localmax #(
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
-    wire [COLS:0]   gtl;                       // N[c] > N[c-1]
+    // Only registers follow them (taken when the window shifts, with N into w0_q): per
+    // column N > N left (cl_q), N >= threshold (ct_q), N above its earlier neighbours in P
+    // (cu_q) and P's later neighbours in N below P (dm_q: P's "down" mask).  N's partial
+    // mask is a function of these registers in the next cycles (part_c), and P's maxima
+    // are its partial mask AND dm_q, applied in the serialiser (no comparator before it).
+    wire [COLS-1:0] gtl;                       // N[c] > N[c-1]
     wire [COLS-1:0] gtv;                       // N[c] > P[c]
     wire [COLS:0]   gd1;                       // N[c] > P[c-1]
     wire [COLS:0]   gd2;                       // N[c] > P[c+1] at [c+1]
-    wire [COLS-1:0] part_n, down_n;
-    assign gtl[0] = 1'b1;  assign gtl[COLS] = 1'b0;
+    wire [COLS-1:0] thr_n, up_n, down_n;
+    assign gtl[0] = 1'b1;
     assign gd1[0] = 1'b1;  assign gd1[COLS] = 1'b0;
     assign gd2[0] = 1'b0;  assign gd2[COLS] = 1'b1;
     genvar c;
@@ -291,30 +301,36 @@ module fmt_localmax #(
             if (c < COLS - 1) begin : g_r
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
-            wire thr_ok = (n >= threshold_i);
-            // N's earlier neighbours: left (strict), above, above-left, above-right (strict)
-            wire up_ok  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
-            assign part_n[c] = thr_ok && gtl[c] && !gtl[c+1] && (t2_q || up_ok);
+            assign thr_n[c] = (n >= threshold_i);
+            // N's earlier neighbours in P: above, above-left, above-right (strict)
+            assign up_n[c]  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
             // P's later neighbours in N: below, below-left, below-right (P >= them)
-            wire dn_ok  = !gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c]));
-            assign down_n[c] = x2_q || dn_ok;
+            assign down_n[c] = x2_q || (!gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c])));
         end
     endgenerate
+    reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
+    reg [COLS-1:0]  ct_q, cu_q;                // thr_n, up_n of w0_q's row
+    reg [COLS-1:0]  dm_q;                      // down_n: w1_q's row >= its later neighbours
+    reg             t3_q;                      // w0_q's row is row 0
+    wire [COLS:0]   cl = {1'b0, cl_q};
+    // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
+    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu_q | {COLS{t3_q}});
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
-    reg [COLS-1:0]      part_q;                // partial mask of w0_q
-    reg [COLS-1:0]      rem_q;                 // maxima of w1_q not yet taken
+    reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     reg                 mtop_q, mbot_q;        // w1_q is the first / last row
-    wire [COLS-1:0] rem_m1  = rem_q - 1'b1;
-    wire [COLS-1:0] rem_low = rem_q & ~rem_m1;   // its lowest maximum, one-hot
-    wire [COLS-1:0] rem_nx  = rem_q & rem_m1;    // the others
-    wire [COLS-1:0] mask_n  = part_q & down_n;   // P's maxima (final mask)
+    // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
+    // shifts it into w1_q) AND its test against the row below (dm_q, loaded then too)
+    wire [COLS-1:0] rem_e   = rem_q & dm_q;
+    wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
+    wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
+    wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
     // adv's next value: rem_q's next value is 0, and no finishing step with a partial
     // mask (a superset of its final mask: the stall for a row whose maxima the row below
-    // all removes is one cycle, with rem_q = 0 and no capture)
-    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_q)) : !(|rem_nx));
+    // all removes is one cycle, with no capture)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !(|rem_nx));
     // the window shifts next cycle: adv then, and a step in s2 then
     wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
 
@@ -342,7 +358,10 @@ module fmt_localmax #(
                     w0_q[gk*HM_W +: HM_W] <= do_q[gk*HM_W +: HM_W];
                     w1_q[gk*HM_W +: HM_W] <= w0_q[gk*HM_W +: HM_W];
                     w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
-                    part_q[gk]            <= part_n[gk];
+                    cl_q[gk]              <= gtl[gk];
+                    ct_q[gk]              <= thr_n[gk];
+                    cu_q[gk]              <= up_n[gk];
+                    dm_q[gk]              <= down_n[gk];
                 end
             end
         end
@@ -386,10 +405,18 @@ module fmt_localmax #(
     reg                 iv_q;                  // a maximum to capture
     (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
     reg [COL_IDX_W-1:0] icol_q;
+    // The capture selects a cell of each group in two registered steps: the low LO_W
+    // bits of its number pick one cell in each quarter of the group (NQ quarters of NL
+    // cells: a select local to the quarter's columns, with its own copy of the select
+    // bits per quarter: keep, not merged by synthesis; one copy per quarter and window
+    // row routed at 84.1 MHz, the decode's fan-out to the 36 copies critical), then
+    // the high HI_W bits pick the quarter.
+    localparam LO_W = (QI_W > 2) ? 2 : 1;
+    localparam HI_W = QI_W - LO_W;
+    localparam NL   = 1 << LO_W;
+    localparam NQ   = 1 << HI_W;
     (* fsm_encoding = "none" *)
-    reg [QI_W-1:0]      iq_q;                  // icol_q / 3
-    (* fsm_encoding = "none" *)
-    reg [QI_W-1:0]      ig0_q, ig1_q;          // the cells of groups 0 and 1 (q or q + 1)
+    reg [HI_W-1:0]      ih0_q, ih1_q, ih2_q;   // high bits: group 0, 1 cells and icol_q / 3
     (* fsm_encoding = "none" *)
     reg [1:0]           im_q;                  // icol_q mod 3
 
@@ -437,11 +464,46 @@ module fmt_localmax #(
             end
         end
     endgenerate
-    // first capture register: the three cells of each row (group order), then the
-    // rotation by m and the rows outside the sensor
-    wire [HM_W-1:0] sa0 = ga0[ig0_q], sa1 = ga1[ig1_q], sa2 = ga2[iq_q];
-    wire [HM_W-1:0] sb0 = gb0[ig0_q], sb1 = gb1[ig1_q], sb2 = gb2[iq_q];
-    wire [HM_W-1:0] sc0 = gc0[ig0_q], sc1 = gc1[ig1_q], sc2 = gc2[iq_q];
+    // capture step 1: per quarter, the cells of the nine groups (rows a, b, c; groups 0,
+    // 1, 2) at the low select bits, registered (s1_q, quarter h at [h*Z9_W +: Z9_W],
+    // group order as pz_q)
+    wire [NQ*Z9_W-1:0] s1_q;
+    genvar gq;
+    generate
+        for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
+            (* fsm_encoding = "none", keep *)
+            reg [LO_W-1:0] l0_q, l1_q, l2_q;       // group 0, 1, 2 cell, low bits
+            reg [Z9_W-1:0] s_q;
+            always @(posedge clk) begin
+                if (!advs_q) begin
+                    l0_q <= lo_g0[LO_W-1:0];  l1_q <= lo_g1[LO_W-1:0];  l2_q <= lo_q[LO_W-1:0];
+                end
+                s_q <= {gc2[gq*NL + l2_q], gc1[gq*NL + l1_q], gc0[gq*NL + l0_q],
+                        gb2[gq*NL + l2_q], gb1[gq*NL + l1_q], gb0[gq*NL + l0_q],
+                        ga2[gq*NL + l2_q], ga1[gq*NL + l1_q], ga0[gq*NL + l0_q]};
+            end
+            assign s1_q[gq*Z9_W +: Z9_W] = s_q;
+        end
+    endgenerate
+    reg             p1v_q;                     // capture step 1 valid
+    reg [HI_W-1:0]  p1h0_q, p1h1_q, p1h2_q;    // the quarters of groups 0, 1, 2
+    reg [1:0]       p1m_q;
+    reg             p1top_q, p1bot_q;
+    reg [IDX_W-1:0] p1idx_q;
+    // capture step 2: the quarter of each group
+    reg [Z9_W-1:0]  s2;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_s2
+        integer h, r;
+        s2 = {Z9_W{1'b0}};
+        for (h = 0; h < NQ; h = h + 1)
+            for (r = 0; r < 3; r = r + 1) begin
+                if (p1h0_q == h[HI_W-1:0]) s2[(3*r+0)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+0)*HM_W +: HM_W];
+                if (p1h1_q == h[HI_W-1:0]) s2[(3*r+1)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+1)*HM_W +: HM_W];
+                if (p1h2_q == h[HI_W-1:0]) s2[(3*r+2)*HM_W +: HM_W] = s1_q[h*Z9_W + (3*r+2)*HM_W +: HM_W];
+            end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
     reg             pv_q;                      // pre-capture valid
     reg [Z9_W-1:0]  pz_q;                      // the nine cells, group order
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
@@ -476,10 +538,13 @@ module fmt_localmax #(
     wire [K*SLOT_W-1:0] l_slot;                // 3x3 store slot of entry i
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
+    // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
+    // and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1)) u_list (
+                      .HAS_POP(1), .EARLY(1)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
+        .nxt_key_i(z9[4*HM_W +: HM_W]), .nxt_tie_i(pidx_q),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -509,21 +574,29 @@ module fmt_localmax #(
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
     end
 
+    // the limit and the counts of the finish, registered: limit_i two cycles old, found_q
+    // one (it does not change in the cycle before finish: fin_pre_q waits for no capture)
     wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
-    wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_eff};
-    wire             over     = (found_q > lim_ext);
-    wire [LIM_W-1:0] n_emit   = over ? lim_eff : found_q[LIM_W-1:0];
+    reg  [LIM_W-1:0] lim_q;
+    wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_q};
+    wire             over_d   = (found_q > lim_ext);
+    reg              over_q;                   // found_q > the limit
+    reg  [LIM_W-1:0] n_emit_q;                 // candidates to emit
+    reg  [FOUND_W-1:0] dropped_q;              // found_q - n_emit_q
     wire             complete = (arr_p == {ROWS{1'b1}});
     // finish: the frame's eof seen, no row ready, nothing in flight -- registered (one
     // cycle old: nothing can start in between, as no row was ready)
     reg              fin_pre_q;
     wire             finish   = run && fin_pre_q;
-    wire [FOUND_W-1:0] dropped = found_q - {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, n_emit};
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
-    wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped};
+    wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped_q};
 
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
+        lim_q     <= lim_eff;
+        over_q    <= over_d;
+        n_emit_q  <= over_d ? lim_q : found_q[LIM_W-1:0];
+        dropped_q <= over_d ? found_q - lim_ext : {FOUND_W{1'b0}};
         jx_q     <= jx_d;
         jx1h_q   <= jx1h_d;
         jx0_q    <= rdy_low[0] | rdy_low[1];
@@ -535,7 +608,8 @@ module fmt_localmax #(
             f0_q <= rule_a;
             r1_q <= r0_q;  t1_q <= t0_q;  x1_q <= x0_q;  f1_q <= f0_q;
             r2_q <= r1_q;  t2_q <= t1_q;  x2_q <= x1_q;  f2_q <= f1_q;
-            if (v2_q) begin
+            if (v2_q) begin                    // the window shifts
+                t3_q   <= t2_q;
                 mrow_q <= r2_q;
                 mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
                 mbot_q <= x2_q;
@@ -543,16 +617,23 @@ module fmt_localmax #(
         end
         if (!advs_q) begin
             icol_q <= lo_col;
-            iq_q   <= lo_q;
-            ig0_q  <= lo_g0;
-            ig1_q  <= lo_g1;
+            ih0_q  <= lo_g0[QI_W-1:LO_W];
+            ih1_q  <= lo_g1[QI_W-1:LO_W];
+            ih2_q  <= lo_q[QI_W-1:LO_W];
             im_q   <= lo_m;
         end
-        pz_q      <= {sc2, sc1, sc0, sb2, sb1, sb0, sa2, sa1, sa0};
-        pm_q      <= im_q;
-        ptop_q    <= mtop_q;
-        pbot_q    <= mbot_q;
-        pidx_q    <= {mrow_q, icol_q};
+        p1h0_q    <= ih0_q;
+        p1h1_q    <= ih1_q;
+        p1h2_q    <= ih2_q;
+        p1m_q     <= im_q;
+        p1top_q   <= mtop_q;
+        p1bot_q   <= mbot_q;
+        p1idx_q   <= {mrow_q, icol_q};
+        pz_q      <= s2;
+        pm_q      <= p1m_q;
+        ptop_q    <= p1top_q;
+        pbot_q    <= p1bot_q;
+        pidx_q    <= p1idx_q;
         cap_z_q   <= z9;
         cap_idx_q <= pidx_q;
         cand_z_o       <= z9_rd_q;
@@ -582,6 +663,7 @@ module fmt_localmax #(
             rem_q    <= {COLS{1'b0}};
             iv_q     <= 1'b0;
             cap_v_q  <= 1'b0;
+            p1v_q    <= 1'b0;
             pv_q     <= 1'b0;
             fin_pre_q <= 1'b0;
             found_q  <= {FOUND_W{1'b0}};
@@ -648,29 +730,30 @@ module fmt_localmax #(
             end
 
             // ---- serialiser ----
-            if (!advs_q) begin                 // rem_q != 0, or one stall cycle with rem_q = 0
+            if (!advs_q) begin                 // rem_e != 0, or one stall cycle with rem_e = 0
                 rem_q <= rem_nx;
-                iv_q  <= |rem_q;
+                iv_q  <= |rem_e;
             end else begin
                 iv_q  <= 1'b0;
-                if (v2_q && f2_q) rem_q <= mask_n;
+                if (v2_q && f2_q) rem_q <= part_c;   // rem_q = 0 here (advs_q): a new row
             end
-            pv_q    <= iv_q;
+            p1v_q   <= iv_q;
+            pv_q    <= p1v_q;
             cap_v_q <= pv_q;
             if (cap_v_q) found_q <= found_q + 1'b1;
 
             // ---- finish and emit ----
             fin_pre_q <= run && eofs_q[pb_q] && !(|ready) && !v0_q && !v1_q && !v2_q && adv
-                      && !iv_q && !pv_q && !cap_v_q;
+                      && !iv_q && !p1v_q && !pv_q && !cap_v_q;
             if (finish) begin
                 state_q    <= S_EMIT;
                 em_frame_q <= pb_q ? frm1_q : frm0_q;
-                left_q     <= complete ? n_emit : {LIM_W{1'b0}};
-                cand_count_o      <= complete ? n_emit : {LIM_W{1'b0}};
+                left_q     <= complete ? n_emit_q : {LIM_W{1'b0}};
+                cand_count_o      <= complete ? n_emit_q : {LIM_W{1'b0}};
                 cand_found_o      <= complete ? found_q : {FOUND_W{1'b0}};
-                cand_overflow_o   <= complete && over;
+                cand_overflow_o   <= complete && over_q;
                 cand_incomplete_o <= !complete;
-                if (complete && over) begin
+                if (complete && over_q) begin
                     overflow_flag_o <= 1'b1;
                     drop_count_o    <= drop_sum[CNT_W] ? {CNT_W{1'b1}} : drop_sum[CNT_W-1:0];
                 end

@@ -31,6 +31,14 @@
 // HAS_POP = 0 removes the pop select (Yosys synth_xilinx keeps the module as a block,
 // so a constant pop_i = 0 at the instance would not remove it): fmt_blob never pops.
 //
+// EARLY = 1: the comparisons are made a cycle early and registered: nxt_key_i and
+// nxt_tie_i give the key and tie of the next cycle's insert (the user's register inputs
+// of ins_key_i / ins_tie_i; they must equal them in every cycle with ins_i, simulation
+// reports a mismatch).  Every entry is compared with them as it will be in the next
+// cycle: the results (and the inserted entry's own, one more comparator) move with their
+// entries on an insert or pop, so no comparator is between ins_key_i and the entries'
+// enables.  EARLY = 0: ins_key_i is compared in the cycle of the insert (nxt_* unused).
+//
 // Cost: K comparators of KEY_W + TIE_W bits, a 3:1 (2:1 with HAS_POP = 0) select per
 // entry bit; no arithmetic beyond the comparators.  Against the lists the two blocks
 // had inline (Yosys synth_xilinx, scripts/synth.py): fmt_localmax 6,555 -> 6,507 LUT,
@@ -44,7 +52,8 @@ module fmt_sorted_list #(
     parameter PAY_W       = 4,   // payload width; 0 = no payload (pay_o, drop_pay_o are one
                                  // constant 0 bit per entry); >= $clog2(K + 1) with PAY_RST_IDX
     parameter PAY_RST_IDX = 0,   // 1: rst sets payload i = i and drop_pay_o = K; 0: no reset
-    parameter HAS_POP     = 1    // 1: pop_i works; 0: pop_i is ignored (no pop circuit)
+    parameter HAS_POP     = 1,   // 1: pop_i works; 0: pop_i is ignored (no pop circuit)
+    parameter EARLY       = 0    // 1: compare with nxt_key_i / nxt_tie_i a cycle early
 ) (
     input  wire               clk,
     input  wire               rst,         // synchronous, active high
@@ -52,6 +61,10 @@ module fmt_sorted_list #(
     input  wire               ins_i,       // insert this cycle
     input  wire [KEY_W-1:0]   ins_key_i,   // its key (descending)
     input  wire [TIE_W-1:0]   ins_tie_i,   // its tie-break key (ascending)
+    /* verilator lint_off UNUSEDSIGNAL */  // EARLY = 0: not read
+    input  wire [KEY_W-1:0]   nxt_key_i,   // EARLY = 1: ins_key_i of the next cycle
+    input  wire [TIE_W-1:0]   nxt_tie_i,   // EARLY = 1: ins_tie_i of the next cycle
+    /* verilator lint_on UNUSEDSIGNAL */
     input  wire [((PAY_W > 0) ? PAY_W : 1)-1:0]   ins_pay_i,   // its payload
     input  wire               pop_i,       // remove entry 0, the rest moves up (HAS_POP = 1)
     output reg  [K-1:0]       valid_o,     // entry i holds data
@@ -78,6 +91,10 @@ module fmt_sorted_list #(
             $display("fmt_sorted_list: PAY_RST_IDX %0d must be 0 or 1", PAY_RST_IDX);
             $finish;
         end
+        if (EARLY != 0 && EARLY != 1) begin
+            $display("fmt_sorted_list: EARLY %0d must be 0 or 1", EARLY);
+            $finish;
+        end
         if (PAY_RST_IDX == 1 && PAY_W < IW) begin
             $display("fmt_sorted_list: PAY_W %0d < %0d bits of the entry numbers 0..K (K %0d)",
                      PAY_W, IW, K);
@@ -92,12 +109,55 @@ module fmt_sorted_list #(
 
     // entry i stays ahead of the inserted entry
     reg [K-1:0] better;
-    always @(*) begin : c_better
-        integer i;
-        for (i = 0; i < K; i = i + 1)
-            better[i] = valid_o[i] && ({key_o[i*KEY_W +: KEY_W], ~tie_o[i*TIE_W +: TIE_W]} >
-                                       {ins_key_i, ~ins_tie_i});
-    end
+    generate
+        if (EARLY == 1) begin : g_early
+            // ahead_q[i]: entry i (as it is now) ranks ahead of this cycle's insert
+            reg [K-1:0] ahead_q;
+            reg [K-1:0] ahead_c;               // entry i now ahead of the next insert
+            wire        ahead_ins = ({ins_key_i, ~ins_tie_i} > {nxt_key_i, ~nxt_tie_i});
+            always @(*) begin : c_better
+                integer i;
+                for (i = 0; i < K; i = i + 1) begin
+                    better[i]  = valid_o[i] && ahead_q[i];
+                    ahead_c[i] = ({key_o[i*KEY_W +: KEY_W], ~tie_o[i*TIE_W +: TIE_W]} >
+                                  {nxt_key_i, ~nxt_tie_i});
+                end
+            end
+            // the results move with their entries (as the list below)
+            always @(posedge clk) begin : s_ahead
+                integer i;
+                ahead_q <= ahead_c;
+                if (ins_i) begin
+                    for (i = 0; i < K; i = i + 1)
+                        if (!better[i])
+                            ahead_q[i] <= (i == 0 || better[(i == 0) ? 0 : i - 1])
+                                        ? ahead_ins : ahead_c[(i == 0) ? 0 : i - 1];
+                end
+                if (HAS_POP == 1 && pop_i) begin
+                    for (i = 0; i < K - 1; i = i + 1)
+                        ahead_q[i] <= ahead_c[i + 1];
+                end
+            end
+            // synthesis translate_off
+            reg [KEY_W-1:0] nk_q;
+            reg [TIE_W-1:0] nt_q;
+            always @(posedge clk) begin
+                nk_q <= nxt_key_i;
+                nt_q <= nxt_tie_i;
+                if (!rst && ins_i && (nk_q !== ins_key_i || nt_q !== ins_tie_i))
+                    $display("%m: ERROR: insert differs from the previous nxt_key_i / nxt_tie_i at %0t",
+                             $time);
+            end
+            // synthesis translate_on
+        end else begin : g_now
+            always @(*) begin : c_better
+                integer i;
+                for (i = 0; i < K; i = i + 1)
+                    better[i] = valid_o[i] && ({key_o[i*KEY_W +: KEY_W], ~tie_o[i*TIE_W +: TIE_W]} >
+                                               {ins_key_i, ~ins_tie_i});
+            end
+        end
+    endgenerate
 
     // ---- payloads: registers of PW bits (PAY_W = 0: 1 bit, unused, removed) -------------
     localparam PW = (PAY_W > 0) ? PAY_W : 1;

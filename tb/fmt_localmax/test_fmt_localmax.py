@@ -8,7 +8,7 @@ frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges
 corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
 neighbourhoods, a reset in the middle of a frame, undefined row, data and frame inputs
 (X under Icarus, garbage under Verilator) between beats.  The latency from the last row beat
-(and from hm_eof) to the last candidate is measured and bounded: 14 + n + m + e for n
+(and from hm_eof) to the last candidate is measured and bounded: 15 + n + m + e for n
 candidates, m maxima in the rows completed by the last beat and e of those rows with a
 partial mask but no maximum (rtl/fmt_localmax.v).
 """
@@ -34,7 +34,7 @@ from fmt.localmax import local_maxima_fixed, maxima_mask, offsets
 # latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m + e
 # for n candidates, m maxima in the rows completed by the last beat and e of those rows
 # with a partial mask (every test but the row below) and no maximum (one stall cycle each)
-LAT_C = 14
+LAT_C = 15
 
 
 def partial_mask(hm, threshold: int, neighbourhood: str) -> np.ndarray:

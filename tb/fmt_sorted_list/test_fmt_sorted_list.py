@@ -7,7 +7,8 @@ keys and tie keys of the valid entries, the payloads and drop_pay_o must equal t
 model's.  With PAY_RST_IDX = 1 the test inserts with ins_pay_i = drop_pay_o (the free
 slot, as fmt_blob does) and checks that the payloads and drop_pay_o stay a permutation
 of 0..K.  Parametrized over K (1, 3, 8), PAY_W = 0 (no payload: outputs 0) and
-HAS_POP = 0 (pop_i is driven and must be ignored).
+HAS_POP = 0 (pop_i is driven and must be ignored), and EARLY = 1 (nxt_key_i / nxt_tie_i
+carry the next cycle's insert key a cycle ahead; an insert always takes them).
 """
 from __future__ import annotations
 
@@ -126,11 +127,16 @@ async def random_ops(dut):
     counts = {"ins": 0, "pop": 0, "clear": 0, "rst": 0, "drop_new": 0, "equal": 0}
     n_key = min(1 << tb.kw, 6)                         # few keys: many equal ones
     n_tie = min(1 << tb.tw, 4)
+    early = env_int("EARLY", 0)
+    pend = (rng.randrange(n_key), rng.randrange(n_tie))     # the next insert's key and tie
+    dut.nxt_key_i.value, dut.nxt_tie_i.value = pend
     for _ in range(3000):
         await FallingEdge(tb.clk)
         tb.check()
         d = dut
         d.ins_i.value = d.pop_i.value = d.clear_i.value = 0
+        cur, pend = pend, (rng.randrange(n_key), rng.randrange(n_tie))
+        d.nxt_key_i.value, d.nxt_tie_i.value = pend
         r = rng.random()
         if r < 0.005:
             counts["rst"] += 1
@@ -138,7 +144,7 @@ async def random_ops(dut):
             tb.m.reset()
             continue
         if r < 0.60:
-            key, tie = rng.randrange(n_key), rng.randrange(n_tie)
+            key, tie = cur if early else (rng.randrange(n_key), rng.randrange(n_tie))
             if tb.pri:
                 pay = fields(d.drop_pay_o.value, 1, tb.pw)[0]
             else:
@@ -165,12 +171,14 @@ async def random_ops(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop",
-                         [(1, 4, 1, 1), (3, 4, 0, 1), (8, 4, 1, 1), (5, 0, 0, 1), (4, 3, 1, 0)],
-                         ids=["k1_idx", "k3", "k8_idx", "k5_nopay", "k4_idx_nopop"])
-def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop):
+@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop,early",
+                         [(1, 4, 1, 1, 0), (3, 4, 0, 1, 0), (8, 4, 1, 1, 0), (5, 0, 0, 1, 0),
+                          (4, 3, 1, 0, 0), (1, 4, 1, 1, 1), (8, 4, 1, 1, 1), (5, 3, 0, 1, 1)],
+                         ids=["k1_idx", "k3", "k8_idx", "k5_nopay", "k4_idx_nopop",
+                              "k1_idx_early", "k8_idx_early", "k5_early"])
+def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early):
     p = {"K": k, "KEY_W": 4, "TIE_W": 3, "PAY_W": pay_w, "PAY_RST_IDX": pay_rst_idx,
-         "HAS_POP": has_pop}
+         "HAS_POP": has_pop, "EARLY": early}
     run_cocotb(sim=sim, toplevel="fmt_sorted_list", sources=sources("fmt_sorted_list"),
                test_module="test_fmt_sorted_list", test_dir=Path(__file__).parent,
                parameters=p, extra_env={**p, "SEED": 1})
