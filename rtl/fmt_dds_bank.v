@@ -19,8 +19,9 @@
 // 2^TABLE_ADDR >= 2^LOG2_N every exact-bin tone is exactly periodic in every N-sample
 // window (no leakage).  Table amplitude quantization sets a worst spur of roughly -6 dB
 // per SINE_BITS bit (measured by scripts/dds_purity.py); the default 16-bit table is
-// below the 12-bit DAC word's own rounding.  No DSP48E: the amplitude product is a LUT
-// shift-add (fmt_dds_chan).
+// below the 12-bit DAC word's own rounding.  The amplitude product (fmt_dds_chan): one
+// multiplier per engine (DSP48E / ECP5 MULT18X18D, registered as XST packs it) when R > 1,
+// a LUT-only Booth sum when R = 1 (no DSP48E).
 //
 // Output: dac_o[r*DAC_BITS +: DAC_BITS] is row r, signed, registered.  Timing: with
 // sample k = k-th ce edge after reset, the word of sample k (phase = sum of the tuning
