@@ -37,7 +37,7 @@ FUZZ_BYTES   ?= 1000000
 SIM          ?=
 export SIM
 
-.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz mutate test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -81,6 +81,11 @@ sim-model: setup
 fuzz: setup
 	$(VPY) scripts/fuzz_ctrl.py --bytes $(FUZZ_BYTES) --seed $(SEED)
 
+# One rule at a time (rounding, tie, boundary, delay) broken in a copy of the tree: the
+# block's own test must fail for each (scripts/mutate.py; ~20 min; also in test-long)
+mutate: setup
+	$(VPY) scripts/mutate.py
+
 # ---- tests ---------------------------------------------------------------------
 test: setup lint formal
 	$(VPY) -m pytest -q -n $(JOBS) sim/tests tb
@@ -96,6 +101,7 @@ test-rtl: setup
 test-long: setup
 	FMT_LONG=1 FFT_LONG=1 FMT_CORE_DEFAULT=1 FMT_TOUCH_DEFAULT=1 FMT_RX_FULL=1 FMT_DDS_FULL=1 \
 	  $(VPY) -m pytest -q -n $(JOBS) sim/tests tb
+	$(VPY) scripts/mutate.py
 
 lint: setup
 	@bash scripts/lint.sh

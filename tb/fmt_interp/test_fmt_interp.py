@@ -196,6 +196,54 @@ async def bit_exact_random(dut):
     dut._log.info(f"{n_tp} touches bit-exact, latency {LAT}")
 
 
+def clamp_boundary_cands(cfg):
+    """Interior candidates whose x quotient q (|offset| in 1/512 cell, before the clamp
+    and the rounding) is exactly 255..258, for the Moore and the Von Neumann fit: q = 257
+    is the first clamped value (0.5 cell, flag bit 0), q = 256 the last one rounded.
+    Found by scanning the right neighbour of a fixed 3 x 3 patch (q moves by less than
+    one per LSB there) and reading q from the model's own quotient."""
+    found = {}
+    miss = np.zeros((3, 3), dtype=bool)
+    row, col = cfg.rows // 2, cfg.cols // 2
+    for moore, base, span in ((True, [[3000, 5200, 3100], [5000, 9000, 0], [2900, 5100, 3000]],
+                               range(12500, 13800)),
+                              (False, [[0, 5200, 0], [5000, 9000, 0], [0, 5100, 0]],
+                               range(8500, 9300))):
+        for right in span:
+            z = np.array(base, dtype=np.int64)
+            z[1][2] = right
+            sel, moore_ok, _, _, _ = interp._select(z.tolist(), miss, moore)
+            num, den, kind = sel[0]
+            if kind != ("moore" if moore else "vn") or moore_ok != moore:
+                continue
+            q, ovf = interp.div_fixed(abs(num) << 9, den)
+            if not ovf and 255 <= q <= 258 and (moore, q) not in found:
+                found[(moore, q)] = Candidate(row, col, z, 0)
+    return found
+
+
+@cocotb.test()
+async def clamp_boundary(dut):
+    """The offset clamp starts exactly at 257/512 cell: quotients 255..258 of both fits
+    (random stimulus almost never lands on them), bit-exact with the model, and the
+    model itself rounds 256 to 128 unflagged and clamps 257 with flag bit 0."""
+    tb = TB(dut)
+    await tb.reset()
+    found = clamp_boundary_cands(tb.cfg)
+    assert {(True, 256), (True, 257)} <= set(found), sorted(found)
+    beats = []
+    for (moore, q), c in sorted(found.items()):
+        beats.append(("c", c, 0, moore, False))
+    beats.append(("e", 0, len(found), 0))
+    assert interp.offset_fixed(256, 512) == (128, False)
+    assert interp.offset_fixed(257, 512) == (128, True)
+    exp = await tb.drive(beats)
+    await tb.cycles(LAT + 4)
+    compare(tb, exp, tb.out)
+    flags = {(m, q): e[2][7] & 1 for ((m, q), _), e in zip(sorted(found.items()), exp)}
+    assert all(f == (q >= 257) for (m, q), f in flags.items()), flags
+
+
 @cocotb.test()
 async def back_to_back_and_reset(dut):
     """64 candidates on consecutive cycles, then a reset in the middle of a stream: no

@@ -356,6 +356,43 @@ async def scripted_scenarios(dut):
 
 
 @cocotb.test()
+async def gate_boundaries(dut):
+    """The match gates include their bound: a touch exactly max_jump (L1, Q8.8) from a
+    contact seen last frame, or exactly hold_jump from one in hold-off, continues it; one
+    unit farther starts a new contact.  No velocity (max_speed 0): the prediction is the
+    last position, so the distances are exact."""
+    tb = TB(dut)
+    mj, hj = 300, 100
+    p = TrackParams(max_jump_q=mj, hold_jump_q=hj, hold_off_frames=3, vel_shift=0,
+                    max_speed_v=0, max_touches=tb.mt)
+    tb.set_params(p)
+    await tb.reset()
+    x0, y0 = 2000, 1500
+    frames = [[Touch(x0, y0, 3000)],
+              [Touch(x0 + mj - 40, y0 + 40, 3000)],           # D = max_jump: move
+              [Touch(x0 + 2 * mj - 40 + 1, y0 + 40, 3000)],   # D = max_jump + 1: new
+              [],                                             # both in hold-off
+              [Touch(x0 + 2 * mj - 39 + hj - 30, y0 + 70, 3000)],   # D = hold_jump: move
+              [],
+              [Touch(x0 + 2 * mj - 39 + 2 * hj - 30 + 1, y0 + 70, 3000)]]  # hold_jump + 1
+    n0 = len(tb.events)
+    await run_frames(tb, p, frames)
+    per = {}
+    for _, e, _ in tb.events[n0:]:
+        per.setdefault(e[0], []).append((e[1], e[2]))    # frame -> [(id, type)]
+    new, move = 0, 1
+    first_id = per[0][0][0]
+    assert per[0] == [(first_id, new)]
+    assert per[1] == [(first_id, move)], f"D = max_jump must match: {per[1]}"
+    assert [t for _, t in per[2]] == [new] and per[2][0][0] != first_id, \
+        f"D = max_jump + 1 must not match: {per[2]}"
+    second_id = per[2][0][0]
+    assert (second_id, move) in per[4], f"D = hold_jump (in hold-off) must match: {per[4]}"
+    assert any(t == new for _, t in per[6]) and (second_id, move) not in per[6], \
+        f"D = hold_jump + 1 must not match: {per[6]}"
+
+
+@cocotb.test()
 async def over_limit_touches(dut):
     """MAX_TOUCHES + 1 touches in a frame, then a new touch while all slots are taken."""
     tb = TB(dut)
