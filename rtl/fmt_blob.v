@@ -184,14 +184,18 @@ module fmt_blob #(
     localparam O_SX   = O_SZ + SZ_W;
     localparam O_SY   = O_SX + SX_W;
     localparam O_RMIN = O_SY + SY_W;
-    localparam O_RMAX = O_RMIN + ROW_IDX_W;
+    localparam O_FC   = O_RMIN + ROW_IDX_W;          // column of the first cell (row = rmin)
+    localparam O_RMAX = O_FC + COL_IDX_W;
     localparam O_CMIN = O_RMAX + ROW_IDX_W;
     localparam O_CMAX = O_CMIN + COL_IDX_W;
     localparam O_PEAK = O_CMAX + COL_IDX_W;
     localparam O_PR   = O_PEAK + HM_W;
     localparam O_PC   = O_PR + ROW_IDX_W;
-    localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
-    localparam E_W    = O_FC + COL_IDX_W;
+    localparam E_W    = O_PC + COL_IDX_W;
+    // the accumulator memory in field slices (each with its own address registers; a
+    // field's update uses its own slice only): {area, sum z}, sum z*c, sum z*r,
+    // {rmin, first column, rmax, cmin, cmax}, {peak, its row and column}
+    localparam NAS    = 5;
     // event FIFO between the extraction (E, X1..X5) and the labelling (L1, L2)
     localparam FP_W   = 5;                           // FIFO pointer width
     localparam FD     = 1 << FP_W;                   // entries (>= events of a row + 6)
@@ -792,7 +796,6 @@ module fmt_blob #(
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
     reg                 x4_mrg_q;             // x4_op_q == OP_MERGE (a step was a merge)
-    reg [LBL_W-1:0]     x4_a_q, x4_b_q;
     reg [NL:1]          x4_lp_q, x4_lc_q;     // P's and C's labels after the step
     wire [NL:1]         x4_k = x4_last_q ? (x4_lp_q | x4_lc_q) : (x4_lp_q & ~x4_lc_q);
     reg [ROW_IDX_W-1:0] x4_row_q;
@@ -800,7 +803,6 @@ module fmt_blob #(
     reg [E_W-1:0]       run_e;
     // the second operand of an update: the run (ADD) or label B's entry (MERGE); one
     // combine() serves both
-    wire [E_W-1:0]      acc_y;
     always @(*) begin
         run_e = {E_W{1'b0}};
         run_e[O_AREA +: AREA_W]    = l2_e_q[F_CNT +: AREA_W];
@@ -819,22 +821,15 @@ module fmt_blob #(
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
     // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
-    // or else the close engine's label (a closed label waits while a MERGE is applied)
-    reg [E_W-1:0] acc_q [0:NL];             // (0: never written, keeps the reads in range)
-    wire            b_merge = x4_mrg_q;      // (x4_op_q == OP_MERGE)
-    wire [LBL_W-1:0] acc_b_lbl;
-    wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
-    assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
-    // W: the update is applied one cycle after its reads (both read ports registered);
-    // an operand written by the update of the cycle before is taken from w_res_q
+    // or else the close engine's label (a closed label waits while a MERGE is applied).
+    // K reads both (registered), W combines and writes one cycle later; an operand that
+    // the update of the cycle before wrote is taken from that update's register.  The
+    // memory is split into NAS field slices (a field's update needs its own slice only),
+    // each with its own copies of the read and write addresses and of the controls,
+    // registered from their next values (the address nets stay inside a slice).
+    wire             b_merge = x4_mrg_q;     // (x4_op_q == OP_MERGE)
     reg  [1:0]       w_op_q;
-    reg  [LBL_W-1:0] w_a_q;
-    reg  [E_W-1:0]   w_ra_q, w_y_q, w_res_q;
-    reg              w_fa_q, w_fb_q;          // operand A / Y is the update of the cycle before
     wire             w_wr  = (w_op_q != OP_NONE);
-    wire [E_W-1:0]   w_x   = w_fa_q ? w_res_q : w_ra_q;
-    wire [E_W-1:0]   w_yy  = w_fb_q ? w_res_q : w_y_q;
-    wire [E_W-1:0]   w_res = (w_op_q == OP_NEW) ? w_yy : combine(w_x, w_yy);
     // the close engine's next label (lowest pending), picked one cycle ahead
     reg  [LBL_W-1:0] pk_q;
     reg              pk_v_q;
@@ -854,9 +849,55 @@ module fmt_blob #(
         for (i = 1; i <= NL; i = i + 1)
             cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
     end
-    assign acc_b_lbl = b_merge ? x4_b_q : pk_q;
+    // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
+    // MERGE, else the close engine's label)
+    wire [LBL_W-1:0] pk_nx  = (pk_fill && !rst) ? p_enc : pk_q;
+    wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
+    wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
+    wire [LBL_W-1:0] rb_nx  = do_merge ? l2_y_q : pk_nx;
+    wire             wr_nx  = !rst && (x4_op_q != OP_NONE);  // w_op_q's next: W writes
+    wire             nw_nx  = (x4_op_q == OP_NEW);
+    // the slices' registers, assembled
+    wire [E_W-1:0]   w_x, w_yy, cl_e_q;
+    wire [E_W-1:0]   w_res = combine(w_x, w_yy);     // (a NEW writes w_yy: per slice)
+    genvar ga;
+    generate
+        for (ga = 0; ga < NAS; ga = ga + 1) begin : g_acc
+            localparam LO = (ga == 0) ? O_AREA : (ga == 1) ? O_SX : (ga == 2) ? O_SY
+                          : (ga == 3) ? O_RMIN : O_PEAK;
+            localparam HI = (ga == 0) ? O_SX : (ga == 1) ? O_SY : (ga == 2) ? O_RMIN
+                          : (ga == 3) ? O_PEAK : E_W;
+            localparam SW = HI - LO;
+            reg  [SW-1:0]    acc_q [0:NL];    // (0: never written, keeps the reads in range)
+            reg  [LBL_W-1:0] ra_q, rb_q, wa_q;
+            reg              we_q, nw_q, mrg_q, pkv_q, fa_q, fb_q;
+            reg  [SW-1:0]    ra_d_q, y_q, wr_q, cl_q;   // read A, operand Y, the update
+            // copies (keep: one flip-flop each, not merged by synthesis)
+            (* keep *) always @(posedge clk) begin
+                ra_q  <= ra_nx;
+                rb_q  <= rb_nx;
+                mrg_q <= do_merge;
+                pkv_q <= pkv_nx;
+                we_q  <= wr_nx;
+                nw_q  <= nw_nx;
+                wa_q  <= ra_q;
+            end
+            wire [SW-1:0] rd_b = acc_q[rb_q];
+            always @(posedge clk) begin
+                ra_d_q <= acc_q[ra_q];
+                y_q    <= mrg_q ? rd_b : x4_e_q[LO +: SW];
+                fa_q   <= we_q && (ra_q == wa_q);
+                fb_q   <= we_q && mrg_q && (rb_q == wa_q);
+                wr_q   <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
+                if (we_q) acc_q[wa_q] <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
+                if (pkv_q && !mrg_q) cl_q <= rd_b;          // cl_go
+            end
+            assign w_x[LO +: SW]     = fa_q ? wr_q : ra_d_q;
+            assign w_yy[LO +: SW]    = fb_q ? wr_q : y_q;
+            assign cl_e_q[LO +: SW]  = cl_q;
+        end
+    endgenerate
     reg           cl_v_q;
-    reg [E_W-1:0] cl_e_q;
     reg [ROW_IDX_W-1:0] crow_q [0:NL];        // row at whose end the label was closed (0: unused)
     reg [ROW_IDX_W-1:0] cl_row_q;
     reg [LBL_W-1:0]     cl_lbl_q;
@@ -1136,8 +1177,6 @@ module fmt_blob #(
         if (do_run) x_q <= lrun;
         x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
         x4_mrg_q <= do_merge;
-        x4_a_q   <= do_merge ? x_q : lrun;
-        x4_b_q   <= l2_y_q;
         x4_e_q   <= run_e;
         x4_row_q <= l2_row;
         x4_end_q <= row_done;
@@ -1146,15 +1185,8 @@ module fmt_blob #(
         x4_lc_q  <= livec_nx;
         // accumulators: K reads (label A, and label B of a MERGE), W combines and writes
         w_op_q  <= x4_op_q;                   // (OP_NONE when no step)
-        w_a_q   <= x4_a_q;
-        w_ra_q  <= acc_q[x4_a_q];
-        w_y_q   <= acc_y;
-        w_fa_q  <= w_wr && (x4_a_q == w_a_q);
-        w_fb_q  <= w_wr && x4_mrg_q && (x4_b_q == w_a_q);
-        w_res_q <= w_res;
-        if (w_wr) acc_q[w_a_q] <= w_res;
+        pk_q    <= pk_nx;
         if (cl_go) begin
-            cl_e_q   <= acc_b;
             cl_row_q <= crow_q[pk_q];
             cl_lbl_q <= pk_q;
         end
@@ -1307,10 +1339,7 @@ module fmt_blob #(
             x4_v_q <= do_merge || do_run || row_done;
             pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
                     | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
-            if (pk_fill) begin
-                pk_q   <= p_enc;
-                pk_v_q <= |pend_q;
-            end
+            if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
             idle_q <= !pipe_busy && !fetch;
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
                      && !fetch && fr_in && !arr_p[fr_row] && !releasing;
