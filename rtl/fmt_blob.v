@@ -658,7 +658,17 @@ module fmt_blob #(
     wire             step     = l2_v_q && !l2_stall;
     wire             do_run   = step && l2_isrun;
     wire             do_new   = do_run && !l2_hy;
-    wire             do_merge = step && !l2_isrun && l2_hy && (l2_y_q != x_q);
+    // a merge (its event has a label y != x): decided when L2 loads (dm_q; a merge never
+    // waits in L2), with copies of dm_q, x_q and l2_y_q for the wide renames (keep)
+    reg              dm_q;
+    wire             do_merge = dm_q;
+    localparam NAG = 4;                       // alias groups (of ALG labels) with own copies
+    localparam ALG = (NL + NAG - 1) / NAG;
+    localparam NYC = NG + NAG + 1;            // copies: per GS columns of P and C, per alias
+                                              // group, one for the label masks (VC)
+    localparam VC  = NG + NAG;
+    reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
+    reg  [NYC-1:0]       dmc_q;               // copies of dm_q
     wire             row_done = step && l2_last;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
     assign           new_wait = l2_stall;
@@ -666,7 +676,7 @@ module fmt_blob #(
     always @(*) begin : c_bits
         integer i;
         for (i = 1; i <= NL; i = i + 1) begin
-            vbit[i] = (l2_y_q == i[LBL_W-1:0]);
+            vbit[i] = (yc_q[VC*LBL_W +: LBL_W] == i[LBL_W-1:0]);
             rbit[i] = (lrun == i[LBL_W-1:0]);
         end
     end
@@ -691,8 +701,8 @@ module fmt_blob #(
             raw_c[b] = |t_c;
         end
         for (i = 0; i < COLS; i = i + 1) begin
-            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
-            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
+            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
+            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
             l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
                    && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
@@ -716,6 +726,29 @@ module fmt_blob #(
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
+    // (l1_hit: x becomes lrun) or x_q (a merge now: x stays), or else ya
+    wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
+    wire             ne_nx = !l1_hit && !(do_merge && eqa)
+                          && (sa_run ? (s_lrun_q != x_nx) : (sa_mrg ? (s_x_q != x_nx) : (l1_y_q != x_nx)));
+    wire             dm_nx = !rst && l2_ld && !l1_f[0] && l1_f[1] && ne_nx;
+    always @(posedge clk) dm_q <= dm_nx;
+    genvar gy;
+    generate
+        for (gy = 0; gy < NYC; gy = gy + 1) begin : g_yc
+            (* keep *) always @(posedge clk) dmc_q[gy] <= dm_nx;
+            (* keep *) always @(posedge clk) if (l2_ld) yc_q[gy*LBL_W +: LBL_W] <= y1;
+            (* keep *) always @(posedge clk) if (do_run) xc_q[gy*LBL_W +: LBL_W] <= lrun;
+        end
+    endgenerate
+    // synthesis translate_off
+    always @(posedge clk) begin
+        if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
+            $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
+            $finish;
+        end
+    end
+    // synthesis translate_on
     assign           l0_free = !l0_v_q || l1_ld;
 
     // next label vectors and live masks of this cycle's step
@@ -726,12 +759,12 @@ module fmt_blob #(
         p_nx = p_q;
         c_nx = c_q;
         for (i = 0; i < COLS; i = i + 1) begin
-            if (do_merge && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = x_q;
-            if (do_merge && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = x_q;
+            if (dmc_q[i/GS] && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
+            if (dmc_q[i/GS] && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
             if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
         end
-        livep_nx = livep_q & ~(do_merge ? vbit : {NL{1'b0}});
-        livec_nx = (livec_q & ~(do_merge ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
+        livep_nx = livep_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}});
+        livec_nx = (livec_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
     end
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
@@ -757,7 +790,9 @@ module fmt_blob #(
         for (i = 1; i <= NL; i = i + 1) begin
             alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
             alias_nx[(i-1)*LBL_W +: LBL_W] =
-                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == l2_y_q) ? x_q : alias_q[(i-1)*LBL_W +: LBL_W];
+                (dmc_q[NG + (i-1)/ALG]
+                 && alias_q[(i-1)*LBL_W +: LBL_W] == yc_q[(NG + (i-1)/ALG)*LBL_W +: LBL_W])
+                ? xc_q[(NG + (i-1)/ALG)*LBL_W +: LBL_W] : alias_q[(i-1)*LBL_W +: LBL_W];
         end
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
@@ -1334,7 +1369,7 @@ module fmt_blob #(
                 n0v_q <= |free_q;
             end
             free_q <= (free_q & ~(n0_fill ? f_low : {NL{1'b0}}))
-                    | (do_merge ? vbit : {NL{1'b0}})
+                    | (dmc_q[VC] ? vbit : {NL{1'b0}})
                     | cpick_bit;
             x4_v_q <= do_merge || do_run || row_done;
             pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
