@@ -999,8 +999,15 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    // the sums of list entry em_i_q (an index >= MB reads entry 0)
-    wire [SL_W-1:0]  em_slot = (em_i_q < MB_C) ? l_slot_q[em_i_q[MBI_W-1:0]] : l_slot_q[0];
+    // next index and phase (the list and the sums are stable from the frame's finish on)
+    wire              fin_go;                 // fin_ok || fin_abort
+    wire              em_wrap  = !em_ph_q && (em_i_q + 1'b1 == em_n_q);
+    wire [CNT_W-1:0]  em_i_nx  = (rst || fin_go) ? {CNT_W{1'b0}}
+                               : (em_issue ? (em_wrap ? {CNT_W{1'b0}} : em_i_q + 1'b1) : em_i_q);
+    wire              em_ph_nx = (rst || fin_go) ? 1'b0 : ((em_issue && em_wrap) ? 1'b1 : em_ph_q);
+    // the divider's operands for entry em_i_q, read and summed a cycle ahead (from the
+    // next index; an index >= MB reads entry 0)
+    wire [SL_W-1:0]  em_slot = (em_i_nx < MB_C) ? l_slot_q[em_i_nx[MBI_W-1:0]] : l_slot_q[0];
     wire [PE_W-1:0]  em_p    = pe_mem[em_slot];
     wire [SZ_W-1:0]  em_sz   = em_p[0 +: SZ_W];
     wire [SX_W-1:0]  em_sx   = em_p[SZ_W +: SX_W];
@@ -1009,6 +1016,12 @@ module fmt_blob #(
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
     wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_sy, 8'd0}
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
+    reg  [NUM_W-1:0] em_num_q;
+    reg  [SZ_W-1:0]  em_den_q;
+    always @(posedge clk) begin
+        em_num_q <= em_ph_nx ? num_y : num_x;
+        em_den_q <= em_sz;
+    end
     // One divider for both coordinates: the x quotients of the n list entries are
     // issued first, then the y quotients; an x result waits in qx_q (indexed by the
     // entry) for its y result, which comes n cycles later, so the blobs still leave on
@@ -1019,8 +1032,8 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [QW-1:0] dq;
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_ph_q ? num_y : num_x),
-        .den_i(em_sz), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_num_q),
+        .den_i(em_den_q), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
     // index, phase and end token travel beside the divider
     reg [DL-1:0]       dl_v_q, dl_x_q, dl_t_q;
     reg [CNT_W-1:0]    dl_i_q [0:DL-1];
@@ -1147,6 +1160,7 @@ module fmt_blob #(
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
     reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
     wire fin_abort = (state_q == S_RUN) && abort_q;
+    assign fin_go  = fin_ok || fin_abort;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
@@ -1231,6 +1245,8 @@ module fmt_blob #(
         end
         // emission side registers
         dl_i_q[0] <= em_i_q;
+        em_i_q    <= em_i_nx;                 // (after the x quotients: the y ones)
+        em_ph_q   <= em_ph_nx;
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
         blob_area_o     <= out_p[0 +: AREA_W];
         if (out_x) qx_q[out_i[MBI_W-1:0]] <= dq;
@@ -1287,8 +1303,6 @@ module fmt_blob #(
             cl_v_q   <= 1'b0;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
-            em_i_q   <= {CNT_W{1'b0}};
-            em_ph_q  <= 1'b0;
             em_n_q   <= {CNT_W{1'b0}};
             em_frame_q <= {FRAME_W{1'b0}};
             em_incomplete_q <= 1'b0;
@@ -1387,8 +1401,6 @@ module fmt_blob #(
             // ---- finish, emit, release ----
             if (fin_ok || fin_abort) begin
                 state_q         <= S_EMIT;
-                em_i_q          <= {CNT_W{1'b0}};
-                em_ph_q         <= 1'b0;
                 em_n_q          <= (fin_ok && complete) ? (over ? MB_A[CNT_W-1:0] : found_q[CNT_W-1:0])
                                                         : {CNT_W{1'b0}};
                 em_frame_q      <= frm_q[pb_q];
@@ -1430,14 +1442,6 @@ module fmt_blob #(
             end
             if (out_tok) tok_q <= 1'b1;
 
-            if (em_issue) begin
-                if (!em_ph_q && em_i_q + 1'b1 == em_n_q) begin
-                    em_i_q  <= {CNT_W{1'b0}};     // x quotients issued: now the y ones
-                    em_ph_q <= 1'b1;
-                end else begin
-                    em_i_q  <= em_i_q + 1'b1;
-                end
-            end
             if (em_tok) state_q <= S_WAIT;
             dl_v_q <= {dl_v_q[DL-2:0], em_issue && em_ph_q};
             dl_x_q <= {dl_x_q[DL-2:0], em_issue && !em_ph_q};
