@@ -655,8 +655,12 @@ module fmt_blob #(
     wire [COL_IDX_W-1:0] l2_cmin = l2_e_q[F_CMN +: COL_IDX_W];
     // L2 step
     wire             l2_stall = l2_v_q && l2_isrun && !l2_hy && !n0v_q;   // NEW waits
-    wire             step     = l2_v_q && !l2_stall;
-    wire             do_run   = step && l2_isrun;
+    // step, run and row end registered from their next values (st_q, run_q, rd_q, below),
+    // with copies like those of the merge
+    reg              st_q, run_q, rd_q;
+    reg  [NG+NAG:0]  runc_q, rdc_q;           // copies (indices as yc_q's)
+    wire             step     = st_q;
+    wire             do_run   = run_q;
     wire             do_new   = do_run && !l2_hy;
     // a merge (its event has a label y != x): decided when L2 loads (dm_q; a merge never
     // waits in L2), with copies of dm_q, x_q and l2_y_q for the wide renames (keep)
@@ -669,7 +673,7 @@ module fmt_blob #(
     localparam VC  = NG + NAG;
     reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
     reg  [NYC-1:0]       dmc_q;               // copies of dm_q
-    wire             row_done = step && l2_last;
+    wire             row_done = rd_q;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
     assign           new_wait = l2_stall;
     reg  [NL:1]      vbit, rbit;              // one-hot of the merge victim, the run label
@@ -733,10 +737,24 @@ module fmt_blob #(
                           && (sa_run ? (s_lrun_q != x_nx) : (sa_mrg ? (s_x_q != x_nx) : (l1_y_q != x_nx)));
     wire             dm_nx = !rst && l2_ld && !l1_f[0] && l1_f[1] && ne_nx;
     always @(posedge clk) dm_q <= dm_nx;
+    // next L2 state: valid, flags, and whether a NEW label is ready (n0v_q's next)
+    wire             l2v_nx  = !rst && (l2_ld || (l2_v_q && !step));
+    wire [2:0]       l2f_nx  = l2_ld ? l1_f[2:0] : l2_f[2:0];
+    wire             n0v_nx  = !rst && !releasing && (n0_fill ? |free_q : n0v_q);
+    wire             st_nx   = l2v_nx && !(l2f_nx[0] && !l2f_nx[1] && !n0v_nx);
+    wire             run_nx  = st_nx && l2f_nx[0];
+    wire             rd_nx   = st_nx && l2f_nx[2];
+    always @(posedge clk) begin
+        st_q  <= st_nx;
+        run_q <= run_nx;
+        rd_q  <= rd_nx;
+    end
     genvar gy;
     generate
         for (gy = 0; gy < NYC; gy = gy + 1) begin : g_yc
             (* keep *) always @(posedge clk) dmc_q[gy] <= dm_nx;
+            (* keep *) always @(posedge clk) runc_q[gy] <= run_nx;
+            (* keep *) always @(posedge clk) rdc_q[gy] <= rd_nx;
             (* keep *) always @(posedge clk) if (l2_ld) yc_q[gy*LBL_W +: LBL_W] <= y1;
             (* keep *) always @(posedge clk) if (do_run) xc_q[gy*LBL_W +: LBL_W] <= lrun;
         end
@@ -745,6 +763,11 @@ module fmt_blob #(
     always @(posedge clk) begin
         if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
             $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
+            $finish;
+        end
+        if (!rst && (st_q !== (l2_v_q && !l2_stall) || run_q !== (l2_v_q && !l2_stall && l2_isrun)
+                     || rd_q !== (l2_v_q && !l2_stall && l2_last))) begin
+            $display("fmt_blob: st_q %b run_q %b rd_q %b differ from the step", st_q, run_q, rd_q);
             $finish;
         end
     end
@@ -761,13 +784,14 @@ module fmt_blob #(
         for (i = 0; i < COLS; i = i + 1) begin
             if (dmc_q[i/GS] && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
             if (dmc_q[i/GS] && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
-            if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
+            if (runc_q[i/GS] && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
         end
         livep_nx = livep_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}});
-        livec_nx = (livec_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
+        livec_nx = (livec_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}})) | (runc_q[VC] ? rbit : {NL{1'b0}});
     end
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
+    wire        releasing;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
     reg  [LBL_W-1:0] f_enc;
     reg  [NL:1]      f_t;
@@ -951,7 +975,6 @@ module fmt_blob #(
     localparam SL_W = $clog2(MB + 1);
     localparam PE_W = SZ_W + SX_W + SY_W;
     localparam PO_W = AREA_W + 2 * ROW_IDX_W + 2 * COL_IDX_W + HM_W + IDX_W;
-    wire               releasing;
     /* verilator lint_off UNUSEDSIGNAL */     // the emission reads the slots only
     wire [MB-1:0]        l_v;
     wire [MB*AREA_W-1:0] l_area;
@@ -1070,7 +1093,18 @@ module fmt_blob #(
         lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
-    wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
+    // the row whose close records are read (bw_first ? LAST_ROW : bw_row_q + 1),
+    // registered from bw_row1_q, in copies per NCF labels (keep: the read-address fan-out)
+    localparam NCF = 13;
+    reg  [((NL + NCF - 1) / NCF)*ROW_IDX_W-1:0] cf_row_q;
+    genvar gc;
+    generate
+        for (gc = 0; gc < (NL + NCF - 1) / NCF; gc = gc + 1) begin : g_cfr
+            (* keep *) always @(posedge clk)
+                if (!rst) cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W]
+                              <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
+        end
+    endgenerate
     // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
     // was a blob (written by the close engine, read for row cf_row)
     wire [NL:1]          cfr;
@@ -1082,7 +1116,7 @@ module fmt_blob #(
             always @(posedge clk) begin
                 if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= cl_isblob;
             end
-            assign cfr[gl] = cf_mem[cf_row];
+            assign cfr[gl] = cf_mem[cf_row_q[((gl - 1) / NCF)*ROW_IDX_W +: ROW_IDX_W]];
         end
     endgenerate
     // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
@@ -1366,15 +1400,19 @@ module fmt_blob #(
             else if (step) l2_v_q <= 1'b0;
 
             // ---- labelling state ----
-            alias_q <= row_done ? alias_id : alias_nx;
-            if (row_done) begin
-                p_q     <= l2_lastrow ? {(COLS*LBL_W){1'b0}} : c_nx;
-                c_q     <= c_nx;              // kept: the next row's first event reads it
+            // at a row end P = C (0 after the last row; C kept: the next row's first
+            // event reads it), the live masks move; the row-end copies per group
+            for (i = 1; i <= NL; i = i + 1)
+                alias_q[(i-1)*LBL_W +: LBL_W] <= rdc_q[NG + (i-1)/ALG] ? alias_id[(i-1)*LBL_W +: LBL_W]
+                                                                     : alias_nx[(i-1)*LBL_W +: LBL_W];
+            for (i = 0; i < COLS; i = i + 1)
+                p_q[i*LBL_W +: LBL_W] <= !rdc_q[i/GS] ? p_nx[i*LBL_W +: LBL_W]
+                                       : (l2_lastrow ? {LBL_W{1'b0}} : c_nx[i*LBL_W +: LBL_W]);
+            c_q <= c_nx;
+            if (rdc_q[VC]) begin
                 livep_q <= l2_lastrow ? {NL{1'b0}} : livec_nx;
                 livec_q <= {NL{1'b0}};
             end else begin
-                p_q     <= p_nx;
-                c_q     <= c_nx;
                 livep_q <= livep_nx;
                 livec_q <= livec_nx;
             end
@@ -1389,9 +1427,11 @@ module fmt_blob #(
             pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
                     | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
             if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
-            idle_q <= !pipe_busy && !fetch;
+            // (with the pipeline idle F1 is empty: a fetch is state RUN and the next row
+            // present; abort_q's row is absent, so no fetch)
+            idle_q <= !pipe_busy && !((state_q == S_RUN) && fr_in && arr_p[fr_row]);
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
-                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
+                     && fr_in && !arr_p[fr_row] && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
