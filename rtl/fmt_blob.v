@@ -755,14 +755,20 @@ module fmt_blob #(
             (* keep *) always @(posedge clk) dmc_q[gy] <= dm_nx;
             (* keep *) always @(posedge clk) runc_q[gy] <= run_nx;
             (* keep *) always @(posedge clk) rdc_q[gy] <= rd_nx;
-            (* keep *) always @(posedge clk) if (l2_ld) yc_q[gy*LBL_W +: LBL_W] <= y1;
-            (* keep *) always @(posedge clk) if (do_run) xc_q[gy*LBL_W +: LBL_W] <= lrun;
+            // (no clock enables: synthesis keeps a kept flip-flop's feedback multiplexer;
+            // the copies of l2_y_q are read only for a merge, which L2 loaded the cycle before)
+            (* keep *) always @(posedge clk) yc_q[gy*LBL_W +: LBL_W] <= y1;
+            (* keep *) always @(posedge clk) xc_q[gy*LBL_W +: LBL_W] <= x_nx;
         end
     endgenerate
     // synthesis translate_off
     always @(posedge clk) begin
         if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
             $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
+            $finish;
+        end
+        if (!rst && dm_q && (yc_q !== {NYC{l2_y_q}} || xc_q !== {NYC{x_q}})) begin
+            $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
             $finish;
         end
         if (!rst && (st_q !== (l2_v_q && !l2_stall) || run_q !== (l2_v_q && !l2_stall && l2_isrun)
@@ -1100,9 +1106,8 @@ module fmt_blob #(
     genvar gc;
     generate
         for (gc = 0; gc < (NL + NCF - 1) / NCF; gc = gc + 1) begin : g_cfr
-            (* keep *) always @(posedge clk)
-                if (!rst) cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W]
-                              <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
+            (* keep *) always @(posedge clk)   // (read while the pass runs only)
+                cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W] <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
         end
     endgenerate
     // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
