@@ -1028,12 +1028,12 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    // next index and phase (the list and the sums are stable from the frame's finish on)
-    wire              fin_go;                 // fin_ok || fin_abort
+    // next index and phase in S_EMIT (the emission starts at 0, x; the list and the sums
+    // are stable from the frame's finish on)
     wire              em_wrap  = !em_ph_q && (em_i_q + 1'b1 == em_n_q);
-    wire [CNT_W-1:0]  em_i_nx  = (rst || fin_go) ? {CNT_W{1'b0}}
+    wire [CNT_W-1:0]  em_i_nx  = (state_q != S_EMIT) ? {CNT_W{1'b0}}
                                : (em_issue ? (em_wrap ? {CNT_W{1'b0}} : em_i_q + 1'b1) : em_i_q);
-    wire              em_ph_nx = (rst || fin_go) ? 1'b0 : ((em_issue && em_wrap) ? 1'b1 : em_ph_q);
+    wire              em_ph_nx = (state_q != S_EMIT) ? 1'b0 : ((em_issue && em_wrap) ? 1'b1 : em_ph_q);
     // the divider's operands for entry em_i_q, read and summed a cycle ahead (from the
     // next index; an index >= MB reads entry 0)
     wire [SL_W-1:0]  em_slot = (em_i_nx < MB_C) ? l_slot_q[em_i_nx[MBI_W-1:0]] : l_slot_q[0];
@@ -1199,7 +1199,6 @@ module fmt_blob #(
     wire fin_ok    = (state_q == S_RUN) && eofs_q[pb_q] && lab_done_q && idle_q;
     reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
     wire fin_abort = (state_q == S_RUN) && abort_q;
-    assign fin_go  = fin_ok || fin_abort;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
     wire over      = (found_q > MB_A);
 
@@ -1284,8 +1283,7 @@ module fmt_blob #(
         end
         // emission side registers
         dl_i_q[0] <= em_i_q;
-        em_i_q    <= em_i_nx;                 // (after the x quotients: the y ones)
-        em_ph_q   <= em_ph_nx;
+
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
         blob_area_o     <= out_p[0 +: AREA_W];
         if (out_x) qx_q[out_i[MBI_W-1:0]] <= dq;
@@ -1342,6 +1340,8 @@ module fmt_blob #(
             cl_v_q   <= 1'b0;
             found_q  <= {AREA_W{1'b0}};
             lab_done_q <= 1'b0;
+            em_i_q   <= {CNT_W{1'b0}};
+            em_ph_q  <= 1'b0;
             em_n_q   <= {CNT_W{1'b0}};
             em_frame_q <= {FRAME_W{1'b0}};
             em_incomplete_q <= 1'b0;
@@ -1446,6 +1446,8 @@ module fmt_blob #(
             // ---- finish, emit, release ----
             if (fin_ok || fin_abort) begin
                 state_q         <= S_EMIT;
+                em_i_q          <= {CNT_W{1'b0}};
+                em_ph_q         <= 1'b0;
                 em_n_q          <= (fin_ok && complete) ? (over ? MB_A[CNT_W-1:0] : found_q[CNT_W-1:0])
                                                         : {CNT_W{1'b0}};
                 em_frame_q      <= frm_q[pb_q];
@@ -1488,6 +1490,14 @@ module fmt_blob #(
             if (out_tok) tok_q <= 1'b1;
 
             if (em_tok) state_q <= S_WAIT;
+            if (em_issue) begin
+                if (em_wrap) begin
+                    em_i_q  <= {CNT_W{1'b0}};     // x quotients issued: now the y ones
+                    em_ph_q <= 1'b1;
+                end else begin
+                    em_i_q  <= em_i_q + 1'b1;
+                end
+            end
             dl_v_q <= {dl_v_q[DL-2:0], em_issue && em_ph_q};
             dl_x_q <= {dl_x_q[DL-2:0], em_issue && !em_ph_q};
             dl_t_q <= {dl_t_q[DL-2:0], em_tok};
