@@ -32,6 +32,10 @@
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
 //         MERGE, y != x         -> MERGE(x <- y): y is renamed x in P, C and alias; y is
 //                                  free again
+//       The step's controls are registers: a merge is decided when L2 loads its event
+//       (a merge never waits in L2), the step, its run and the row end from their next
+//       values; they, x and y have copies per 8 columns of P and C, per alias group and
+//       for the label masks (the wide renames take no high-fanout net).
 //       The row's last event ends it: the labels of P no longer in C are closed (their
 //       region is complete), P = C; after the last row every live label is closed.
 //       Labels are slots 1..NL, NL = 2*ceil(COLS/2) + 12: P and C hold at most
@@ -46,6 +50,9 @@
 //       written one cycle later (W); an operand that the update of the cycle before
 //       wrote is taken from that update's register.  (A closed label is read two
 //       cycles after its last update at the earliest: the close timing is unchanged.)
+//       The memory is split into five field slices (a field's update reads its own
+//       slice only), each with its own read and write address registers, computed from
+//       their next values, and its own copies of the controls.
 //   C : the close engine takes one closed label per cycle (picked one cycle ahead):
 //       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
 //       (fmt_sorted_list: area descending, ties by the raster index of the region's
