@@ -1035,15 +1035,8 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    // next index and phase in S_EMIT (the emission starts at 0, x; the list and the sums
-    // are stable from the frame's finish on)
-    wire              em_wrap  = !em_ph_q && (em_i_q + 1'b1 == em_n_q);
-    wire [CNT_W-1:0]  em_i_nx  = (state_q != S_EMIT) ? {CNT_W{1'b0}}
-                               : (em_issue ? (em_wrap ? {CNT_W{1'b0}} : em_i_q + 1'b1) : em_i_q);
-    wire              em_ph_nx = (state_q != S_EMIT) ? 1'b0 : ((em_issue && em_wrap) ? 1'b1 : em_ph_q);
-    // the divider's operands for entry em_i_q, read and summed a cycle ahead (from the
-    // next index; an index >= MB reads entry 0)
-    wire [SL_W-1:0]  em_slot = (em_i_nx < MB_C) ? l_slot_q[em_i_nx[MBI_W-1:0]] : l_slot_q[0];
+    // the sums of list entry em_i_q (an index >= MB reads entry 0)
+    wire [SL_W-1:0]  em_slot = (em_i_q < MB_C) ? l_slot_q[em_i_q[MBI_W-1:0]] : l_slot_q[0];
     wire [PE_W-1:0]  em_p    = pe_mem[em_slot];
     wire [SZ_W-1:0]  em_sz   = em_p[0 +: SZ_W];
     wire [SX_W-1:0]  em_sx   = em_p[SZ_W +: SX_W];
@@ -1052,12 +1045,6 @@ module fmt_blob #(
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
     wire [NUM_W-1:0] num_y = {{(NUM_W-SY_W-8){1'b0}}, em_sy, 8'd0}
                            + {{(NUM_W-SZ_W+1){1'b0}}, em_sz[SZ_W-1:1]};
-    reg  [NUM_W-1:0] em_num_q;
-    reg  [SZ_W-1:0]  em_den_q;
-    always @(posedge clk) begin
-        em_num_q <= em_ph_nx ? num_y : num_x;
-        em_den_q <= em_sz;
-    end
     // One divider for both coordinates: the x quotients of the n list entries are
     // issued first, then the y quotients; an x result waits in qx_q (indexed by the
     // entry) for its y result, which comes n cycles later, so the blobs still leave on
@@ -1068,8 +1055,8 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [QW-1:0] dq;
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_num_q),
-        .den_i(em_den_q), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_ph_q ? num_y : num_x),
+        .den_i(em_sz), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
     // index, phase and end token travel beside the divider
     reg [DL-1:0]       dl_v_q, dl_x_q, dl_t_q;
     reg [CNT_W-1:0]    dl_i_q [0:DL-1];
@@ -1439,11 +1426,9 @@ module fmt_blob #(
             pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
                     | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
             if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
-            // (with the pipeline idle F1 is empty: a fetch is state RUN and the next row
-            // present; abort_q's row is absent, so no fetch)
-            idle_q <= !pipe_busy && !((state_q == S_RUN) && fr_in && arr_p[fr_row]);
+            idle_q <= !pipe_busy && !fetch;
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
-                     && fr_in && !arr_p[fr_row] && !releasing;
+                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
@@ -1498,7 +1483,7 @@ module fmt_blob #(
 
             if (em_tok) state_q <= S_WAIT;
             if (em_issue) begin
-                if (em_wrap) begin
+                if (!em_ph_q && em_i_q + 1'b1 == em_n_q) begin
                     em_i_q  <= {CNT_W{1'b0}};     // x quotients issued: now the y ones
                     em_ph_q <= 1'b1;
                 end else begin
