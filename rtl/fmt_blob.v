@@ -32,6 +32,10 @@
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
 //         MERGE, y != x         -> MERGE(x <- y): y is renamed x in P, C and alias; y is
 //                                  free again
+//       The step's controls are registers: a merge is decided when L2 loads its event
+//       (a merge never waits in L2), the step, its run and the row end from their next
+//       values; they, x and y have copies per 8 columns of P and C, per alias group and
+//       for the label masks (the wide renames take no high-fanout net).
 //       The row's last event ends it: the labels of P no longer in C are closed (their
 //       region is complete), P = C; after the last row every live label is closed.
 //       Labels are slots 1..NL, NL = 2*ceil(COLS/2) + 12: P and C hold at most
@@ -46,6 +50,9 @@
 //       written one cycle later (W); an operand that the update of the cycle before
 //       wrote is taken from that update's register.  (A closed label is read two
 //       cycles after its last update at the earliest: the close timing is unchanged.)
+//       The memory is split into five field slices (a field's update reads its own
+//       slice only), each with its own read and write address registers, computed from
+//       their next values, and its own copies of the controls.
 //   C : the close engine takes one closed label per cycle (picked one cycle ahead):
 //       if its area >= min_cells it is inserted into a sorted list of MAX_BLOBS entries
 //       (fmt_sorted_list: area descending, ties by the raster index of the region's
@@ -184,14 +191,18 @@ module fmt_blob #(
     localparam O_SX   = O_SZ + SZ_W;
     localparam O_SY   = O_SX + SX_W;
     localparam O_RMIN = O_SY + SY_W;
-    localparam O_RMAX = O_RMIN + ROW_IDX_W;
+    localparam O_FC   = O_RMIN + ROW_IDX_W;          // column of the first cell (row = rmin)
+    localparam O_RMAX = O_FC + COL_IDX_W;
     localparam O_CMIN = O_RMAX + ROW_IDX_W;
     localparam O_CMAX = O_CMIN + COL_IDX_W;
     localparam O_PEAK = O_CMAX + COL_IDX_W;
     localparam O_PR   = O_PEAK + HM_W;
     localparam O_PC   = O_PR + ROW_IDX_W;
-    localparam O_FC   = O_PC + COL_IDX_W;            // column of the first cell (row = rmin)
-    localparam E_W    = O_FC + COL_IDX_W;
+    localparam E_W    = O_PC + COL_IDX_W;
+    // the accumulator memory in field slices (each with its own address registers; a
+    // field's update uses its own slice only): {area, sum z}, sum z*c, sum z*r,
+    // {rmin, first column, rmax, cmin, cmax}, {peak, its row and column}
+    localparam NAS    = 5;
     // event FIFO between the extraction (E, X1..X5) and the labelling (L1, L2)
     localparam FP_W   = 5;                           // FIFO pointer width
     localparam FD     = 1 << FP_W;                   // entries (>= events of a row + 6)
@@ -651,18 +662,32 @@ module fmt_blob #(
     wire [COL_IDX_W-1:0] l2_cmin = l2_e_q[F_CMN +: COL_IDX_W];
     // L2 step
     wire             l2_stall = l2_v_q && l2_isrun && !l2_hy && !n0v_q;   // NEW waits
-    wire             step     = l2_v_q && !l2_stall;
-    wire             do_run   = step && l2_isrun;
+    // step, run and row end registered from their next values (st_q, run_q, rd_q, below),
+    // with copies like those of the merge
+    reg              st_q, run_q, rd_q;
+    reg  [NG+NAG:0]  runc_q, rdc_q;           // copies (indices as yc_q's)
+    wire             step     = st_q;
+    wire             do_run   = run_q;
     wire             do_new   = do_run && !l2_hy;
-    wire             do_merge = step && !l2_isrun && l2_hy && (l2_y_q != x_q);
-    wire             row_done = step && l2_last;
+    // a merge (its event has a label y != x): decided when L2 loads (dm_q; a merge never
+    // waits in L2), with copies of dm_q, x_q and l2_y_q for the wide renames (keep)
+    reg              dm_q;
+    wire             do_merge = dm_q;
+    localparam NAG = 4;                       // alias groups (of ALG labels) with own copies
+    localparam ALG = (NL + NAG - 1) / NAG;
+    localparam NYC = NG + NAG + 1;            // copies: per GS columns of P and C, per alias
+                                              // group, one for the label masks (VC)
+    localparam VC  = NG + NAG;
+    reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
+    reg  [NYC-1:0]       dmc_q;               // copies of dm_q
+    wire             row_done = rd_q;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
     assign           new_wait = l2_stall;
     reg  [NL:1]      vbit, rbit;              // one-hot of the merge victim, the run label
     always @(*) begin : c_bits
         integer i;
         for (i = 1; i <= NL; i = i + 1) begin
-            vbit[i] = (l2_y_q == i[LBL_W-1:0]);
+            vbit[i] = (yc_q[VC*LBL_W +: LBL_W] == i[LBL_W-1:0]);
             rbit[i] = (lrun == i[LBL_W-1:0]);
         end
     end
@@ -687,8 +712,8 @@ module fmt_blob #(
             raw_c[b] = |t_c;
         end
         for (i = 0; i < COLS; i = i + 1) begin
-            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == l2_y_q);
-            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == l2_y_q);
+            ren_p[i] = (p_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
+            ren_c[i] = (c_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
             l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
                    && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
         end
@@ -712,6 +737,54 @@ module fmt_blob #(
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
     wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
+    // (l1_hit: x becomes lrun) or x_q (a merge now: x stays), or else ya
+    wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
+    wire             ne_nx = !l1_hit && !(do_merge && eqa)
+                          && (sa_run ? (s_lrun_q != x_nx) : (sa_mrg ? (s_x_q != x_nx) : (l1_y_q != x_nx)));
+    wire             dm_nx = !rst && l2_ld && !l1_f[0] && l1_f[1] && ne_nx;
+    always @(posedge clk) dm_q <= dm_nx;
+    // next L2 state: valid, flags, and whether a NEW label is ready (n0v_q's next)
+    wire             l2v_nx  = !rst && (l2_ld || (l2_v_q && !step));
+    wire [2:0]       l2f_nx  = l2_ld ? l1_f[2:0] : l2_f[2:0];
+    wire             n0v_nx  = !rst && !releasing && (n0_fill ? |free_q : n0v_q);
+    wire             st_nx   = l2v_nx && !(l2f_nx[0] && !l2f_nx[1] && !n0v_nx);
+    wire             run_nx  = st_nx && l2f_nx[0];
+    wire             rd_nx   = st_nx && l2f_nx[2];
+    always @(posedge clk) begin
+        st_q  <= st_nx;
+        run_q <= run_nx;
+        rd_q  <= rd_nx;
+    end
+    genvar gy;
+    generate
+        for (gy = 0; gy < NYC; gy = gy + 1) begin : g_yc
+            (* keep *) always @(posedge clk) dmc_q[gy] <= dm_nx;
+            (* keep *) always @(posedge clk) runc_q[gy] <= run_nx;
+            (* keep *) always @(posedge clk) rdc_q[gy] <= rd_nx;
+            // (no clock enables: synthesis keeps a kept flip-flop's feedback multiplexer;
+            // the copies of l2_y_q are read only for a merge, which L2 loaded the cycle before)
+            (* keep *) always @(posedge clk) yc_q[gy*LBL_W +: LBL_W] <= y1;
+            (* keep *) always @(posedge clk) xc_q[gy*LBL_W +: LBL_W] <= x_nx;
+        end
+    endgenerate
+    // synthesis translate_off
+    always @(posedge clk) begin
+        if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
+            $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
+            $finish;
+        end
+        if (!rst && dm_q && (yc_q !== {NYC{l2_y_q}} || xc_q !== {NYC{x_q}})) begin
+            $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
+            $finish;
+        end
+        if (!rst && (st_q !== (l2_v_q && !l2_stall) || run_q !== (l2_v_q && !l2_stall && l2_isrun)
+                     || rd_q !== (l2_v_q && !l2_stall && l2_last))) begin
+            $display("fmt_blob: st_q %b run_q %b rd_q %b differ from the step", st_q, run_q, rd_q);
+            $finish;
+        end
+    end
+    // synthesis translate_on
     assign           l0_free = !l0_v_q || l1_ld;
 
     // next label vectors and live masks of this cycle's step
@@ -722,15 +795,16 @@ module fmt_blob #(
         p_nx = p_q;
         c_nx = c_q;
         for (i = 0; i < COLS; i = i + 1) begin
-            if (do_merge && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = x_q;
-            if (do_merge && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = x_q;
-            if (do_run && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
+            if (dmc_q[i/GS] && ren_p[i]) p_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
+            if (dmc_q[i/GS] && ren_c[i]) c_nx[i*LBL_W +: LBL_W] = xc_q[(i/GS)*LBL_W +: LBL_W];
+            if (runc_q[i/GS] && l2_m_q[i]) c_nx[i*LBL_W +: LBL_W] = lrun;
         end
-        livep_nx = livep_q & ~(do_merge ? vbit : {NL{1'b0}});
-        livec_nx = (livec_q & ~(do_merge ? vbit : {NL{1'b0}})) | (do_run ? rbit : {NL{1'b0}});
+        livep_nx = livep_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}});
+        livec_nx = (livec_q & ~(dmc_q[VC] ? vbit : {NL{1'b0}})) | (runc_q[VC] ? rbit : {NL{1'b0}});
     end
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
+    wire        releasing;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
     reg  [LBL_W-1:0] f_enc;
     reg  [NL:1]      f_t;
@@ -753,7 +827,9 @@ module fmt_blob #(
         for (i = 1; i <= NL; i = i + 1) begin
             alias_id[(i-1)*LBL_W +: LBL_W] = i[LBL_W-1:0];
             alias_nx[(i-1)*LBL_W +: LBL_W] =
-                (do_merge && alias_q[(i-1)*LBL_W +: LBL_W] == l2_y_q) ? x_q : alias_q[(i-1)*LBL_W +: LBL_W];
+                (dmc_q[NG + (i-1)/ALG]
+                 && alias_q[(i-1)*LBL_W +: LBL_W] == yc_q[(NG + (i-1)/ALG)*LBL_W +: LBL_W])
+                ? xc_q[(NG + (i-1)/ALG)*LBL_W +: LBL_W] : alias_q[(i-1)*LBL_W +: LBL_W];
         end
     end
     wire [NL:1] cont_rec = ~(livep_nx & ~livec_nx);
@@ -792,7 +868,6 @@ module fmt_blob #(
     reg                 x4_v_q, x4_end_q, x4_last_q;
     reg [1:0]           x4_op_q;
     reg                 x4_mrg_q;             // x4_op_q == OP_MERGE (a step was a merge)
-    reg [LBL_W-1:0]     x4_a_q, x4_b_q;
     reg [NL:1]          x4_lp_q, x4_lc_q;     // P's and C's labels after the step
     wire [NL:1]         x4_k = x4_last_q ? (x4_lp_q | x4_lc_q) : (x4_lp_q & ~x4_lc_q);
     reg [ROW_IDX_W-1:0] x4_row_q;
@@ -800,7 +875,6 @@ module fmt_blob #(
     reg [E_W-1:0]       run_e;
     // the second operand of an update: the run (ADD) or label B's entry (MERGE); one
     // combine() serves both
-    wire [E_W-1:0]      acc_y;
     always @(*) begin
         run_e = {E_W{1'b0}};
         run_e[O_AREA +: AREA_W]    = l2_e_q[F_CNT +: AREA_W];
@@ -819,22 +893,15 @@ module fmt_blob #(
 
     // ---- A: accumulators; C: close engine; sorted blob list ---------------------------
     // Two read ports: label A (the updated entry) and a shared one: label B of a MERGE
-    // or else the close engine's label (a closed label waits while a MERGE is applied)
-    reg [E_W-1:0] acc_q [0:NL];             // (0: never written, keeps the reads in range)
-    wire            b_merge = x4_mrg_q;      // (x4_op_q == OP_MERGE)
-    wire [LBL_W-1:0] acc_b_lbl;
-    wire [E_W-1:0]  acc_b = acc_q[acc_b_lbl];
-    assign acc_y = x4_mrg_q ? acc_b : x4_e_q;
-    // W: the update is applied one cycle after its reads (both read ports registered);
-    // an operand written by the update of the cycle before is taken from w_res_q
+    // or else the close engine's label (a closed label waits while a MERGE is applied).
+    // K reads both (registered), W combines and writes one cycle later; an operand that
+    // the update of the cycle before wrote is taken from that update's register.  The
+    // memory is split into NAS field slices (a field's update needs its own slice only),
+    // each with its own copies of the read and write addresses and of the controls,
+    // registered from their next values (the address nets stay inside a slice).
+    wire             b_merge = x4_mrg_q;     // (x4_op_q == OP_MERGE)
     reg  [1:0]       w_op_q;
-    reg  [LBL_W-1:0] w_a_q;
-    reg  [E_W-1:0]   w_ra_q, w_y_q, w_res_q;
-    reg              w_fa_q, w_fb_q;          // operand A / Y is the update of the cycle before
     wire             w_wr  = (w_op_q != OP_NONE);
-    wire [E_W-1:0]   w_x   = w_fa_q ? w_res_q : w_ra_q;
-    wire [E_W-1:0]   w_yy  = w_fb_q ? w_res_q : w_y_q;
-    wire [E_W-1:0]   w_res = (w_op_q == OP_NEW) ? w_yy : combine(w_x, w_yy);
     // the close engine's next label (lowest pending), picked one cycle ahead
     reg  [LBL_W-1:0] pk_q;
     reg              pk_v_q;
@@ -854,9 +921,55 @@ module fmt_blob #(
         for (i = 1; i <= NL; i = i + 1)
             cpick_bit[i] = cl_go && (pk_q == i[LBL_W-1:0]);
     end
-    assign acc_b_lbl = b_merge ? x4_b_q : pk_q;
+    // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
+    // MERGE, else the close engine's label)
+    wire [LBL_W-1:0] pk_nx  = (pk_fill && !rst) ? p_enc : pk_q;
+    wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
+    wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
+    wire [LBL_W-1:0] rb_nx  = do_merge ? l2_y_q : pk_nx;
+    wire             wr_nx  = !rst && (x4_op_q != OP_NONE);  // w_op_q's next: W writes
+    wire             nw_nx  = (x4_op_q == OP_NEW);
+    // the slices' registers, assembled
+    wire [E_W-1:0]   w_x, w_yy, cl_e_q;
+    wire [E_W-1:0]   w_res = combine(w_x, w_yy);     // (a NEW writes w_yy: per slice)
+    genvar ga;
+    generate
+        for (ga = 0; ga < NAS; ga = ga + 1) begin : g_acc
+            localparam LO = (ga == 0) ? O_AREA : (ga == 1) ? O_SX : (ga == 2) ? O_SY
+                          : (ga == 3) ? O_RMIN : O_PEAK;
+            localparam HI = (ga == 0) ? O_SX : (ga == 1) ? O_SY : (ga == 2) ? O_RMIN
+                          : (ga == 3) ? O_PEAK : E_W;
+            localparam SW = HI - LO;
+            reg  [SW-1:0]    acc_q [0:NL];    // (0: never written, keeps the reads in range)
+            reg  [LBL_W-1:0] ra_q, rb_q, wa_q;
+            reg              we_q, nw_q, mrg_q, pkv_q, fa_q, fb_q;
+            reg  [SW-1:0]    ra_d_q, y_q, wr_q, cl_q;   // read A, operand Y, the update
+            // copies (keep: one flip-flop each, not merged by synthesis)
+            (* keep *) always @(posedge clk) begin
+                ra_q  <= ra_nx;
+                rb_q  <= rb_nx;
+                mrg_q <= do_merge;
+                pkv_q <= pkv_nx;
+                we_q  <= wr_nx;
+                nw_q  <= nw_nx;
+                wa_q  <= ra_q;
+            end
+            wire [SW-1:0] rd_b = acc_q[rb_q];
+            always @(posedge clk) begin
+                ra_d_q <= acc_q[ra_q];
+                y_q    <= mrg_q ? rd_b : x4_e_q[LO +: SW];
+                fa_q   <= we_q && (ra_q == wa_q);
+                fb_q   <= we_q && mrg_q && (rb_q == wa_q);
+                wr_q   <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
+                if (we_q) acc_q[wa_q] <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
+                if (pkv_q && !mrg_q) cl_q <= rd_b;          // cl_go
+            end
+            assign w_x[LO +: SW]     = fa_q ? wr_q : ra_d_q;
+            assign w_yy[LO +: SW]    = fb_q ? wr_q : y_q;
+            assign cl_e_q[LO +: SW]  = cl_q;
+        end
+    endgenerate
     reg           cl_v_q;
-    reg [E_W-1:0] cl_e_q;
     reg [ROW_IDX_W-1:0] crow_q [0:NL];        // row at whose end the label was closed (0: unused)
     reg [ROW_IDX_W-1:0] cl_row_q;
     reg [LBL_W-1:0]     cl_lbl_q;
@@ -875,7 +988,6 @@ module fmt_blob #(
     localparam SL_W = $clog2(MB + 1);
     localparam PE_W = SZ_W + SX_W + SY_W;
     localparam PO_W = AREA_W + 2 * ROW_IDX_W + 2 * COL_IDX_W + HM_W + IDX_W;
-    wire               releasing;
     /* verilator lint_off UNUSEDSIGNAL */     // the emission reads the slots only
     wire [MB-1:0]        l_v;
     wire [MB*AREA_W-1:0] l_area;
@@ -982,7 +1094,17 @@ module fmt_blob #(
         lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
-    wire [ROW_IDX_W-1:0] cf_row   = bw_first ? LAST_ROW : bw_row_q + 1'b1;
+    // the row whose close records are read (bw_first ? LAST_ROW : bw_row_q + 1),
+    // registered from bw_row1_q, in copies per NCF labels (keep: the read-address fan-out)
+    localparam NCF = 13;
+    reg  [((NL + NCF - 1) / NCF)*ROW_IDX_W-1:0] cf_row_q;
+    genvar gc;
+    generate
+        for (gc = 0; gc < (NL + NCF - 1) / NCF; gc = gc + 1) begin : g_cfr
+            (* keep *) always @(posedge clk)   // (read while the pass runs only)
+                cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W] <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
+        end
+    endgenerate
     // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
     // was a blob (written by the close engine, read for row cf_row)
     wire [NL:1]          cfr;
@@ -994,7 +1116,7 @@ module fmt_blob #(
             always @(posedge clk) begin
                 if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= cl_isblob;
             end
-            assign cfr[gl] = cf_mem[cf_row];
+            assign cfr[gl] = cf_mem[cf_row_q[((gl - 1) / NCF)*ROW_IDX_W +: ROW_IDX_W]];
         end
     endgenerate
     // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
@@ -1137,8 +1259,6 @@ module fmt_blob #(
         if (do_run) x_q <= lrun;
         x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
         x4_mrg_q <= do_merge;
-        x4_a_q   <= do_merge ? x_q : lrun;
-        x4_b_q   <= l2_y_q;
         x4_e_q   <= run_e;
         x4_row_q <= l2_row;
         x4_end_q <= row_done;
@@ -1147,15 +1267,8 @@ module fmt_blob #(
         x4_lc_q  <= livec_nx;
         // accumulators: K reads (label A, and label B of a MERGE), W combines and writes
         w_op_q  <= x4_op_q;                   // (OP_NONE when no step)
-        w_a_q   <= x4_a_q;
-        w_ra_q  <= acc_q[x4_a_q];
-        w_y_q   <= acc_y;
-        w_fa_q  <= w_wr && (x4_a_q == w_a_q);
-        w_fb_q  <= w_wr && x4_mrg_q && (x4_b_q == w_a_q);
-        w_res_q <= w_res;
-        if (w_wr) acc_q[w_a_q] <= w_res;
+        pk_q    <= pk_nx;
         if (cl_go) begin
-            cl_e_q   <= acc_b;
             cl_row_q <= crow_q[pk_q];
             cl_lbl_q <= pk_q;
         end
@@ -1165,6 +1278,7 @@ module fmt_blob #(
         end
         // emission side registers
         dl_i_q[0] <= em_i_q;
+
         for (i = 1; i < DL; i = i + 1) dl_i_q[i] <= dl_i_q[i-1];
         blob_area_o     <= out_p[0 +: AREA_W];
         if (out_x) qx_q[out_i[MBI_W-1:0]] <= dq;
@@ -1286,15 +1400,19 @@ module fmt_blob #(
             else if (step) l2_v_q <= 1'b0;
 
             // ---- labelling state ----
-            alias_q <= row_done ? alias_id : alias_nx;
-            if (row_done) begin
-                p_q     <= l2_lastrow ? {(COLS*LBL_W){1'b0}} : c_nx;
-                c_q     <= c_nx;              // kept: the next row's first event reads it
+            // at a row end P = C (0 after the last row; C kept: the next row's first
+            // event reads it), the live masks move; the row-end copies per group
+            for (i = 1; i <= NL; i = i + 1)
+                alias_q[(i-1)*LBL_W +: LBL_W] <= rdc_q[NG + (i-1)/ALG] ? alias_id[(i-1)*LBL_W +: LBL_W]
+                                                                     : alias_nx[(i-1)*LBL_W +: LBL_W];
+            for (i = 0; i < COLS; i = i + 1)
+                p_q[i*LBL_W +: LBL_W] <= !rdc_q[i/GS] ? p_nx[i*LBL_W +: LBL_W]
+                                       : (l2_lastrow ? {LBL_W{1'b0}} : c_nx[i*LBL_W +: LBL_W]);
+            c_q <= c_nx;
+            if (rdc_q[VC]) begin
                 livep_q <= l2_lastrow ? {NL{1'b0}} : livec_nx;
                 livec_q <= {NL{1'b0}};
             end else begin
-                p_q     <= p_nx;
-                c_q     <= c_nx;
                 livep_q <= livep_nx;
                 livec_q <= livec_nx;
             end
@@ -1303,15 +1421,12 @@ module fmt_blob #(
                 n0v_q <= |free_q;
             end
             free_q <= (free_q & ~(n0_fill ? f_low : {NL{1'b0}}))
-                    | (do_merge ? vbit : {NL{1'b0}})
+                    | (dmc_q[VC] ? vbit : {NL{1'b0}})
                     | cpick_bit;
             x4_v_q <= do_merge || do_run || row_done;
             pend_q <= (pend_q & ~(pk_fill ? p_low : {NL{1'b0}}))
                     | ((x4_v_q && x4_end_q) ? x4_k : {NL{1'b0}});
-            if (pk_fill) begin
-                pk_q   <= p_enc;
-                pk_v_q <= |pend_q;
-            end
+            if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
             idle_q <= !pipe_busy && !fetch;
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
                      && !fetch && fr_in && !arr_p[fr_row] && !releasing;
@@ -1367,6 +1482,7 @@ module fmt_blob #(
             end
             if (out_tok) tok_q <= 1'b1;
 
+            if (em_tok) state_q <= S_WAIT;
             if (em_issue) begin
                 if (!em_ph_q && em_i_q + 1'b1 == em_n_q) begin
                     em_i_q  <= {CNT_W{1'b0}};     // x quotients issued: now the y ones
@@ -1375,7 +1491,6 @@ module fmt_blob #(
                     em_i_q  <= em_i_q + 1'b1;
                 end
             end
-            if (em_tok) state_q <= S_WAIT;
             dl_v_q <= {dl_v_q[DL-2:0], em_issue && em_ph_q};
             dl_x_q <= {dl_x_q[DL-2:0], em_issue && !em_ph_q};
             dl_t_q <= {dl_t_q[DL-2:0], em_tok};
