@@ -28,8 +28,8 @@
 //        are the negations of N's "above" tests), registered when the window shifts
 //        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1): per column N's left,
 //        threshold and above tests (N's partial mask, earlier neighbours, is a function
-//        of these registers) and P's down mask (its later neighbours in N).  No logic
-//        follows a comparator but the one LUT of these tests.
+//        of these registers) and P's down mask (its later neighbours in N).  Only the one
+//        LUT of each test follows a comparator.
 //   SW4  serialise P's maxima, lowest column first, one per cycle: P's partial mask
 //        (loaded at the shift) AND its down mask (the sweep waits: a row with k maxima
 //        holds the window k cycles, a row with none but a non-empty partial mask one
