@@ -518,5 +518,128 @@ module fmt_ctrl_port #(
         end
     end
 
+`ifdef FORMAL
+    // Formal properties (SymbiYosys, formal/fmt_ctrl_port.sby; never seen by synthesis).
+    // The UART receiver and transmitter are replaced by free stand-ins (formal/stubs), so
+    // the parser is proved for any byte stream and any transmit pacing.  A shadow built
+    // only from the bytes the parser consumes (its own bit-serial CRC, LEN, CMD and the
+    // payload) states the promises: nothing executes before its frame's CRC was checked;
+    // a register write is a word of a good WRITE frame at its address; every error is
+    // counted (saturating); a frame or a discard left without bytes times out, so the
+    // parser always resynchronises; the WRITE never reads past the buffered payload.
+    localparam F_PB = PAYLOAD_MAX * 8;
+    reg          f_rstd_q = 1'b0;                 // a reset has been applied
+    reg  [15:0]  f_crc_q;                         // CRC of LEN..PAYLOAD as consumed
+    reg  [15:0]  f_len_q;
+    reg  [7:0]   f_cmd_q;
+    reg  [7:0]   f_crch_q;
+    reg  [F_PB-1:0] f_pay_q;                      // payload bytes, byte i at [8i +: 8]
+    reg  [15:0]  f_n_q;                           // payload bytes consumed
+    reg          f_good_q;                        // the frame's CRC matched the shadow's
+    reg  [15:0]  f_k_q;                           // register writes of this frame
+    reg  [7:0]   f_idle_q;                        // clocks without a byte while parsing
+    reg  [15:0]  f_cnt_q;                         // err_count_o a cycle ago
+    reg          f_tsync_q;                       // state_q was S_TSYNC a cycle ago
+    integer      fb;
+    reg  [15:0]  f_crc_d;
+    wire         f_byte   = pop && !rferr;        // a byte the frame takes
+    wire         f_pstate = (state_q <= S_DISCARD) && !(state_q == S_HUNT && !junk_q);
+    always @(*) begin                             // one CRC step, bit by bit
+        f_crc_d = f_crc_q;
+        for (fb = 7; fb >= 0; fb = fb - 1)
+            f_crc_d = {f_crc_d[14:0], 1'b0} ^ ({16{f_crc_d[15] ^ rbyte[fb]}} & 16'h1021);
+    end
+    always @(posedge clk) begin
+        f_rstd_q  <= f_rstd_q | rst;
+        f_cnt_q   <= err_count_o;
+        f_tsync_q <= (state_q == S_TSYNC);
+        if (rst || !f_pstate || rx_valid) f_idle_q <= 8'd0;
+        else if (f_idle_q != 8'hFF)       f_idle_q <= f_idle_q + 1'b1;
+        if (state_q == S_HUNT) begin
+            f_good_q <= 1'b0;
+            if (f_byte && rbyte == SYNC) f_crc_q <= 16'hFFFF;
+        end
+        if (f_byte && state_q >= S_LENH && state_q <= S_PAY) f_crc_q <= f_crc_d;
+        if (f_byte && state_q == S_LENH) f_len_q[15:8] <= rbyte;
+        if (f_byte && state_q == S_LENL) f_len_q[7:0]  <= rbyte;
+        if (f_byte && state_q == S_CMD) begin f_cmd_q <= rbyte; f_n_q <= 16'd0; end
+        if (f_byte && state_q == S_PAY) begin
+            if (f_n_q < PAYLOAD_MAX) f_pay_q[8 * f_n_q +: 8] <= rbyte;
+            f_n_q <= f_n_q + 1'b1;
+        end
+        if (f_byte && state_q == S_CRCH) f_crch_q <= rbyte;
+        if (f_byte && state_q == S_CRCL) f_good_q <= ({f_crch_q, rbyte} == f_crc_q);
+        if (state_q == S_EXEC) f_k_q <= 16'd0;
+        else if (reg_we_o)     f_k_q <= f_k_q + 1'b1;
+    end
+    integer fi;
+    wire [FIFO_AW:0] f_used = wp_q - rp_q;        // bytes in the FIFO's RAM
+    wire [15:0]  f_h = (f_n_q < 16'd4) ? f_n_q : 16'd4;   // payload bytes in hdr_q
+    always @(*) begin
+        if (f_rstd_q && !rst) begin
+            // only the defined states
+            assert (state_q <= S_WR || (state_q >= S_TSYNC && state_q <= S_TCRCL));
+            // the parser's running CRC, LEN and payload are those of the bytes consumed
+            if (state_q >= S_LENH && state_q <= S_CRCL) assert (crc_rx_q == f_crc_q);
+            if ((state_q >= S_SEQ && state_q <= S_CRCL) || state_q == S_EXEC || state_q == S_WR)
+                assert (len_q == f_len_q);
+            if (state_q == S_PAY) assert (pidx_q == f_n_q && f_n_q < len_q && len_q <= PMAX16);
+            if (state_q >= S_PAY && state_q <= S_CRCL) assert (cmd_q == f_cmd_q);
+            // the header holds the first (up to four) payload bytes
+            if ((state_q >= S_PAY && state_q <= S_CRCL) || state_q == S_EXEC)
+                for (fi = 0; fi < 4; fi = fi + 1)
+                    if (fi < f_h) assert (hdr_q[8 * (f_h - 1 - fi) +: 8] == f_pay_q[8 * fi +: 8]);
+            if (state_q == S_CRCH || state_q == S_CRCL) assert (f_n_q == len_q && len_q <= PMAX16);
+            assert (after_q == S_HUNT || after_q == S_DISCARD);
+            if (state_q == S_PAY || state_q == S_CRCH || state_q == S_CRCL || state_q == S_EXEC ||
+                state_q == S_WR)
+                for (fi = 0; fi < PAYLOAD_MAX; fi = fi + 1)
+                    if (fi < f_n_q) assert (pbuf[fi] == f_pay_q[8 * fi +: 8]);
+            // nothing executes before its frame's CRC has been checked
+            if (state_q == S_EXEC || state_q == S_WR)
+                assert (f_good_q && cmd_q == f_cmd_q && f_n_q == len_q && len_q <= PMAX16);
+            // the WRITE reads only buffered payload bytes, one word per 4
+            if (state_q == S_WR) begin
+                assert (cmd_q == C_WRITE && wr_len_ok);
+                assert (pidx_q >= 16'd2 && pidx_q < len_q);
+                // words issued: (pidx - 2) / 4, the last one on reg_we_o now
+                assert (f_k_q + (reg_we_o ? 16'd1 : 16'd0) == ((pidx_q - 16'd2) >> 2));
+                assert (rd_addr_q == {f_pay_q[7:0], f_pay_q[15:8]} + ((pidx_q - 16'd2) >> 2));
+                // the word being assembled: the bytes read since the last word
+                for (fi = 1; fi <= 3; fi = fi + 1)
+                    if (((pidx_q - 16'd2) & 16'd3) >= fi)
+                        assert (wacc_q[8 * (fi - 1) +: 8] == f_pay_q[8 * (pidx_q - fi) +: 8]);
+            end
+            // a register write is the k-th word of a good WRITE frame, at ADDR + k
+            if (reg_we_o) begin
+                assert (f_good_q && f_cmd_q == C_WRITE);
+                assert (reg_addr_o == {f_pay_q[7:0], f_pay_q[15:8]} + f_k_q);
+                assert (reg_wdata_o == {f_pay_q[8 * (4 * f_k_q + 2) +: 8],
+                                        f_pay_q[8 * (4 * f_k_q + 3) +: 8],
+                                        f_pay_q[8 * (4 * f_k_q + 4) +: 8],
+                                        f_pay_q[8 * (4 * f_k_q + 5) +: 8]});
+            end
+            // resynchronisation: inside a frame, a discard or a junk burst, the port
+            // never waits longer than the timeout after the last byte (plus the bytes
+            // still queued: the FIFO, its head and the one being written)
+            assert (tmo_q <= TMO_LAST);
+            if (junk_q) assert (state_q == S_HUNT);      // junk is only seen between frames
+            assert (f_used <= (1 << FIFO_AW));           // the FIFO holds at most its depth
+            if (tmo_run) assert (tmo_q <= f_idle_q);
+            assert (f_idle_q <= TMO_CLKS + (1 << FIFO_AW) + 2);
+        end
+    end
+    always @(posedge clk) begin
+        if (f_rstd_q && !rst && !$past(rst)) begin
+            // every error is counted, saturating, never wrapped
+            // (err_pulse_o and the count are loaded at the same edge)
+            if (err_pulse_o && f_cnt_q != 16'hFFFF) assert (err_count_o == f_cnt_q + 1'b1);
+            else                                    assert (err_count_o == f_cnt_q);
+            // every error reply starts with its count
+            if (state_q == S_TSYNC && !f_tsync_q && tx_cmd_q == C_ERROR) assert (err_pulse_o);
+        end
+    end
+`endif
+
 endmodule
 `default_nettype wire
