@@ -37,7 +37,7 @@ FUZZ_BYTES   ?= 1000000
 SIM          ?=
 export SIM
 
-.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz mutate test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz mutate random-scenes test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -102,6 +102,12 @@ test-long: setup
 	FMT_LONG=1 FFT_LONG=1 FMT_CORE_DEFAULT=1 FMT_TOUCH_DEFAULT=1 FMT_RX_FULL=1 FMT_DDS_FULL=1 \
 	  $(VPY) -m pytest -q -n $(JOBS) sim/tests tb
 	$(VPY) scripts/mutate.py
+	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --quiet
+
+# random scenes through the fixed-point model with invariants, the first 200 also
+# through the RTL (small and medium builds), issue #15 item 4; about 10 min here
+random-scenes: setup
+	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200
 
 lint: setup
 	@bash scripts/lint.sh

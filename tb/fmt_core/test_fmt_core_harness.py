@@ -10,12 +10,19 @@ applied), no frame dropped, the latency counters read over the bus equal the cyc
 measured from the logs, and the scene gives new, move and lift events.  The same scene
 under the cocotb path is tb/fmt_core/test_fmt_core.py (Verilog channel + player).
 
+Then, on the same build (in the same test: two tests building one folder at once under
+pytest-xdist would collide), the short sample of the random-scene regression: 8 scenes
+of scripts/random_scenes.py (random contacts, effects and run-time settings) must be
+bit-exact with the model (``make random-scenes`` runs 200 on the small and medium builds).
+
 The build is at -O0 (a few frames; `make sim` builds at -O3 / -O2 and caches the build).
 Verilator only (there is no Icarus variant of a Verilator C++ harness).
 """
 from __future__ import annotations
 
+import importlib.util
 import json
+from pathlib import Path
 
 import pytest
 
@@ -65,3 +72,23 @@ def test_fmt_core_harness(sim):
     assert res["frames_before_status"] <= stt["FRAME_COUNT"] <= res["frames_at_status"]
     print(json.dumps({"build_s": round(build_s, 1), "frames": rep["frames"],
                       "events": res["events"], "clk_per_s": res["clk_per_s"]}))
+    # the random-scene sample through the same build
+    spec = importlib.util.spec_from_file_location(
+        "_random_scenes", Path(__file__).resolve().parents[2] / "scripts" / "random_scenes.py")
+    rs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rs)
+    ran, i = 0, 0
+    while ran < 8:
+        sc, st = rs.random_scene(21, i, "small")
+        i += 1
+        assert i < 100, "too few random scenes fit the bench"
+        try:
+            rep = rsr.run(sc, cps=3, sim="verilator", plot=False, quiet=True, settings=st,
+                          tag="tb_cpp", cflags="-O0")
+        except ValueError as e:
+            if "update records" in str(e):
+                continue
+            raise
+        rc, line = rsr.verdict(rep)
+        assert rc == 0 and rep["frames"] >= sc.frames, (i - 1, line)
+        ran += 1
