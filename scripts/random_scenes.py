@@ -30,8 +30,14 @@ memory; the others are counted as skipped) also run through the RTL of the small
 their random settings written to the registers: heat maps and events must equal the
 model's bit for bit, no frame dropped or missing (``run_sim_rtl.verdict``).
 
+With ``--reset`` each of those RTL runs first keeps the core busy for a random number of
+cycles (up to three frames: random ADC words on every column, random register settings
+with a low threshold, the event consumer stalling at random), so the reset before the
+scene lands at a random point of a frame with the pipeline, the FIFOs and the tracker
+full of state; the scene after it must still be bit-exact (issue #15 item 3).
+
     python scripts/random_scenes.py [--count N] [--seed S] [--sensor small|medium|mixed]
-                                    [--rtl K] [--fail-dir DIR] [--quiet]
+                                    [--rtl K] [--reset] [--fail-dir DIR] [--quiet]
 """
 from __future__ import annotations
 
@@ -149,6 +155,20 @@ def random_scene(seed: int, index: int, sensor: str):
     return sc, random_settings(rng, cfg)
 
 
+def busy_before_reset(seed: int, index: int, sc: _scene.Scene, cps: int = 3) -> dict:
+    """The busy phase before the reset under test (bench/core/sim_main.cpp pre_cycles):
+    random cycles (up to three frames of the scene), random settings with a low threshold
+    and blobs on, a random M and PN setting."""
+    rng = np.random.default_rng([seed, index, 1])
+    cfg = sc.cfg
+    pre_sc = sc.replace(m=int(rng.integers(1, 4)),
+                        effects=dict(sc.effects, pn={"enable": bool(rng.random() < 0.5),
+                                                     "chip_len": int(rng.integers(1, 5))}))
+    st = random_settings(rng, cfg).replace(threshold=int(rng.integers(1, 400)), blobs=True)
+    return {"cycles": int(rng.integers(1, 3 * pre_sc.samples_per_frame * cps)),
+            "seed": int(rng.integers(1, 1 << 62)), "regs": rsr.register_writes(pre_sc, st)}
+
+
 def run_model(sc: _scene.Scene, st: TouchSettings, cps: int = 3):
     eff = rsr.check_scene(sc)
     n = sc.frames * sc.samples_per_frame
@@ -226,6 +246,8 @@ def main(argv=None) -> int:
     ap.add_argument("--sensor", choices=["small", "medium", "mixed"], default="mixed")
     ap.add_argument("--fail-dir", default=str(ROOT / "build" / "random_scenes"))
     ap.add_argument("--rtl", type=int, default=0, help="also run the first K scenes through the RTL")
+    ap.add_argument("--reset", action="store_true",
+                    help="RTL runs start with a busy core reset at a random cycle")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     if a.count < 1:
@@ -246,7 +268,7 @@ def main(argv=None) -> int:
         if not bad and rtl_done < a.rtl:
             try:
                 rep = rsr.run(sc, cps=3, sim="verilator", plot=False, quiet=True, settings=st,
-                              tag="random")
+                              tag="random", pre=busy_before_reset(a.seed, i, sc) if a.reset else None)
                 rc, line = rsr.verdict(rep)
                 rtl_done += 1
                 if rc:
@@ -272,7 +294,8 @@ def main(argv=None) -> int:
                   f"{time.time() - t0:.0f} s", flush=True)
     print(f"random_scenes: {a.count} scenes (seed {a.seed}, indices {a.start}..{a.start + a.count - 1}), "
           f"{frames} frames, {events} events, {fails} failed"
-          + (f"; through the RTL: {rtl_done} (bit-exact unless failed above), "
+          + (f"; through the RTL{' after a busy core was reset' if a.reset else ''}: "
+             f"{rtl_done} (bit-exact unless failed above), "
              f"{rtl_skipped} skipped (bench update memory)" if a.rtl else "")
           + f", {time.time() - t0:.0f} s")
     if a.rtl and rtl_done < a.rtl:

@@ -614,7 +614,8 @@ def harness_build(cfg, cps: int, d: Path, tag: str = "", cflags: str = HARNESS_C
 
 
 def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: int,
-                  verilog_channel: bool = False, serve: dict | None = None) -> None:
+                  verilog_channel: bool = False, serve: dict | None = None,
+                  pre: dict | None = None) -> None:
     """The job of the C++ harness: the same phases as the cocotb run_scene; serve:
     {"port", "seconds", "cycles", "once", "log_clk"} for serve mode (see the module doc;
     log_clk: clk of serving with the loggers on, -1 = all)."""
@@ -630,6 +631,10 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: int,
     for key in ("cal", "regs"):
         lines.append(f"{key} {len(job[key])}")
         lines += [f"{addr(n)} {int(v) & 0xFFFFFFFF}" for n, v in job[key]]
+    if pre is not None:      # a busy core before the reset under test (sim_main.cpp header)
+        lines += [f"pre_cycles {int(pre['cycles'])}", f"pre_seed {int(pre['seed'])}",
+                  f"pre_regs {len(pre['regs'])}"]
+        lines += [f"{addr(n)} {int(v) & 0xFFFFFFFF}" for n, v in pre["regs"]]
     lines.append(f"status {len(STATUS_REGS)}")
     lines += [f"{n} {addr(n)}" for n in STATUS_REGS]
     if serve is not None:
@@ -642,7 +647,7 @@ def write_cpp_job(path: Path, cfg, cps: int, job: dict, d: Path, progress: int,
 
 def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene",
                 tag: str = "cpp", quiet: bool = False, cflags: str = HARNESS_CFLAGS,
-                verilog_channel: bool = False, serve: dict | None = None):
+                verilog_channel: bool = False, serve: dict | None = None, pre: dict | None = None):
     """Build (cached) and run the C++ harness on a prepared job folder; returns
     (job folder, reference, calibration, number of updates, result dict, build seconds).
     serve: serve mode (write_cpp_job); the harness's stdout (the "serving ..." line) is
@@ -657,7 +662,7 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
     from fmt.progress import is_tty
     write_cpp_job(d / "job_cpp.txt", scene.cfg, cps, job, d,
                   progress=0 if quiet else (1 if is_tty(sys.stderr) else 2),
-                  verilog_channel=verilog_channel, serve=serve)
+                  verilog_channel=verilog_channel, serve=serve, pre=pre)
     (d / "serve.log").unlink(missing_ok=True)
     t0 = time.perf_counter()
     sys.stdout.flush()
@@ -716,20 +721,22 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
 def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int = 3,
         sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None,
         engine: str = "cpp", serve: dict | None = None, tag: str = "cpp",
-        cflags: str = HARNESS_CFLAGS) -> dict:
+        cflags: str = HARNESS_CFLAGS, pre: dict | None = None) -> dict:
     """engine "cpp": the standalone C++ harness (Verilator only, the default of
     ``make sim``); "cocotb": the cocotb test run_scene (Verilator or Icarus).
     serve (engine cpp only): serve the UART after the scene (write_cpp_job); tag and
     cflags: the harness's job folder / build (tests use their own, at -O0)."""
     if serve is not None and not (engine == "cpp" and sim == "verilator"):
         raise ValueError("--serve needs the C++ harness (engine cpp, Verilator)")
+    if pre is not None and not (engine == "cpp" and sim == "verilator"):
+        raise ValueError("a busy core before the reset (pre) needs the C++ harness (engine cpp, Verilator)")
     frames = frames or scene.frames
     scene = scene.replace(frames=frames)
     check_scene(scene)                 # refuse an effect the RTL cannot apply, before any build
     if engine == "cpp" and sim == "verilator":
         t0 = time.perf_counter()
         d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet,
-                                                      tag=tag, cflags=cflags, serve=serve)
+                                                      tag=tag, cflags=cflags, serve=serve, pre=pre)
         rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal,
                       max_cycle=res.get("serve_start_cycle"))
         if "serve" in res:

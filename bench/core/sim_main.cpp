@@ -6,6 +6,10 @@
 // tracing, single thread):
 //   phase 1: rst for 8 cycles, one idle cycle, the calibration writes (one per cycle)
 //            through the local bus (play_i = 0);
+//   (pre_cycles > 0, the reset test of scripts/random_scenes.py --reset: the pre_regs
+//            written, then pre_cycles cycles with random ADC words on every column and
+//            the event consumer stalling at random (xorshift64 from pre_seed), so that
+//            the reset of phase 2 lands on a busy core in the middle of a frame)
 //   phase 2: play_i = 1, one cycle later rst for reset_cycles cycles, one idle cycle
 //            (cycle 0), the register writes (one per cycle), then the clock runs until
 //            run_cycles cycles have passed since the first register write;
@@ -108,7 +112,9 @@ struct Update {
 struct Job {
     int rows = 0, cols = 0, cps = 3, frames = 0, progress = 0, ext_channel = 1;
     std::string chan_file, gauss_file, sine_file, upd_file, out;
-    std::vector<std::pair<uint32_t, uint32_t>> cal, regs;
+    std::vector<std::pair<uint32_t, uint32_t>> cal, regs, pre_regs;
+    long long pre_cycles = 0;                 // busy cycles before the phase-2 reset
+    unsigned long long pre_seed = 1;
     std::vector<std::pair<std::string, uint32_t>> status;
     long long reset_cycles = 16, run_cycles = 0;
     // serve mode (serve_port < 0: off)
@@ -168,6 +174,9 @@ Job read_job(const char* path) {
         else if (k == "out") { if (std::fscanf(f, "%4095s", sval) != 1) die(k); j.out = sval; }
         else if (k == "cal") pairs(j.cal);
         else if (k == "regs") pairs(j.regs);
+        else if (k == "pre_regs") pairs(j.pre_regs);
+        else if (k == "pre_cycles") { if (std::fscanf(f, "%lld", &j.pre_cycles) != 1 || j.pre_cycles < 0) die(k); }
+        else if (k == "pre_seed") { if (std::fscanf(f, "%llu", &j.pre_seed) != 1 || j.pre_seed == 0) die(k); }
         else if (k == "status") {
             long n;
             if (std::fscanf(f, "%ld", &n) != 1) die(k);
@@ -413,6 +422,27 @@ int main(int argc, char** argv) {
     top->rst = 1; ticks(8); top->rst = 0;
     tick();
     for (const auto& w : job.cal) bus_write(w.first, w.second);
+    // the busy core before the reset under test (cpp channel only: its ADC words are
+    // replaced; the channel itself restarts at the reset)
+    if (job.pre_cycles > 0) {
+        if (!cpp_channel) die("pre_cycles needs the C++ channel (ext_channel 1)");
+        for (const auto& w : job.pre_regs) bus_write(w.first, w.second);
+        unsigned long long x = job.pre_seed;
+        auto rnd = [&x]() { x ^= x << 13; x ^= x >> 7; x ^= x << 17; return x; };
+        const size_t nbits = static_cast<size_t>(job.cols) * 12;
+        for (long long i = 0; i < job.pre_cycles; ++i) {
+            top->ev_ready_i = (rnd() & 3) != 0;
+            tick();
+            uint32_t* aw = words_of(top->adc_ext_i);
+            for (size_t w = 0; w < ADC_NWORDS; ++w) {
+                const size_t lo = w * 32;
+                const uint32_t m = nbits >= lo + 32 ? 0xFFFFFFFFu
+                                 : (nbits > lo ? ((1u << (nbits - lo)) - 1u) : 0u);
+                aw[w] = static_cast<uint32_t>(rnd()) & m;
+            }
+        }
+        top->ev_ready_i = 1;
+    }
     // phase 2: the run
     top->play_i = 1; ch.playing = true;
     tick();
