@@ -102,12 +102,13 @@ test-long: setup
 	FMT_LONG=1 FFT_LONG=1 FMT_CORE_DEFAULT=1 FMT_TOUCH_DEFAULT=1 FMT_RX_FULL=1 FMT_DDS_FULL=1 \
 	  $(VPY) -m pytest -q -n $(JOBS) sim/tests tb
 	$(VPY) scripts/mutate.py
-	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --quiet
+	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --reset --quiet
 
 # random scenes through the fixed-point model with invariants, the first 200 also
-# through the RTL (small and medium builds), issue #15 item 4; about 10 min here
+# through the RTL (small and medium builds) after a busy core was reset at a random
+# cycle, issue #15 items 3-4; about 10 min here
 random-scenes: setup
-	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200
+	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --reset
 
 lint: setup
 	@bash scripts/lint.sh

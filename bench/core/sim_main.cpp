@@ -8,8 +8,9 @@
 //            through the local bus (play_i = 0);
 //   (pre_cycles > 0, the reset test of scripts/random_scenes.py --reset: the pre_regs
 //            written, then pre_cycles cycles with random ADC words on every column and
-//            the event consumer stalling at random (xorshift64 from pre_seed), so that
-//            the reset of phase 2 lands on a busy core in the middle of a frame)
+//            the event consumer stalling at random (xorshift64 from pre_seed), then one
+//            cycle of rst: the reset under test lands on a busy core in the middle of a
+//            frame; phase 2 follows as usual)
 //   phase 2: play_i = 1, one cycle later rst for reset_cycles cycles, one idle cycle
 //            (cycle 0), the register writes (one per cycle), then the clock runs until
 //            run_cycles cycles have passed since the first register write;
@@ -441,6 +442,10 @@ int main(int argc, char** argv) {
                 aw[w] = static_cast<uint32_t>(rnd()) & m;
             }
         }
+        // the reset under test: one cycle, here, so that nothing of the busy core
+        // leaves in the one cycle of phase 2 before its reset (the loggers run from
+        // play_i = 1 on); phase 2's own reset then meets an idle core
+        top->rst = 1; tick(); top->rst = 0;
         top->ev_ready_i = 1;
     }
     // phase 2: the run

@@ -422,6 +422,32 @@ async def reset_mid_frame(dut):
 
 
 @cocotb.test()
+async def reset_random_points(dut):
+    """Resets at random points of a busy frame (rows arriving, labelling, closing,
+    emission, the membership pass), each followed by new settings and frames that must
+    be exact: nothing of the interrupted frame survives the reset."""
+    tb = TB(dut)
+    await tb.reset()
+    rng, nrng = random.Random(11), np.random.default_rng(11)
+    frame = 100
+    for k in range(10):
+        tb.set(rng.choice([1, 500, 1000]), rng.choice([1, 2, 3]))
+        hm = (nrng.integers(0, 3000, (tb.rows, tb.cols)) * (nrng.random((tb.rows, tb.cols)) < 0.6)
+              ).astype(np.int64)
+        sched = tb.schedule(rng, [hm], frame)
+        cut = rng.randrange(len(sched) + 1)
+        await tb.drive(sched[:cut])
+        for _ in range(rng.randrange(tb.work(hm) + 2 * tb.rows + 60)):
+            await RisingEdge(tb.clk)
+        await tb.reset(rng.choice([1, 2]))
+        frame += 1
+        tb.set(rng.choice([700, 1500]), rng.choice([2, 4]))
+        hms = [bitmap_hm(nrng, random_on(nrng, tb.rows, tb.cols, 0.5), tb.thr) for _ in range(2)]
+        await tb.run_frames(rng, hms, frame)
+        frame += 2
+
+
+@cocotb.test()
 async def overrun(dut):
     """Frames faster than they can be labelled (checkerboards back to back, no idle
     cycles) set the sticky overrun_o; a reset clears it and the next frame is exact."""
