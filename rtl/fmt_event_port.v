@@ -237,6 +237,96 @@ module fmt_event_port #(
         end
     end
 
+`ifdef FORMAL
+    // Formal properties (SymbiYosys, formal/fmt_event_port.sby; never seen by synthesis).
+    // No loss, no duplication, in order: one event chosen by the solver (the f_k-th
+    // written, any k) is followed through the RAM, the read register, next, head and
+    // the output register, and leaves exactly as it was written, as the f_k-th event
+    // the consumer takes.  Whole frames: with at most MAX_EV events per frame (an
+    // assumption on the input, the tracker's bound), every event of an admitted frame is
+    // written (never split) and none of a refused one.  Counters saturate.
+    localparam F_CW = AW + 3;                        // event counters (they wrap)
+    reg               f_rstd_q = 1'b0;
+    reg  [F_CW-1:0]   f_w_q, f_i_q, f_p_q, f_c_q;    // written, read issued, popped, consumed
+    (* anyconst *) reg [F_CW-1:0] f_k;               // the tracked event (f_k-th written)
+    reg  [RW-1:0]     f_data_q;                      // its contents
+    reg  [7:0]        f_nev_q;                       // events of the current frame so far
+    reg               f_adm_q;                       // the current frame was admitted
+    wire [RW-1:0]     f_out = {ev_frame_o, ev_time_o, ev_id_o, ev_type_o, ev_x_o, ev_y_o,
+                               ev_strength_o, ev_axis_major_o, ev_axis_minor_o, ev_angle_o,
+                               ev_flags_o, ev_last_o};
+    wire              f_take = ev_valid_o && ev_ready_i;
+    always @(posedge clk) begin
+        f_rstd_q <= f_rstd_q | rst;
+        if (rst) begin
+            f_w_q <= 0; f_i_q <= 0; f_p_q <= 0; f_c_q <= 0; f_nev_q <= 8'd0; f_adm_q <= 1'b0;
+        end else begin
+            if (wr) f_w_q <= f_w_q + 1'b1;
+            if (wr && f_w_q == f_k) f_data_q <= din;
+            if (issue) f_i_q <= f_i_q + 1'b1;
+            if (pop) f_p_q <= f_p_q + 1'b1;
+            if (f_take) f_c_q <= f_c_q + 1'b1;
+            if (in_valid_i) f_nev_q <= in_last_i ? 8'd0 : f_nev_q + 1'b1;
+            if (first) f_adm_q <= decide;
+        end
+    end
+    // the input: at most MAX_EV events per frame (the last one carries in_last_i)
+    always @(*) if (f_rstd_q && !rst && in_valid_i && f_nev_q == MAX_EV - 1) assume (in_last_i);
+    // the tracked event's place (counters wrap: only differences are compared)
+    wire [F_CW-1:0] f_held = f_w_q - f_c_q;          // written, not yet taken
+    wire [F_CW-1:0] f_ram  = f_w_q - f_i_q;          // in the RAM, not yet read
+    wire [F_CW-1:0] f_pipe = f_i_q - f_c_q;          // read register .. output register
+    wire [F_CW-1:0] f_kk   = f_k - f_c_q;            // the tracked event's place in line
+    wire [F_CW-1:0] f_h    = {{(F_CW-1){1'b0}}, ev_valid_o};  // its place when in head
+    wire [F_CW-1:0] f_n    = f_h + head_v_q;         // in next
+    wire [F_CW-1:0] f_q    = f_n + next_v_q;         // in the read register
+    wire [F_CW-1:0] f_kr   = f_kk - f_pipe;          // its offset in the RAM
+    wire [AW-1:0]   f_ka   = rd_ptr_q + f_kr[AW-1:0];
+    always @(*) begin
+        if (f_rstd_q && !rst) begin
+            assert (f_p_q - f_c_q == {{(F_CW-1){1'b0}}, ev_valid_o});
+            assert (f_i_q - f_p_q == {{(F_CW-1){1'b0}}, q_v_q} + next_v_q + head_v_q);
+            assert (f_ram <= DEPTH && wr_ptr_q == rd_ptr_q + f_ram[AW-1:0]);
+            assert ({{(F_CW-AW-1){1'b0}}, count_q} == f_w_q - f_p_q && count_q <= DEPTH);
+            assert (room_q == (count_q <= ROOM) && not_full_q == (count_q < FULL));
+            if (elig_q) assert (head_v_q || next_v_q);
+            // the tracked event, wherever it is, is unchanged
+            if (f_kk < f_held) begin
+                if (ev_valid_o && f_kk == 0)      assert (f_out == f_data_q);
+                if (head_v_q && f_kk == f_h)      assert (head_q == f_data_q);
+                if (next_v_q && f_kk == f_n)      assert (next_q == f_data_q);
+                if (q_v_q && f_kk == f_q)         assert (q_q == f_data_q);
+                if (f_kk >= f_pipe)               assert (mem[f_ka] == f_data_q);
+            end
+            // whole frames: an admitted frame is never split, a refused one never written
+            if (in_valid_i && admit_cur) assert (wr);
+            if (in_valid_i && !admit_cur) assert (!wr);
+            if (in_frame_q) assert (admit_q == f_adm_q);
+            if (in_frame_q && admit_q) assert (count_q + (MAX_EV - f_nev_q) <= DEPTH);  // room kept for the rest
+            if (!in_frame_q) assert (f_nev_q == 8'd0);
+            assert (f_nev_q < MAX_EV);
+        end
+    end
+    // the consumer takes the tracked event as the f_k-th: no loss, no duplicate, in order
+    always @(posedge clk)
+        if (f_rstd_q && !rst && f_take && f_c_q == f_k) assert (f_held != 0 && f_out == f_data_q);
+    // drop and skip counts: +1 per refused frame, saturating
+    reg [CNT_W-1:0] f_dc_q, f_sc_q;
+    reg             f_drop_q, f_skip_q;
+    always @(posedge clk) begin
+        f_dc_q <= drop_count_o; f_sc_q <= skip_count_o;
+        f_drop_q <= !rst && first && !decide && dok_q;
+        f_skip_q <= !rst && first && !decide && !dok_q;
+        if (f_rstd_q && !rst && !$past(rst)) begin
+            if (f_drop_q && f_dc_q != {CNT_W{1'b1}}) assert (drop_count_o == f_dc_q + 1'b1);
+            else                                      assert (drop_count_o == f_dc_q);
+            if (f_skip_q && f_sc_q != {CNT_W{1'b1}}) assert (skip_count_o == f_sc_q + 1'b1);
+            else                                      assert (skip_count_o == f_sc_q);
+            if (f_drop_q) assert (overflow_o);
+        end
+    end
+`endif
+
 endmodule
 
 `default_nettype wire
