@@ -367,7 +367,12 @@ module fmt_localmax #(
         end
     endgenerate
 
-    // column index, its quotient and remainder by 3, as ORs of the one-hot lowest bit
+    // The serialiser's lowest maximum, one-hot, registered (low_q: loaded in every cycle,
+    // used when iv_q is set): its column index, quotient and remainder by 3 and the
+    // capture's selects are decoded from it in the next cycle, each into registers of
+    // its own, so no encoder output fans out to select copies.
+    reg  [COLS-1:0] low_q;
+    // column index, its quotient and remainder by 3, as ORs of the one-hot bits of low_q
     localparam NPC  = COLS + 2;
     localparam NGR  = (NPC + 2) / 3;
     localparam QI_W = $clog2(NGR + 1);
@@ -388,7 +393,7 @@ module fmt_localmax #(
         lo_g1  = {QI_W{1'b0}};
         lo_m   = 2'd0;
         for (i = 0; i < COLS; i = i + 1)
-            if (rem_low[i]) begin
+            if (low_q[i]) begin
                 qd     = i / 3;
                 md     = i % 3;
                 lo_col = lo_col | i[COL_IDX_W-1:0];
@@ -403,28 +408,22 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
 
     reg                 iv_q;                  // a maximum to capture
-    (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
-    reg [COL_IDX_W-1:0] icol_q;
-    // The capture selects a cell of each group in two registered steps: the low LO_W
-    // bits of its number pick one cell in each quarter of the group (NQ quarters of NL
-    // cells: a select local to the quarter's columns, with its own copy of the select
-    // bits per quarter: keep, not merged by synthesis; one copy per quarter and window
-    // row routed at 84.1 MHz, the decode's fan-out to the 36 copies critical), then
-    // the high HI_W bits pick the quarter.
+    // The capture selects a cell of each group in two registered steps: one cell in each
+    // quarter of the group (NQ quarters of NL cells), picked by the one-hot low_q bits of
+    // the columns whose window holds it (a select local to the quarter's columns), then
+    // the quarter, by the high HI_W bits of the cell number decoded from low_q.  (Before:
+    // the select bits encoded from the lowest bit and registered in copies per quarter,
+    // the encoder's fan-out to the copies critical at 84.1 MHz.)
     localparam LO_W = (QI_W > 2) ? 2 : 1;
     localparam HI_W = QI_W - LO_W;
     localparam NL   = 1 << LO_W;
     localparam NQ   = 1 << HI_W;
-    (* fsm_encoding = "none" *)
-    reg [HI_W-1:0]      ih0_q, ih1_q, ih2_q;   // high bits: group 0, 1 cells and icol_q / 3
-    (* fsm_encoding = "none" *)
-    reg [1:0]           im_q;                  // icol_q mod 3
 
     // ---- capture: the 3x3 of the maximum from the window ----------------------------------
     // The three rows padded with a zero cell at each end (padded cell p = column p - 1);
-    // the maximum's window is padded cells p0 .. p0 + 2, p0 = icol_q.  The padded cells
-    // are split by p mod 3 into three groups of NGR cells (cell j of group g is p = 3j + g,
-    // 0 beyond the row): the window holds exactly one cell of each group, cell q or q + 1
+    // the maximum's window is padded cells p0 .. p0 + 2, p0 = the maximum's column.  The
+    // padded cells are split by p mod 3 into three groups of NGR cells (cell j of group g
+    // is p = 3j + g, 0 beyond the row): the window holds exactly one cell of each group, cell q or q + 1
     // (q = p0 / 3, m = p0 mod 3: q + 1 for the groups g < m), and window position k takes
     // group (m + k) mod 3.  Three NGR : 1 selects and a 3 : 1 rotation per row and bit
     // instead of three (COLS + 2) : 1 selects.
@@ -471,17 +470,31 @@ module fmt_localmax #(
     genvar gq;
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
-            (* fsm_encoding = "none", keep *)
-            reg [LO_W-1:0] l0_q, l1_q, l2_q;       // group 0, 1, 2 cell, low bits
+            // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g
+            reg [NL-1:0]   e0, e1, e2;         // group 0, 1, 2: cell gq*NL + l selected
+            reg [Z9_W-1:0] s_d;
             reg [Z9_W-1:0] s_q;
-            always @(posedge clk) begin
-                if (!advs_q) begin
-                    l0_q <= lo_g0[LO_W-1:0];  l1_q <= lo_g1[LO_W-1:0];  l2_q <= lo_q[LO_W-1:0];
+            always @(*) begin : c_sel
+                integer l, i, j;
+                for (l = 0; l < NL; l = l + 1) begin
+                    j     = gq * NL + l;
+                    e0[l] = 1'b0;  e1[l] = 1'b0;  e2[l] = 1'b0;
+                    for (i = 0; i < COLS; i = i + 1) begin
+                        if (i >= 3 * j - 2 && i <= 3 * j)     e0[l] = e0[l] | low_q[i];
+                        if (i >= 3 * j - 1 && i <= 3 * j + 1) e1[l] = e1[l] | low_q[i];
+                        if (i >= 3 * j     && i <= 3 * j + 2) e2[l] = e2[l] | low_q[i];
+                    end
                 end
-                s_q <= {gc2[gq*NL + l2_q], gc1[gq*NL + l1_q], gc0[gq*NL + l0_q],
-                        gb2[gq*NL + l2_q], gb1[gq*NL + l1_q], gb0[gq*NL + l0_q],
-                        ga2[gq*NL + l2_q], ga1[gq*NL + l1_q], ga0[gq*NL + l0_q]};
+                s_d = {Z9_W{1'b0}};
+                for (l = 0; l < NL; l = l + 1)
+                    s_d = s_d | {{HM_W{e2[l]}} & gc2[gq*NL + l], {HM_W{e1[l]}} & gc1[gq*NL + l],
+                                 {HM_W{e0[l]}} & gc0[gq*NL + l],
+                                 {HM_W{e2[l]}} & gb2[gq*NL + l], {HM_W{e1[l]}} & gb1[gq*NL + l],
+                                 {HM_W{e0[l]}} & gb0[gq*NL + l],
+                                 {HM_W{e2[l]}} & ga2[gq*NL + l], {HM_W{e1[l]}} & ga1[gq*NL + l],
+                                 {HM_W{e0[l]}} & ga0[gq*NL + l]};
             end
+            always @(posedge clk) s_q <= s_d;
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
     endgenerate
@@ -615,20 +628,14 @@ module fmt_localmax #(
                 mbot_q <= x2_q;
             end
         end
-        if (!advs_q) begin
-            icol_q <= lo_col;
-            ih0_q  <= lo_g0[QI_W-1:LO_W];
-            ih1_q  <= lo_g1[QI_W-1:LO_W];
-            ih2_q  <= lo_q[QI_W-1:LO_W];
-            im_q   <= lo_m;
-        end
-        p1h0_q    <= ih0_q;
-        p1h1_q    <= ih1_q;
-        p1h2_q    <= ih2_q;
-        p1m_q     <= im_q;
+        low_q     <= rem_low;
+        p1h0_q    <= lo_g0[QI_W-1:LO_W];
+        p1h1_q    <= lo_g1[QI_W-1:LO_W];
+        p1h2_q    <= lo_q[QI_W-1:LO_W];
+        p1m_q     <= lo_m;
         p1top_q   <= mtop_q;
         p1bot_q   <= mbot_q;
-        p1idx_q   <= {mrow_q, icol_q};
+        p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
