@@ -499,7 +499,9 @@ module fmt_localmax #(
         end
     endgenerate
     reg             p1v_q;                     // capture step 1 valid
+    (* fsm_encoding = "none" *)             // (Yosys would extract them as FSMs)
     reg [HI_W-1:0]  p1h0_q, p1h1_q, p1h2_q;    // the quarters of groups 0, 1, 2
+    (* fsm_encoding = "none" *)
     reg [1:0]       p1m_q;
     reg             p1top_q, p1bot_q;
     reg [IDX_W-1:0] p1idx_q;
