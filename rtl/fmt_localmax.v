@@ -275,19 +275,19 @@ module fmt_localmax #(
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
-    // Only registers follow them (taken when the window shifts, with N into w0_q): per
-    // column N > N left (cl_q), N >= threshold (ct_q), N above its earlier neighbours in P
-    // (cu_q) and P's later neighbours in N below P (dm_q: P's "down" mask).  N's partial
-    // mask is a function of these registers in the next cycles (part_c), and P's maxima
-    // are its partial mask AND dm_q, applied in the serialiser (no comparator before it).
+    // Only registers follow them, each comparator's output its own (taken when the window
+    // shifts, with N into w0_q): per column N > N left (cl_q), N >= threshold (ct_q), N >
+    // P (cg_q), N > P left (g1_q) and N > P right (g2_q), no gate between a comparator and
+    // its register.  N's test against its earlier neighbours in P (cu) and P's against
+    // its later neighbours in N (dm: P's "down" mask) are functions of these registers;
+    // N's partial mask is one too (part_c), and P's maxima are its partial mask AND dm,
+    // applied in the serialiser.
     wire [COLS-1:0] gtl;                       // N[c] > N[c-1]
     wire [COLS-1:0] gtv;                       // N[c] > P[c]
-    wire [COLS:0]   gd1;                       // N[c] > P[c-1]
-    wire [COLS:0]   gd2;                       // N[c] > P[c+1] at [c+1]
-    wire [COLS-1:0] thr_n, up_n, down_n;
+    wire [COLS-1:1] gd1;                       // N[c] > P[c-1]
+    wire [COLS-1:1] gd2;                       // N[c] > P[c+1] at [c+1]
+    wire [COLS-1:0] thr_n;
     assign gtl[0] = 1'b1;
-    assign gd1[0] = 1'b1;  assign gd1[COLS] = 1'b0;
-    assign gd2[0] = 1'b0;  assign gd2[COLS] = 1'b1;
     genvar c;
     generate
         for (c = 0; c < COLS; c = c + 1) begin : g_cmp
@@ -302,28 +302,32 @@ module fmt_localmax #(
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
             assign thr_n[c] = (n >= threshold_i);
-            // N's earlier neighbours in P: above, above-left, above-right (strict)
-            assign up_n[c]  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
-            // P's later neighbours in N: below, below-left, below-right (P >= them)
-            assign down_n[c] = x2_q || (!gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c])));
         end
     endgenerate
     reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
-    reg [COLS-1:0]  ct_q, cu_q;                // thr_n, up_n of w0_q's row
-    reg [COLS-1:0]  dm_q;                      // down_n: w1_q's row >= its later neighbours
+    reg [COLS-1:0]  ct_q, cg_q;                // thr_n, gtv: w0_q's row against w1_q's
+    reg [COLS-1:1]  g1_q, g2_q;                // gd1, gd2 (d1, d2 below: with the constant ends)
     reg             t3_q;                      // w0_q's row is row 0
+    reg             mtop_q, mbot_q;            // w1_q is the first / last row
     wire [COLS:0]   cl = {1'b0, cl_q};
+    wire [COLS:0]   d1 = {1'b0, g1_q, 1'b1};
+    wire [COLS:0]   d2 = {1'b1, g2_q, 1'b0};
+    // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
+    // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
+    // below-left, below-right; all of them when w1_q holds the last row)
+    wire [COLS-1:0] cu = cg_q & ({COLS{!moore_i}} | (d1[COLS-1:0] & d2[COLS:1]));
+    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & ({COLS{!moore_i}} | (~d1[COLS:1] & ~d2[COLS-1:0])));
     // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
-    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu_q | {COLS{t3_q}});
+    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu | {COLS{t3_q}});
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
     reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
-    reg                 mtop_q, mbot_q;        // w1_q is the first / last row
     // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
-    // shifts it into w1_q) AND its test against the row below (dm_q, loaded then too)
-    wire [COLS-1:0] rem_e   = rem_q & dm_q;
+    // shifts it into w1_q) AND its test against the row below (dm, of the registers
+    // loaded then too)
+    wire [COLS-1:0] rem_e   = rem_q & dm;
     wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
@@ -360,9 +364,15 @@ module fmt_localmax #(
                     w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
                     cl_q[gk]              <= gtl[gk];
                     ct_q[gk]              <= thr_n[gk];
-                    cu_q[gk]              <= up_n[gk];
-                    dm_q[gk]              <= down_n[gk];
+                    cg_q[gk]              <= gtv[gk];
                 end
+            end
+            if (gk > 0) begin : g_d
+                always @(posedge clk)
+                    if (wsh_q[(gk * NWC) / COLS]) begin
+                        g1_q[gk] <= gd1[gk];
+                        g2_q[gk] <= gd2[gk];
+                    end
             end
         end
     endgenerate
