@@ -419,9 +419,10 @@ module fmt_localmax #(
 
     reg                 iv_q;                  // a maximum to capture
     // The capture selects a cell of each group in two registered steps: one cell in each
-    // quarter of the group (NQ quarters of NL cells), picked by the one-hot low_q bits of
-    // the columns whose window holds it (a select local to the quarter's columns), then
-    // the quarter, by the high HI_W bits of the cell number decoded from low_q.  (Before:
+    // quarter of the group (NQ quarters of NL cells), by its number within the quarter
+    // decoded from the low_q bits of the quarter's columns (a select local to the
+    // quarter's columns), then the quarter, by the high HI_W bits of the cell number
+    // decoded from low_q.  (Before:
     // the select bits encoded from the lowest bit and registered in copies per quarter,
     // the encoder's fan-out to the copies critical at 84.1 MHz.)
     localparam LO_W = (QI_W > 2) ? 2 : 1;
@@ -480,31 +481,27 @@ module fmt_localmax #(
     genvar gq;
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
-            // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g
-            reg [NL-1:0]   e0, e1, e2;         // group 0, 1, 2: cell gq*NL + l selected
-            reg [Z9_W-1:0] s_d;
+            // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g: its
+            // number within the quarter, from the low_q bits of the quarter's columns (0
+            // when the maximum is in another quarter: step 2 does not pick this one)
+            reg [LO_W-1:0] l0, l1, l2;         // group 0, 1, 2 cell, low bits
             reg [Z9_W-1:0] s_q;
+            /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
             always @(*) begin : c_sel
-                integer l, i, j;
-                for (l = 0; l < NL; l = l + 1) begin
-                    j     = gq * NL + l;
-                    e0[l] = 1'b0;  e1[l] = 1'b0;  e2[l] = 1'b0;
-                    for (i = 0; i < COLS; i = i + 1) begin
-                        if (i >= 3 * j - 2 && i <= 3 * j)     e0[l] = e0[l] | low_q[i];
-                        if (i >= 3 * j - 1 && i <= 3 * j + 1) e1[l] = e1[l] | low_q[i];
-                        if (i >= 3 * j     && i <= 3 * j + 2) e2[l] = e2[l] | low_q[i];
-                    end
+                integer i, j0, j1, j2;
+                l0 = {LO_W{1'b0}};  l1 = {LO_W{1'b0}};  l2 = {LO_W{1'b0}};
+                for (i = 0; i < COLS; i = i + 1) begin
+                    j0 = (i + 2) / 3;  j1 = (i + 1) / 3;  j2 = i / 3;
+                    if (j0 / NL == gq) l0 = l0 | ({LO_W{low_q[i]}} & j0[LO_W-1:0]);
+                    if (j1 / NL == gq) l1 = l1 | ({LO_W{low_q[i]}} & j1[LO_W-1:0]);
+                    if (j2 / NL == gq) l2 = l2 | ({LO_W{low_q[i]}} & j2[LO_W-1:0]);
                 end
-                s_d = {Z9_W{1'b0}};
-                for (l = 0; l < NL; l = l + 1)
-                    s_d = s_d | {{HM_W{e2[l]}} & gc2[gq*NL + l], {HM_W{e1[l]}} & gc1[gq*NL + l],
-                                 {HM_W{e0[l]}} & gc0[gq*NL + l],
-                                 {HM_W{e2[l]}} & gb2[gq*NL + l], {HM_W{e1[l]}} & gb1[gq*NL + l],
-                                 {HM_W{e0[l]}} & gb0[gq*NL + l],
-                                 {HM_W{e2[l]}} & ga2[gq*NL + l], {HM_W{e1[l]}} & ga1[gq*NL + l],
-                                 {HM_W{e0[l]}} & ga0[gq*NL + l]};
             end
-            always @(posedge clk) s_q <= s_d;
+            /* verilator lint_on UNUSEDSIGNAL */
+            always @(posedge clk)
+                s_q <= {gc2[gq*NL + l2], gc1[gq*NL + l1], gc0[gq*NL + l0],
+                        gb2[gq*NL + l2], gb1[gq*NL + l1], gb0[gq*NL + l0],
+                        ga2[gq*NL + l2], ga1[gq*NL + l1], ga0[gq*NL + l0]};
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
     endgenerate
