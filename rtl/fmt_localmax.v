@@ -26,19 +26,21 @@
 //        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
 //        (5 x COLS comparators; each pair of cells is compared once: P's "below" tests
 //        are the negations of N's "above" tests), registered when the window shifts
-//        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1): per column N's left,
-//        threshold and above tests (N's partial mask, earlier neighbours, is a function
-//        of these registers) and P's down mask (its later neighbours in N).  Only the one
-//        LUT of each test follows a comparator.
+//        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1), each comparator's
+//        output in a register of its own (no gate between them): N's above test and
+//        partial mask (earlier neighbours) and P's down mask (its later neighbours in N)
+//        are functions of these registers.
 //   SW4  serialise P's maxima, lowest column first, one per cycle: P's partial mask
-//        (loaded at the shift) AND its down mask (the sweep waits: a row with k maxima
+//        (loaded at the shift) AND its down mask; the lowest maximum is registered
+//        one-hot and decoded in the next cycle (the sweep waits: a row with k maxima
 //        holds the window k cycles, a row with none but a non-empty partial mask one
 //        cycle; the stall enable is a register, computed a cycle early from the partial
 //        mask and the serialiser's mask, in copies per column group: no comparator and
 //        no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
-//        each quarter of a group (select copies per quarter), then the quarter;
+//        each quarter of a group (its select decoded per quarter from the one-hot
+//        lowest maximum), then the quarter;
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
