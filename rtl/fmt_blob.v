@@ -1094,29 +1094,30 @@ module fmt_blob #(
         lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
-    // the row whose close records are read (bw_first ? LAST_ROW : bw_row_q + 1),
-    // registered from bw_row1_q, in copies per NCF labels (keep: the read-address fan-out)
-    localparam NCF = 13;
-    reg  [((NL + NCF - 1) / NCF)*ROW_IDX_W-1:0] cf_row_q;
-    genvar gc;
-    generate
-        for (gc = 0; gc < (NL + NCF - 1) / NCF; gc = gc + 1) begin : g_cfr
-            (* keep *) always @(posedge clk)   // (read while the pass runs only)
-                cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W] <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
-        end
-    endgenerate
-    // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
-    // was a blob (written by the close engine, read for row cf_row)
+    // Close records: per row r a word of NL fields of CFB bits, field l-1 all set when
+    // label l closed at the end of row r was a blob (written by the close engine, one
+    // field per cycle: block RAM with byte enables, no read-modify-write); read for the
+    // row bw_first ? LAST_ROW : bw_row_q + 1 synchronously, from bw_row1_q (keep: the
+    // read-address register and the enables of the pass are not shared)
+    localparam CFB = 8;                       // bits per label field: one byte enable
+    wire [ROW_IDX_W-1:0] cf_row_nx = (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
+    (* ram_style = "block", no_rw_check *)    // (written while labelling, read in the pass)
+    reg  [NL*CFB-1:0]    cf_mem [0:ROWS-1];
+    /* verilator lint_off UNUSEDSIGNAL */     // a field's bits beyond the first
+    reg  [NL*CFB-1:0]    cf_rd_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    always @(posedge clk) begin : s_cf
+        integer l;
+        for (l = 1; l <= NL; l = l + 1)
+            if (cl_v_q && cl_lbl_q == l[LBL_W-1:0])
+                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isblob}};
+        cf_rd_q <= cf_mem[cf_row_nx];
+    end
     wire [NL:1]          cfr;
     genvar gl;
     generate
         for (gl = 1; gl <= NL; gl = gl + 1) begin : g_cf
-            localparam [LBL_W-1:0] LBL = gl;
-            reg cf_mem [0:ROWS-1];
-            always @(posedge clk) begin
-                if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= cl_isblob;
-            end
-            assign cfr[gl] = cf_mem[cf_row_q[((gl - 1) / NCF)*ROW_IDX_W +: ROW_IDX_W]];
+            assign cfr[gl] = cf_rd_q[(gl-1)*CFB];
         end
     endgenerate
     // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
