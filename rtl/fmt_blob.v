@@ -274,10 +274,14 @@ module fmt_blob #(
         for (i = 0; i < COLS; i = i + 1)
             hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
     end
+    // a copy in block RAM for the labelling's row end (read synchronously into lr_on_q)
+    (* ram_style = "block", no_rw_check *)    // (a row is not rewritten while labelled)
+    reg [COLS-1:0]       on_bm [0:(2<<ROW_IDX_W)-1];
     always @(posedge clk) begin
         if (hm_valid_i) begin
             mem[wr_addr]    <= hm_data_i;
             on_mem[{wb_q, hm_row_i}] <= hm_on;
+            on_bm[{wb_q, hm_row_i}]  <= hm_on;
         end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
@@ -525,42 +529,47 @@ module fmt_blob #(
     reg [AREA_W-1:0]    x3_cnt_q;
     reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
-    reg [NG*SX_W-1:0]   x3_gw_q;              // per group: sum z*c
+    // sum z*c = sum over the groups of (sum z*(c mod 8) + 8g * sum z): X3 adds the
+    // groups' sums z*(c mod 8) (a balanced tree) and T = sum g * (sum z of group g)
+    // (by the bits of g), X4 adds the two: sum z*c = that sum + 8 T
+    localparam NGB   = (NG > 1) ? $clog2(NG) : 1;           // bits of a group index
+    localparam GXT_W = GSX_W + NGB;                          // sum of the groups' gx
+    localparam GT_W  = GSZ_W + $clog2(NG * (NG - 1) / 2 + 1); // T
+    reg [GXT_W-1:0]     x3_gx_q;
+    reg [GT_W-1:0]      x3_gt_q;
     reg [NG*SZ_W-1:0]   tr_s;                 // sum z: a balanced tree over the groups
-    reg [NG*SX_W-1:0]   gw;
+    reg [NG*GXT_W-1:0]  tr_g;                 // sum z*(c mod 8): the same tree
+    reg [NGB*GT_W-1:0]  gtb;                  // per bit b of g: sum of the groups' sum z
+    reg [GT_W-1:0]      gt;
     always @(*) begin : c_x3
         integer g, b, n;
+        gtb = {(NGB*GT_W){1'b0}};
         for (g = 0; g < NG; g = g + 1) begin
-            tr_s[g*SZ_W +: SZ_W] = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
-            // sum z*c of the group = sum z*(c mod 8) + 8g * sum z, shift-add
-            gw[g*SX_W +: SX_W] = {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
-            for (b = 0; b < COL_IDX_W; b = b + 1)
-                if ((((g * GS) >> b) & 1) == 1)
-                    gw[g*SX_W +: SX_W] = gw[g*SX_W +: SX_W]
-                        + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
+            tr_s[g*SZ_W +: SZ_W]   = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            tr_g[g*GXT_W +: GXT_W] = {{(GXT_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            for (b = 0; b < NGB; b = b + 1)
+                if (((g >> b) & 1) == 1)
+                    gtb[b*GT_W +: GT_W] = gtb[b*GT_W +: GT_W]
+                                        + {{(GT_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
         end
+        gt = {GT_W{1'b0}};
+        for (b = 0; b < NGB; b = b + 1)
+            gt = gt + (gtb[b*GT_W +: GT_W] << b);
         // pairwise: entry k = entries 2k + 2k+1 (written after both are read)
         for (n = NG; n > 1; n = (n + 1) / 2)
             for (g = 0; g < (n + 1) / 2; g = g + 1)
-                if (2 * g + 1 < n)
+                if (2 * g + 1 < n) begin
                     tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W]
                                          + tr_s[((2*g+1 < NG) ? 2*g+1 : 0)*SZ_W +: SZ_W];
-                else
-                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W];
+                    tr_g[g*GXT_W +: GXT_W] = tr_g[(2*g)*GXT_W +: GXT_W]
+                                           + tr_g[((2*g+1 < NG) ? 2*g+1 : 0)*GXT_W +: GXT_W];
+                end else begin
+                    tr_s[g*SZ_W +: SZ_W]   = tr_s[(2*g)*SZ_W +: SZ_W];
+                    tr_g[g*GXT_W +: GXT_W] = tr_g[(2*g)*GXT_W +: GXT_W];
+                end
     end
-    // X4: sum z*c, a balanced tree over the groups' sums
-    reg [NG*SX_W-1:0]   tr_x;
-    always @(*) begin : c_x4
-        integer g, n;
-        tr_x = x3_gw_q;
-        for (n = NG; n > 1; n = (n + 1) / 2)
-            for (g = 0; g < (n + 1) / 2; g = g + 1)
-                if (2 * g + 1 < n)
-                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W]
-                                         + tr_x[((2*g+1 < NG) ? 2*g+1 : 0)*SX_W +: SX_W];
-                else
-                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W];
-    end
+    // X4: sum z*c
+    wire [SX_W-1:0] sx4 = {{(SX_W-GXT_W){1'b0}}, x3_gx_q} + ({{(SX_W-GT_W){1'b0}}, x3_gt_q} << $clog2(GS));
 
 
     // ---- X4, X5: sum z*r = r * sum z, shift and add (low and high row bits, then both)
@@ -837,7 +846,6 @@ module fmt_blob #(
     reg [LR_W-1:0]           lr_mem [0:ROWS-1];     // {on-cells, pair labels} of a row
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
-    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
     // The run's cells share its label at the row end, and two run starts are never
     // adjacent: per column pair one label is kept, the label of the pair's run start (if
     // any).  Written one cycle after the row end, from C and the row's on-cells then.
@@ -857,7 +865,7 @@ module fmt_blob #(
     always @(posedge clk) begin
         lr_we_q  <= row_done && !rst;
         lr_row_q <= l2_row;
-        lr_on_q  <= on_l2;
+        lr_on_q  <= on_bm[{pb_q, l2_row}];    // the row's on-cells
         if (lr_we_q) lr_mem[lr_row_q] <= {lr_on_q, lr_pl};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
@@ -1231,9 +1239,9 @@ module fmt_blob #(
         x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= tr_s[SZ_W-1:0];  x3_gw_q <= gw;  x3_pk_q <= pk3[PN3*PK_W-1:0];
+        x3_s_q <= tr_s[SZ_W-1:0];  x3_gx_q <= tr_g[GXT_W-1:0];  x3_gt_q <= gt;  x3_pk_q <= pk3[PN3*PK_W-1:0];
         y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
-        y4_sx_q <= tr_x[SX_W-1:0];
+        y4_sx_q <= sx4;
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
