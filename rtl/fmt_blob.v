@@ -5,7 +5,8 @@
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,
 // stored in an inferred block RAM of 2 x ROWS words of COLS*HM_W bits (two frame
 // buffers, as in fmt_localmax), and their on-cells (z >= blob_threshold_i as the row
-// arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
+// arrives) in a LUT RAM (on_mem; a block-RAM copy, on_bm, for the row ends).  The
+// frame is labelled in raster order as soon as a
 // prefix of rows is present:
 //   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
 //       against the previous row's on-cells P (A = C & P) the row's events are found:
@@ -17,8 +18,9 @@
 //   E : one event per cycle (lowest remaining event column, one carry chain), the C
 //       run's columns for a RUN event.
 //   X1..X5: the run's sums: X2 the masked cells' sums per 8-column group and the
-//       extent; X3 sum z over the groups (a balanced tree) and each group's sum z*c;
-//       X4 sum z*c (a balanced tree) and the two halves of sum z*r = r * sum z (shift
+//       extent; X3 sum z over the groups and the groups' sums z*(c mod 8) (balanced
+//       trees) and T = sum g * (group g's sum z); X4 sum z*c = that sum + 8 T and the
+//       two halves of sum z*r = r * sum z (shift
 //       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
 //       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
 //       extraction runs ahead of the labelling by up to the FIFO depth.
@@ -70,7 +72,8 @@
 // run starts are never adjacent); at the end of row r+1, for each label of row r,
 // whether it continued into row r+1 and as which label (after the merges of row r+1)
 // (fr_mem); and the close engine stores, per label and row r, whether the
-// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
+// label closed at the end of row r was a blob (cf_mem: block RAM, a byte enable per
+// label).  After the frame a pass from
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
 // not continue, its close record; one stage later every run start of the row gets its
