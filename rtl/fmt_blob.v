@@ -855,6 +855,11 @@ module fmt_blob #(
     reg                  lr_we_q;
     reg [ROW_IDX_W-1:0]  lr_row_q;
     reg [COLS-1:0]       lr_on_q;
+    // on_bm read a cycle ahead, at L2's next row (the block RAM's read register, then
+    // lr_on_q as its output register)
+    wire [ROW_IDX_W-1:0] l2_row_nx = l2_ld ? l1_e_q[F_ROW +: ROW_IDX_W] : l2_row;
+    reg  [COLS-1:0]      on_bm_q;
+    always @(posedge clk) on_bm_q <= on_bm[{pb_q, l2_row_nx}];
     reg [NPR*LBL_W-1:0]  lr_pl;
     always @(*) begin : c_lr_pl
         integer j;
@@ -868,7 +873,7 @@ module fmt_blob #(
     always @(posedge clk) begin
         lr_we_q  <= row_done && !rst;
         lr_row_q <= l2_row;
-        lr_on_q  <= on_bm[{pb_q, l2_row}];    // the row's on-cells
+        lr_on_q  <= on_bm_q;                  // the row's on-cells
         if (lr_we_q) lr_mem[lr_row_q] <= {lr_on_q, lr_pl};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
@@ -1108,27 +1113,30 @@ module fmt_blob #(
     // Close records: per row r a word of NL fields of CFB bits, field l-1 all set when
     // label l closed at the end of row r was a blob (written by the close engine, one
     // field per cycle: block RAM with byte enables, no read-modify-write); read for the
-    // row bw_first ? LAST_ROW : bw_row_q + 1 synchronously, from bw_row1_q (keep: the
-    // read-address register and the enables of the pass are not shared)
+    // row bw_first ? LAST_ROW : bw_row_q + 1 in two registered steps beside fr_mem, the
+    // address from bw_r_q
     localparam CFB = 8;                       // bits per label field: one byte enable
-    wire [ROW_IDX_W-1:0] cf_row_nx = (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
+    wire [ROW_IDX_W-1:0] cf_row_nx = (bw_r_q == LAST_ROW) ? LAST_ROW : bw_r_q + 1'b1;
     (* ram_style = "block", no_rw_check *)    // (written while labelling, read in the pass)
     reg  [NL*CFB-1:0]    cf_mem [0:ROWS-1];
     /* verilator lint_off UNUSEDSIGNAL */     // a field's bits beyond the first
-    reg  [NL*CFB-1:0]    cf_rd_q;
+    reg  [NL*CFB-1:0]    cf_rd1_q;
     /* verilator lint_on UNUSEDSIGNAL */
+    reg  [NL:1]          cf_rd_q;
     always @(posedge clk) begin : s_cf
         integer l;
         for (l = 1; l <= NL; l = l + 1)
             if (cl_v_q && cl_lbl_q == l[LBL_W-1:0])
                 cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isblob}};
-        cf_rd_q <= cf_mem[cf_row_nx];
+        cf_rd1_q <= cf_mem[cf_row_nx];        // with fr_rd1_q (row bw_r_q)
+        for (l = 1; l <= NL; l = l + 1)
+            cf_rd_q[l] <= cf_rd1_q[(l-1)*CFB]; // the output register, with fr_rd_q
     end
     wire [NL:1]          cfr;
     genvar gl;
     generate
         for (gl = 1; gl <= NL; gl = gl + 1) begin : g_cf
-            assign cfr[gl] = cf_rd_q[(gl-1)*CFB];
+            assign cfr[gl] = cf_rd_q[gl];
         end
     endgenerate
     // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
