@@ -5,8 +5,7 @@
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most,
 // stored in an inferred block RAM of 2 x ROWS words of COLS*HM_W bits (two frame
 // buffers, as in fmt_localmax), and their on-cells (z >= blob_threshold_i as the row
-// arrives) in a LUT RAM (on_mem; a block-RAM copy, on_bm, for the row ends).  The
-// frame is labelled in raster order as soon as a
+// arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
 // prefix of rows is present:
 //   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
 //       against the previous row's on-cells P (A = C & P) the row's events are found:
@@ -277,14 +276,10 @@ module fmt_blob #(
         for (i = 0; i < COLS; i = i + 1)
             hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
     end
-    // a copy in block RAM for the labelling's row end (read synchronously into lr_on_q)
-    (* ram_style = "block", no_rw_check *)    // (a row is not rewritten while labelled)
-    reg [COLS-1:0]       on_bm [0:(2<<ROW_IDX_W)-1];
     always @(posedge clk) begin
         if (hm_valid_i) begin
             mem[wr_addr]    <= hm_data_i;
             on_mem[{wb_q, hm_row_i}] <= hm_on;
-            on_bm[{wb_q, hm_row_i}]  <= hm_on;
         end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
@@ -854,12 +849,8 @@ module fmt_blob #(
     // any).  Written one cycle after the row end, from C and the row's on-cells then.
     reg                  lr_we_q;
     reg [ROW_IDX_W-1:0]  lr_row_q;
+    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
     reg [COLS-1:0]       lr_on_q;
-    // on_bm read a cycle ahead, at L2's next row (the block RAM's read register, then
-    // lr_on_q as its output register)
-    wire [ROW_IDX_W-1:0] l2_row_nx = l2_ld ? l1_e_q[F_ROW +: ROW_IDX_W] : l2_row;
-    reg  [COLS-1:0]      on_bm_q;
-    always @(posedge clk) on_bm_q <= on_bm[{pb_q, l2_row_nx}];
     reg [NPR*LBL_W-1:0]  lr_pl;
     always @(*) begin : c_lr_pl
         integer j;
@@ -873,7 +864,7 @@ module fmt_blob #(
     always @(posedge clk) begin
         lr_we_q  <= row_done && !rst;
         lr_row_q <= l2_row;
-        lr_on_q  <= on_bm_q;                  // the row's on-cells
+        lr_on_q  <= on_l2;
         if (lr_we_q) lr_mem[lr_row_q] <= {lr_on_q, lr_pl};
         if (row_done && l2_row != {ROW_IDX_W{1'b0}})
             fr_mem[l2_row - 1'b1] <= {cont_rec, alias_nx};
