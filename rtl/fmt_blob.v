@@ -390,9 +390,11 @@ module fmt_blob #(
     wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
     wire                 ev_run  = |(e1_b_q & e1_cs);
     wire [COLS-1:0]      cge     = e1_c_q & e1_ge_q;
-    wire [COLS-1:0]      crun    = cge & ~(cge + e1_b_q); // the C run starting at b
-    wire [COLS-1:0]      ev_m    = ev_run ? crun : {COLS{1'b0}};
-    wire [COLS-1:0]      ev_lc   = ev_run ? (e1_fa_q & crun) : e1_b_q;
+    // the C run starting at b for a run event (the carry of b & cs runs through it), 0
+    // for a merge event; the label column: the run's first A cell, or a merge event's b
+    // (no OR over the columns on these paths: ev_run is for the flags only)
+    wire [COLS-1:0]      ev_m    = cge & ~(cge + (e1_b_q & e1_cs));
+    wire [COLS-1:0]      ev_lc   = (e1_fa_q & ev_m) | (e1_b_q & ~e1_cs);
 
     // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
     // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
