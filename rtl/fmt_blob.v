@@ -17,8 +17,9 @@
 //   E : one event per cycle (lowest remaining event column, one carry chain), the C
 //       run's columns for a RUN event.
 //   X1..X5: the run's sums: X2 the masked cells' sums per 8-column group and the
-//       extent; X3 sum z over the groups (a balanced tree) and each group's sum z*c;
-//       X4 sum z*c (a balanced tree) and the two halves of sum z*r = r * sum z (shift
+//       extent; X3 sum z over the groups and the groups' sums z*(c mod 8) (balanced
+//       trees) and T = sum g * (group g's sum z); X4 sum z*c = that sum + 8 T and the
+//       two halves of sum z*r = r * sum z (shift
 //       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
 //       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
 //       extraction runs ahead of the labelling by up to the FIFO depth.
@@ -70,7 +71,8 @@
 // run starts are never adjacent); at the end of row r+1, for each label of row r,
 // whether it continued into row r+1 and as which label (after the merges of row r+1)
 // (fr_mem); and the close engine stores, per label and row r, whether the
-// label closed at the end of row r was a blob (cf_mem).  After the frame a pass from
+// label closed at the end of row r was a blob (cf_mem: block RAM, a byte enable per
+// label).  After the frame a pass from
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
 // not continue, its close record; one stage later every run start of the row gets its
@@ -388,9 +390,11 @@ module fmt_blob #(
     wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
     wire                 ev_run  = |(e1_b_q & e1_cs);
     wire [COLS-1:0]      cge     = e1_c_q & e1_ge_q;
-    wire [COLS-1:0]      crun    = cge & ~(cge + e1_b_q); // the C run starting at b
-    wire [COLS-1:0]      ev_m    = ev_run ? crun : {COLS{1'b0}};
-    wire [COLS-1:0]      ev_lc   = ev_run ? (e1_fa_q & crun) : e1_b_q;
+    // the C run starting at b for a run event (the carry of b & cs runs through it), 0
+    // for a merge event; the label column: the run's first A cell, or a merge event's b
+    // (no OR over the columns on these paths: ev_run is for the flags only)
+    wire [COLS-1:0]      ev_m    = cge & ~(cge + (e1_b_q & e1_cs));
+    wire [COLS-1:0]      ev_lc   = (e1_fa_q & ev_m) | (e1_b_q & ~e1_cs);
 
     // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
     // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
@@ -525,42 +529,47 @@ module fmt_blob #(
     reg [AREA_W-1:0]    x3_cnt_q;
     reg [COL_IDX_W-1:0] x3_cmin_q, x3_cmax_q;
     reg [SZ_W-1:0]      x3_s_q;
-    reg [NG*SX_W-1:0]   x3_gw_q;              // per group: sum z*c
+    // sum z*c = sum over the groups of (sum z*(c mod 8) + 8g * sum z): X3 adds the
+    // groups' sums z*(c mod 8) (a balanced tree) and T = sum g * (sum z of group g)
+    // (by the bits of g), X4 adds the two: sum z*c = that sum + 8 T
+    localparam NGB   = (NG > 1) ? $clog2(NG) : 1;           // bits of a group index
+    localparam GXT_W = GSX_W + NGB;                          // sum of the groups' gx
+    localparam GT_W  = GSZ_W + $clog2(NG * (NG - 1) / 2 + 1); // T
+    reg [GXT_W-1:0]     x3_gx_q;
+    reg [GT_W-1:0]      x3_gt_q;
     reg [NG*SZ_W-1:0]   tr_s;                 // sum z: a balanced tree over the groups
-    reg [NG*SX_W-1:0]   gw;
+    reg [NG*GXT_W-1:0]  tr_g;                 // sum z*(c mod 8): the same tree
+    reg [NGB*GT_W-1:0]  gtb;                  // per bit b of g: sum of the groups' sum z
+    reg [GT_W-1:0]      gt;
     always @(*) begin : c_x3
         integer g, b, n;
+        gtb = {(NGB*GT_W){1'b0}};
         for (g = 0; g < NG; g = g + 1) begin
-            tr_s[g*SZ_W +: SZ_W] = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
-            // sum z*c of the group = sum z*(c mod 8) + 8g * sum z, shift-add
-            gw[g*SX_W +: SX_W] = {{(SX_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
-            for (b = 0; b < COL_IDX_W; b = b + 1)
-                if ((((g * GS) >> b) & 1) == 1)
-                    gw[g*SX_W +: SX_W] = gw[g*SX_W +: SX_W]
-                        + ({{(SX_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]} << b);
+            tr_s[g*SZ_W +: SZ_W]   = {{(SZ_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
+            tr_g[g*GXT_W +: GXT_W] = {{(GXT_W-GSX_W){1'b0}}, x2_gx_q[g*GSX_W +: GSX_W]};
+            for (b = 0; b < NGB; b = b + 1)
+                if (((g >> b) & 1) == 1)
+                    gtb[b*GT_W +: GT_W] = gtb[b*GT_W +: GT_W]
+                                        + {{(GT_W-GSZ_W){1'b0}}, x2_gs_q[g*GSZ_W +: GSZ_W]};
         end
+        gt = {GT_W{1'b0}};
+        for (b = 0; b < NGB; b = b + 1)
+            gt = gt + (gtb[b*GT_W +: GT_W] << b);
         // pairwise: entry k = entries 2k + 2k+1 (written after both are read)
         for (n = NG; n > 1; n = (n + 1) / 2)
             for (g = 0; g < (n + 1) / 2; g = g + 1)
-                if (2 * g + 1 < n)
+                if (2 * g + 1 < n) begin
                     tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W]
                                          + tr_s[((2*g+1 < NG) ? 2*g+1 : 0)*SZ_W +: SZ_W];
-                else
-                    tr_s[g*SZ_W +: SZ_W] = tr_s[(2*g)*SZ_W +: SZ_W];
+                    tr_g[g*GXT_W +: GXT_W] = tr_g[(2*g)*GXT_W +: GXT_W]
+                                           + tr_g[((2*g+1 < NG) ? 2*g+1 : 0)*GXT_W +: GXT_W];
+                end else begin
+                    tr_s[g*SZ_W +: SZ_W]   = tr_s[(2*g)*SZ_W +: SZ_W];
+                    tr_g[g*GXT_W +: GXT_W] = tr_g[(2*g)*GXT_W +: GXT_W];
+                end
     end
-    // X4: sum z*c, a balanced tree over the groups' sums
-    reg [NG*SX_W-1:0]   tr_x;
-    always @(*) begin : c_x4
-        integer g, n;
-        tr_x = x3_gw_q;
-        for (n = NG; n > 1; n = (n + 1) / 2)
-            for (g = 0; g < (n + 1) / 2; g = g + 1)
-                if (2 * g + 1 < n)
-                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W]
-                                         + tr_x[((2*g+1 < NG) ? 2*g+1 : 0)*SX_W +: SX_W];
-                else
-                    tr_x[g*SX_W +: SX_W] = tr_x[(2*g)*SX_W +: SX_W];
-    end
+    // X4: sum z*c
+    wire [SX_W-1:0] sx4 = {{(SX_W-GXT_W){1'b0}}, x3_gx_q} + ({{(SX_W-GT_W){1'b0}}, x3_gt_q} << $clog2(GS));
 
 
     // ---- X4, X5: sum z*r = r * sum z, shift and add (low and high row bits, then both)
@@ -837,12 +846,12 @@ module fmt_blob #(
     reg [LR_W-1:0]           lr_mem [0:ROWS-1];     // {on-cells, pair labels} of a row
     (* ram_style = "block" *)
     reg [NL*(LBL_W+1)-1:0]   fr_mem [0:ROWS-1];
-    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
     // The run's cells share its label at the row end, and two run starts are never
     // adjacent: per column pair one label is kept, the label of the pair's run start (if
     // any).  Written one cycle after the row end, from C and the row's on-cells then.
     reg                  lr_we_q;
     reg [ROW_IDX_W-1:0]  lr_row_q;
+    wire [COLS-1:0]      on_l2 = on_mem[{pb_q, l2_row}];     // the row's on-cells
     reg [COLS-1:0]       lr_on_q;
     reg [NPR*LBL_W-1:0]  lr_pl;
     always @(*) begin : c_lr_pl
@@ -1094,29 +1103,33 @@ module fmt_blob #(
         lr_rd_q <= lr_rd1_q;
     end
     wire                 bw_first = (bw_row_q == LAST_ROW);
-    // the row whose close records are read (bw_first ? LAST_ROW : bw_row_q + 1),
-    // registered from bw_row1_q, in copies per NCF labels (keep: the read-address fan-out)
-    localparam NCF = 13;
-    reg  [((NL + NCF - 1) / NCF)*ROW_IDX_W-1:0] cf_row_q;
-    genvar gc;
-    generate
-        for (gc = 0; gc < (NL + NCF - 1) / NCF; gc = gc + 1) begin : g_cfr
-            (* keep *) always @(posedge clk)   // (read while the pass runs only)
-                cf_row_q[gc*ROW_IDX_W +: ROW_IDX_W] <= (bw_row1_q == LAST_ROW) ? LAST_ROW : bw_row1_q + 1'b1;
-        end
-    endgenerate
-    // per label a ROWS x 1 distributed RAM: bit r = the label closed at the end of row r
-    // was a blob (written by the close engine, read for row cf_row)
+    // Close records: per row r a word of NL fields of CFB bits, field l-1 all set when
+    // label l closed at the end of row r was a blob (written by the close engine, one
+    // field per cycle: block RAM with byte enables, no read-modify-write); read for the
+    // row bw_first ? LAST_ROW : bw_row_q + 1 in two registered steps beside fr_mem, the
+    // address from bw_r_q
+    localparam CFB = 8;                       // bits per label field: one byte enable
+    wire [ROW_IDX_W-1:0] cf_row_nx = (bw_r_q == LAST_ROW) ? LAST_ROW : bw_r_q + 1'b1;
+    (* ram_style = "block", no_rw_check *)    // (written while labelling, read in the pass)
+    reg  [NL*CFB-1:0]    cf_mem [0:ROWS-1];
+    /* verilator lint_off UNUSEDSIGNAL */     // a field's bits beyond the first
+    reg  [NL*CFB-1:0]    cf_rd1_q;
+    /* verilator lint_on UNUSEDSIGNAL */
+    reg  [NL:1]          cf_rd_q;
+    always @(posedge clk) begin : s_cf
+        integer l;
+        for (l = 1; l <= NL; l = l + 1)
+            if (cl_v_q && cl_lbl_q == l[LBL_W-1:0])
+                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isblob}};
+        cf_rd1_q <= cf_mem[cf_row_nx];        // with fr_rd1_q (row bw_r_q)
+        for (l = 1; l <= NL; l = l + 1)
+            cf_rd_q[l] <= cf_rd1_q[(l-1)*CFB]; // the output register, with fr_rd_q
+    end
     wire [NL:1]          cfr;
     genvar gl;
     generate
         for (gl = 1; gl <= NL; gl = gl + 1) begin : g_cf
-            localparam [LBL_W-1:0] LBL = gl;
-            reg cf_mem [0:ROWS-1];
-            always @(posedge clk) begin
-                if (cl_v_q && cl_lbl_q == LBL) cf_mem[cl_row_q] <= cl_isblob;
-            end
-            assign cfr[gl] = cf_mem[cf_row_q[((gl - 1) / NCF)*ROW_IDX_W +: ROW_IDX_W]];
+            assign cfr[gl] = cf_rd_q[gl];
         end
     endgenerate
     // status of the labels of row r: an indexed select (one 2^LBL_W : 1 multiplexer)
@@ -1230,9 +1243,9 @@ module fmt_blob #(
         x2_cmin_q <= cmin;  x2_cmax_q <= cmax;
         x3_f_q <= x2_f_q;  x3_lc_q <= x2_lc_q;  x3_row_q <= x2_row_q;
         x3_cnt_q <= {{(AREA_W-COL_IDX_W){1'b0}}, x2_cmax_q - x2_cmin_q} + 1'b1;  x3_cmin_q <= x2_cmin_q;  x3_cmax_q <= x2_cmax_q;
-        x3_s_q <= tr_s[SZ_W-1:0];  x3_gw_q <= gw;  x3_pk_q <= pk3[PN3*PK_W-1:0];
+        x3_s_q <= tr_s[SZ_W-1:0];  x3_gx_q <= tr_g[GXT_W-1:0];  x3_gt_q <= gt;  x3_pk_q <= pk3[PN3*PK_W-1:0];
         y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
-        y4_sx_q <= tr_x[SX_W-1:0];
+        y4_sx_q <= sx4;
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
