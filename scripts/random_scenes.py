@@ -12,7 +12,8 @@ RTL path (``bench/core/run_sim_rtl.model_reference``: DDS -> fixed-point channel
 receive array -> touch chain, calibrated as ``make sim`` calibrates).
 
 Invariants checked on every frame (a violation prints the scene's seed and index and
-the script exits 1; the scene is written to ``--fail-dir`` to replay with ``make sim``):
+the script exits 1; the scene and its settings are written to ``--fail-dir``, whose
+earlier ``random_*.json`` files are removed at the start):
   * nothing raises;
   * heat-map cells within 0 .. 2^HM_W - 1;
   * events carry their frame's number, in order: the tracker's events, then blob events;
@@ -250,9 +251,12 @@ def main(argv=None) -> int:
                     help="RTL runs start with a busy core reset at a random cycle")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
-    if a.count < 1:
-        print("random_scenes: --count must be >= 1", file=sys.stderr)
+    if a.count < 1 or a.rtl < 0 or a.start < 0:
+        print("random_scenes: --count must be >= 1, --rtl and --start >= 0", file=sys.stderr)
         return 2
+    # failing scenes of an earlier run must not look like this run's
+    for old in Path(a.fail_dir).glob("random_*.json"):
+        old.unlink()
     t0 = time.time()
     fails, frames, events = 0, 0, 0
     rtl_done, rtl_skipped = 0, 0
