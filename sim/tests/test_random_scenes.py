@@ -3,7 +3,7 @@
 fixed-point twin of the RTL path and checks invariants.  ``make random-scenes`` runs
 10^4 of them (also part of ``make test-long``).
 
-Here: 300 scenes must run clean and exercise what the invariants are about (lifts,
+Here: 200 scenes must run clean and exercise what the invariants are about (lifts,
 blobs, several contacts, effects), and the checker must flag doctored event streams
 (a check that cannot fail would prove nothing)."""
 from __future__ import annotations
@@ -27,7 +27,7 @@ def rs():
 
 
 def test_random_scenes_clean_and_varied(rs):
-    n = 300
+    n = 200
     kinds, blob_ev, multi, effects, frames = set(), 0, 0, set(), 0
     for i in range(n):
         sc, st = rs.random_scene(11, i, "mixed")

@@ -430,7 +430,7 @@ async def reset_random_points(dut):
     await tb.reset()
     rng, nrng = random.Random(11), np.random.default_rng(11)
     frame = 100
-    for k in range(10):
+    for _k in range(6):
         tb.set(rng.choice([1, 500, 1000]), rng.choice([1, 2, 3]))
         hm = (nrng.integers(0, 3000, (tb.rows, tb.cols)) * (nrng.random((tb.rows, tb.cols)) < 0.6)
               ).astype(np.int64)
