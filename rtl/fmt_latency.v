@@ -266,8 +266,11 @@ module fmt_latency #(
         if (hl_we) hist_last_mem[s2_bin_q]  <= hl_new;
     end
 
+    // reads 0 on the cycle after a reset (the valid bits were not cleared yet when it read)
     always @(posedge clk) begin
-        if (hist_sel_i)
+        if (rst)
+            hist_data_o <= {NUM_W{1'b0}};
+        else if (hist_sel_i)
             hist_data_o <= hist_last_ok_q[hist_addr_i] ? hist_last_mem[hist_addr_i] : {NUM_W{1'b0}};
         else
             hist_data_o <= hist_first_ok_q[hist_addr_i] ? hist_first_mem[hist_addr_i] : {NUM_W{1'b0}};
