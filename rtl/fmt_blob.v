@@ -1270,8 +1270,10 @@ module fmt_blob #(
             l2_m_q <= l1_m_q;
         end
         if (do_run) x_q <= lrun;
-        x4_op_q  <= do_merge ? OP_MERGE : (do_new ? OP_NEW : (do_run ? OP_ADD : OP_NONE));
-        x4_mrg_q <= do_merge;
+        // (reset: the step registers before it are reset one cycle late for this one)
+        x4_op_q  <= rst ? OP_NONE : (do_merge ? OP_MERGE : (do_new ? OP_NEW
+                                  : (do_run ? OP_ADD : OP_NONE)));
+        x4_mrg_q <= do_merge && !rst;
         x4_e_q   <= run_e;
         x4_row_q <= l2_row;
         x4_end_q <= row_done;
