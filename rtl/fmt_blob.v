@@ -258,8 +258,8 @@ module fmt_blob #(
     endfunction
 
     // ---- frame buffers and arrival bookkeeping (as fmt_localmax) ----------------------
-    (* ram_style = "block" *)                 // one write, one read port: block RAM
-    reg [RW-1:0]         mem [0:2*ROWS-1];
+    // (the heat-map block RAM is one memory per GS columns, each read with its own
+    // copy of the fetch enable: see g_mem)
     reg [ROWS-1:0]       arr_q [0:1];
     reg [1:0]            eofs_q;
     reg [FRAME_W-1:0]    frm_q [0:1];
@@ -277,10 +277,8 @@ module fmt_blob #(
             hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
     end
     always @(posedge clk) begin
-        if (hm_valid_i) begin
-            mem[wr_addr]    <= hm_data_i;
+        if (hm_valid_i)
             on_mem[{wb_q, hm_row_i}] <= hm_on;
-        end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
 
@@ -302,7 +300,22 @@ module fmt_blob #(
     wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
     wire                 fr_in = (fr_q < ROWS_R);
     wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
-    wire                 fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!f1_v_q || f1_mv);
+    // The fetch decision from registers only: av_q = the next row is present (state
+    // S_RUN, fr_q < ROWS, arr_p[fr_row]), registered from its next value (below, beside
+    // the state machine); E takes F2's row this cycle (etk) from E's registers.  The wide
+    // enables are per GS columns: fetch_g (the group's block-RAM read), mv_g (F2's
+    // registers), take_g (E's registers), each from a kept copy of av_q, f1_v_q, f2_v_q
+    // (no register drives hundreds of loads across the die).
+    reg                  av_q;
+    reg  [NG-1:0]        avc_q, f1vc_q, f2vc_q;
+    wire                 etk;                 // E takes a row (f2_take = f2_v_q && etk)
+    wire                 av_nx;
+    wire                 fetch = av_q && (!f1_v_q || !f2_v_q || etk);
+    wire [NG-1:0]        fetch_g = avc_q & {NG{!f1_v_q || !f2_v_q || etk}};
+    wire [NG-1:0]        mv_g    = f1vc_q & {NG{!f2_v_q || etk}};
+    wire [NG-1:0]        take_g  = f2vc_q & {NG{etk}};
+    wire                 f1_v_nx = !rst && (fetch || (f1_v_q && !f1_mv));
+    wire                 f2_v_nx = !rst && (f1_mv || (f2_v_q && !f2_take));
     wire [ADDR_W-1:0]    rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
                                  + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
     // Events of a row (C: its on-cells, P: the previous row's): A = C & P; each C run
@@ -322,20 +335,13 @@ module fmt_blob #(
     wire [COLS-1:0]      es_neg = ~f1_es_q + 1'b1;    // the first event: lowest bit and up
     always @(posedge clk) begin
         if (fetch) begin
-            f1_z_q   <= mem[rd_addr];
             f1_c_q   <= on_f;
             f1_es_q  <= es_f;
             f1_fa_q  <= fa_f;
             f1_row_q <= fr_row;
         end
         if (f1_mv) begin
-            f2_z_q   <= f1_z_q;
-            f2_c_q   <= f1_c_q;
-            f2_es_q  <= f1_es_q;
-            f2_fa_q  <= f1_fa_q;
-            f2_b_q   <= f1_es_q & es_neg;
             f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
-            f2_ge_q  <= f1_es_q | es_neg;
             f2_row_q <= f1_row_q;
         end
     end
@@ -385,6 +391,7 @@ module fmt_blob #(
     wire                 ev_last = e1_last_q;
     wire                 ev_go   = e1_v_q && !res_q[FP_W];   // res_q < FD
     assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
+    assign               etk     = !e1_v_q || (!res_q[FP_W] && e1_last_q);
     wire [COLS-1:0]      e1_remr = e1_rem_q & ~e1_b_q;
     wire [COLS-1:0]      e1_neg  = ~e1_remr + 1'b1;      // lowest bit and up: one carry
     wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
@@ -395,6 +402,47 @@ module fmt_blob #(
     // (no OR over the columns on these paths: ev_run is for the flags only)
     wire [COLS-1:0]      ev_m    = cge & ~(cge + (e1_b_q & e1_cs));
     wire [COLS-1:0]      ev_lc   = (e1_fa_q & ev_m) | (e1_b_q & ~e1_cs);
+
+    // F2's and E's column registers and the heat-map block RAM, per GS columns
+    genvar gm;
+    generate
+        for (gm = 0; gm < NG; gm = gm + 1) begin : g_mem
+            localparam MW = ((gm + 1) * GS <= COLS) ? GS * HM_W : (COLS - gm * GS) * HM_W;
+            (* ram_style = "block" *)         // one write, one read port: block RAM
+            reg [MW-1:0] mem [0:2*ROWS-1];
+            always @(posedge clk) begin
+                if (hm_valid_i)
+                    mem[wr_addr] <= hm_data_i[gm*GS*HM_W +: MW];
+                if (fetch_g[gm])
+                    f1_z_q[gm*GS*HM_W +: MW] <= mem[rd_addr];
+            end
+            (* keep *) always @(posedge clk) avc_q[gm]  <= av_nx;
+            (* keep *) always @(posedge clk) f1vc_q[gm] <= f1_v_nx;
+            (* keep *) always @(posedge clk) f2vc_q[gm] <= f2_v_nx;
+            always @(posedge clk) begin
+                if (mv_g[gm]) begin
+                    f2_z_q[gm*GS*HM_W +: MW] <= f1_z_q[gm*GS*HM_W +: MW];
+                    f2_c_q[gm*GS +: MW/HM_W]  <= f1_c_q[gm*GS +: MW/HM_W];
+                    f2_es_q[gm*GS +: MW/HM_W] <= f1_es_q[gm*GS +: MW/HM_W];
+                    f2_fa_q[gm*GS +: MW/HM_W] <= f1_fa_q[gm*GS +: MW/HM_W];
+                    f2_b_q[gm*GS +: MW/HM_W]  <= f1_es_q[gm*GS +: MW/HM_W] & es_neg[gm*GS +: MW/HM_W];
+                    f2_ge_q[gm*GS +: MW/HM_W] <= f1_es_q[gm*GS +: MW/HM_W] | es_neg[gm*GS +: MW/HM_W];
+                end
+                if (take_g[gm]) begin
+                    e1_z_q[gm*GS*HM_W +: MW] <= f2_z_q[gm*GS*HM_W +: MW];
+                    e1_c_q[gm*GS +: MW/HM_W]  <= f2_c_q[gm*GS +: MW/HM_W];
+                    e1_fa_q[gm*GS +: MW/HM_W] <= f2_fa_q[gm*GS +: MW/HM_W];
+                    e1_rem_q[gm*GS +: MW/HM_W] <= f2_es_q[gm*GS +: MW/HM_W];
+                    e1_b_q[gm*GS +: MW/HM_W]   <= f2_b_q[gm*GS +: MW/HM_W];
+                    e1_ge_q[gm*GS +: MW/HM_W]  <= f2_ge_q[gm*GS +: MW/HM_W];
+                end else if (ev_go) begin
+                    e1_rem_q[gm*GS +: MW/HM_W] <= e1_remr[gm*GS +: MW/HM_W];
+                    e1_b_q[gm*GS +: MW/HM_W]   <= e1_remr[gm*GS +: MW/HM_W] & e1_neg[gm*GS +: MW/HM_W];
+                    e1_ge_q[gm*GS +: MW/HM_W]  <= e1_remr[gm*GS +: MW/HM_W] | e1_neg[gm*GS +: MW/HM_W];
+                end
+            end
+        end
+    endgenerate
 
     // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
     // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
@@ -1208,27 +1256,44 @@ module fmt_blob #(
     reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
     wire fin_abort = (state_q == S_RUN) && abort_q;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
+    // av_q's next value: in S_RUN (not finishing) row fr_q or, after a fetch, fr_q + 1 of
+    // bank pb_q; after the release row 0 of the other bank; the arrivals of this cycle
+    // counted (both candidates looked up beside fetch, which only picks one)
+    wire [ROW_IDX_W:0]   fr_q1   = fr_q + 1'b1;
+    wire [ROW_IDX_W-1:0] fr_row1 = fr_q1[ROW_IDX_W-1:0];
+    wire [ROWS-1:0]      arr_p1  = arr_p >> 1;          // arr_p1[r] = arr_p[r + 1]
+    wire                 arr_o0  = pb_q ? arr_q[0][0] : arr_q[1][0];   // the other bank's row 0
+    wire                 hm_p    = hm_valid_i && (wb_q == pb_q);
+    wire                 av_0    = fr_in && (arr_p[fr_row] || (hm_p && hm_row_i == fr_row));
+    wire                 av_1    = (fr_q1 < ROWS_R)
+                                && (arr_p1[fr_row] || (hm_p && hm_row_i == fr_row1));
+    wire                 av_r    = arr_o0 || (hm_valid_i && (wb_q != pb_q)
+                                                && hm_row_i == {ROW_IDX_W{1'b0}});
+    assign               av_nx   = !rst && (((state_q == S_RUN) && !fin_ok && !fin_abort
+                                             && (fetch ? av_1 : av_0))
+                                            || (releasing && av_r));
+    always @(posedge clk) av_q <= av_nx;
+    // synthesis translate_off
+    always @(posedge clk) begin
+        if (!rst && (av_q !== ((state_q == S_RUN) && fr_in && arr_p[fr_row])
+                     || avc_q !== {NG{av_q}} || f1vc_q !== {NG{f1_v_q}} || f2vc_q !== {NG{f2_v_q}})) begin
+            $display("fmt_blob: av_q %b or an enable copy differs", av_q);
+            $finish;
+        end
+    end
+    // synthesis translate_on
     wire over      = (found_q > MB_A);
 
     always @(posedge clk) begin : s_main
         integer i;
         // ---- datapath registers (no reset needed) ----
-        if (f2_take) begin
-            e1_z_q   <= f2_z_q;
-            e1_c_q   <= f2_c_q;
-            e1_fa_q  <= f2_fa_q;
+        // (E's and F2's column registers: per GS columns in g_mem)
+        if (f2_take)
             e1_row_q <= f2_row_q;
-        end
         if (f2_take) begin
-            e1_rem_q <= f2_es_q;
-            e1_b_q   <= f2_b_q;
-            e1_ge_q  <= f2_ge_q;
             e1_last_q <= f2_one_q;
             e1_first_q <= 1'b1;
         end else if (ev_go) begin
-            e1_rem_q <= e1_remr;
-            e1_b_q   <= e1_remr & e1_neg;
-            e1_ge_q  <= e1_remr | e1_neg;
             e1_last_q <= le2(e1_rem_q);             // = ((e1_remr & ~e1_neg) == 0): b is in rem
             e1_first_q <= 1'b0;
         end
@@ -1442,7 +1507,7 @@ module fmt_blob #(
             if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
             idle_q <= !pipe_busy && !fetch;
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
-                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
+                     && !fetch && fr_in && !av_q && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
