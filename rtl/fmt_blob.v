@@ -290,6 +290,7 @@ module fmt_blob #(
     // prepares the row's event starts against the previous row's on-cells ---------------
     wire                 f2_take;             // E takes the row in F2
     reg  [ROW_IDX_W:0]   fr_q;                // next row to fetch (ROWS = all fetched)
+    reg  [ROWS-1:0]      fr_oh_q;             // fr_q one-hot (0: all fetched), for av_q
     reg                  f1_v_q, f2_v_q;
     reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
     reg  [RW-1:0]        f1_z_q, f2_z_q;
@@ -1209,12 +1210,6 @@ module fmt_blob #(
     reg [LR_W-1:0]       mk_lr_q;
     reg [NLP-1:0]        mk_s_pad;
     reg [COLS-1:0]       mk_on, mk_st;
-    /* verilator lint_off UNUSEDSIGNAL */     // mk_fill[COLS]: a carry beyond the last column
-    wire [COLS:0]        mk_fill = {1'b0, mk_on} + {1'b0, mk_st};
-    /* verilator lint_on UNUSEDSIGNAL */
-    // a run's cells get the status of its label, from its start: the status bit added at
-    // the start carries through the run (its cells become 0) and stops after it
-    wire [COLS-1:0]      mk_bits = mk_on & ~mk_fill[COLS-1:0];
     always @(*) begin : c_mk
         integer c;
         mk_s_pad = {NLP{1'b0}};
@@ -1224,10 +1219,12 @@ module fmt_blob #(
             mk_st[c] = mk_on[c] && (c == 0 || !mk_on[(c > 0) ? c - 1 : 0])
                     && mk_s_pad[mk_lr_q[(c/2)*LBL_W +: LBL_W]];
     end
+    // the mask row is stored as its on-cells and its blob run starts (the status select
+    // and the fill's carry chain in different cycles); the query fills the row it reads
     (* ram_style = "distributed" *)
-    reg [COLS-1:0]       mask_mem [0:ROWS-1];
+    reg [2*COLS-1:0]     mask_mem [0:ROWS-1];
     always @(posedge clk) begin
-        if (mk_v_q) mask_mem[mk_row_q] <= mk_bits;
+        if (mk_v_q) mask_mem[mk_row_q] <= {mk_st, mk_on};
         mk_s_q   <= bw_s;
         mk_lr_q  <= lr_rd_q;
         mk_row_q <= bw_row_q;
@@ -1238,8 +1235,14 @@ module fmt_blob #(
     reg [COLS-1:0]       q_w_q;               // mask word of the queried row
     reg [COL_IDX_W-1:0]  q_col_q;
     reg [NCP-1:0]        q_w_pad;             // columns >= COLS read 0
+    wire [2*COLS-1:0]    q_rd = mask_mem[mask_q_row_i];
+    /* verilator lint_off UNUSEDSIGNAL */     // q_fill[COLS]: a carry beyond the last column
+    wire [COLS:0]        q_fill = {1'b0, q_rd[0 +: COLS]} + {1'b0, q_rd[COLS +: COLS]};
+    /* verilator lint_on UNUSEDSIGNAL */
     always @(posedge clk) begin
-        q_w_q   <= mask_mem[mask_q_row_i];
+        // a run's cells get the status of its label, from its start: the status bit added
+        // at the start carries through the run (its cells become 0) and stops after it
+        q_w_q   <= q_rd[0 +: COLS] & ~q_fill[COLS-1:0];
         q_col_q <= mask_q_col_i;
     end
     always @(*) begin
@@ -1259,14 +1262,17 @@ module fmt_blob #(
     // av_q's next value: in S_RUN (not finishing) row fr_q or, after a fetch, fr_q + 1 of
     // bank pb_q; after the release row 0 of the other bank; the arrivals of this cycle
     // counted (both candidates looked up beside fetch, which only picks one)
-    wire [ROW_IDX_W:0]   fr_q1   = fr_q + 1'b1;
-    wire [ROW_IDX_W-1:0] fr_row1 = fr_q1[ROW_IDX_W-1:0];
-    wire [ROWS-1:0]      arr_p1  = arr_p >> 1;          // arr_p1[r] = arr_p[r + 1]
+    // (by the one-hot fr_oh_q: an AND-OR over the rows, no index select)
     wire                 arr_o0  = pb_q ? arr_q[0][0] : arr_q[1][0];   // the other bank's row 0
     wire                 hm_p    = hm_valid_i && (wb_q == pb_q);
-    wire                 av_0    = fr_in && (arr_p[fr_row] || (hm_p && hm_row_i == fr_row));
-    wire                 av_1    = (fr_q1 < ROWS_R)
-                                && (arr_p1[fr_row] || (hm_p && hm_row_i == fr_row1));
+    reg  [ROWS-1:0]      arr_pn;              // bank pb_q's arrivals with this cycle's row
+    always @(*) begin : c_arr_pn
+        integer r;
+        for (r = 0; r < ROWS; r = r + 1)
+            arr_pn[r] = arr_p[r] || (hm_p && hm_row_i == r[ROW_IDX_W-1:0]);
+    end
+    wire                 av_0    = |(arr_pn & fr_oh_q);
+    wire                 av_1    = |(arr_pn & {fr_oh_q[ROWS-2:0], 1'b0});
     wire                 av_r    = arr_o0 || (hm_valid_i && (wb_q != pb_q)
                                                 && hm_row_i == {ROW_IDX_W{1'b0}});
     assign               av_nx   = !rst && (((state_q == S_RUN) && !fin_ok && !fin_abort
@@ -1274,10 +1280,14 @@ module fmt_blob #(
                                             || (releasing && av_r));
     always @(posedge clk) av_q <= av_nx;
     // synthesis translate_off
+    reg chk_rst_q;                            // a reset was seen (the checks below after it)
+    initial chk_rst_q = 1'b0;
+    always @(posedge clk) if (rst) chk_rst_q <= 1'b1;
     always @(posedge clk) begin
-        if (!rst && (av_q !== ((state_q == S_RUN) && fr_in && arr_p[fr_row])
+        if (!rst && chk_rst_q && (av_q !== ((state_q == S_RUN) && fr_in && arr_p[fr_row])
+                     || fr_oh_q !== (fr_in ? {{(ROWS-1){1'b0}}, 1'b1} << fr_row : {ROWS{1'b0}})
                      || avc_q !== {NG{av_q}} || f1vc_q !== {NG{f1_v_q}} || f2vc_q !== {NG{f2_v_q}})) begin
-            $display("fmt_blob: av_q %b or an enable copy differs", av_q);
+            $display("fmt_blob: av_q %b or an enable copy differs (fr_oh_q %h fr_q %0d) at %0t", av_q, fr_oh_q, fr_q, $time);
             $finish;
         end
     end
@@ -1379,6 +1389,7 @@ module fmt_blob #(
             pb_q     <= 1'b0;
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
+            fr_oh_q  <= {{(ROWS-1){1'b0}}, 1'b1};
             lastc_q  <= {COLS{1'b0}};
             f1_v_q   <= 1'b0;
             f2_v_q   <= 1'b0;
@@ -1454,6 +1465,7 @@ module fmt_blob #(
 
             // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
+            if (fetch) fr_oh_q <= {fr_oh_q[ROWS-2:0], 1'b0};
             if (fetch) lastc_q <= on_f;
             if (fetch) f1_v_q <= 1'b1;
             else if (f1_mv) f1_v_q <= 1'b0;
@@ -1587,6 +1599,7 @@ module fmt_blob #(
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};
+                fr_oh_q      <= {{(ROWS-1){1'b0}}, 1'b1};
                 lastc_q      <= {COLS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
