@@ -291,6 +291,7 @@ module fmt_blob #(
     wire                 f2_take;             // E takes the row in F2
     reg  [ROW_IDX_W:0]   fr_q;                // next row to fetch (ROWS = all fetched)
     reg  [ROWS-1:0]      fr_oh_q;             // fr_q one-hot (0: all fetched), for av_q
+    reg  [ROW_IDX_W:0]   fr1_q;               // fr_q + 1, for av_q
     reg                  f1_v_q, f2_v_q;
     reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
     reg  [RW-1:0]        f1_z_q, f2_z_q;
@@ -1262,22 +1263,44 @@ module fmt_blob #(
     // av_q's next value: in S_RUN (not finishing) row fr_q or, after a fetch, fr_q + 1 of
     // bank pb_q; after the release row 0 of the other bank; the arrivals of this cycle
     // counted (both candidates looked up beside fetch, which only picks one)
-    // (by the one-hot fr_oh_q: an AND-OR over the rows, no index select)
+    // (by the one-hot fr_oh_q: an AND-OR over the rows in groups of 3, no index select;
+    // this cycle's row by one compare with fr_q, fr1_q = fr_q + 1; the parts are kept
+    // wires, so synthesis maps a balanced tree and not a LUT chain: 11 xc5v levels else)
+    localparam AVG = (ROWS + 2) / 3;
     wire                 arr_o0  = pb_q ? arr_q[0][0] : arr_q[1][0];   // the other bank's row 0
     wire                 hm_p    = hm_valid_i && (wb_q == pb_q);
-    reg  [ROWS-1:0]      arr_pn;              // bank pb_q's arrivals with this cycle's row
-    always @(*) begin : c_arr_pn
-        integer r;
-        for (r = 0; r < ROWS; r = r + 1)
-            arr_pn[r] = arr_p[r] || (hm_p && hm_row_i == r[ROW_IDX_W-1:0]);
+    wire                 fr1_in  = (fr1_q < ROWS_R);
+    reg  [3*AVG-1:0]     av_ap, av_o0, av_o1;
+    reg  [AVG-1:0]       av_s0, av_s1;
+    always @(*) begin : c_av_g
+        integer j;
+        av_ap = {(3*AVG){1'b0}};
+        av_o0 = {(3*AVG){1'b0}};
+        av_o1 = {(3*AVG){1'b0}};
+        av_ap[ROWS-1:0] = arr_p;
+        av_o0[ROWS-1:0] = fr_oh_q;
+        av_o1[ROWS-1:0] = {fr_oh_q[ROWS-2:0], 1'b0};
+        for (j = 0; j < AVG; j = j + 1) begin
+            av_s0[j] = |(av_ap[3*j +: 3] & av_o0[3*j +: 3]);
+            av_s1[j] = |(av_ap[3*j +: 3] & av_o1[3*j +: 3]);
+        end
     end
-    wire                 av_0    = |(arr_pn & fr_oh_q);
-    wire                 av_1    = |(arr_pn & {fr_oh_q[ROWS-2:0], 1'b0});
-    wire                 av_r    = arr_o0 || (hm_valid_i && (wb_q != pb_q)
-                                                && hm_row_i == {ROW_IDX_W{1'b0}});
-    assign               av_nx   = !rst && (((state_q == S_RUN) && !fin_ok && !fin_abort
-                                             && (fetch ? av_1 : av_0))
-                                            || (releasing && av_r));
+    // (kept wires; assigned below)
+    (* keep *) wire [AVG-1:0] av_g0;           // row fr_q arrived (per group of 3 rows)
+    (* keep *) wire [AVG-1:0] av_g1;           // row fr_q + 1
+    (* keep *) wire           av_h0, av_h1;    // ... arriving this cycle
+    (* keep *) wire           av_a0, av_a1;    // row fr_q, fr_q + 1 present next cycle
+    (* keep *) wire           av_run, av_rel;  // S_RUN stays; the release
+    assign av_g0  = av_s0;
+    assign av_g1  = av_s1;
+    assign av_h0  = hm_p && fr_in && (hm_row_i == fr_row);
+    assign av_h1  = hm_p && fr1_in && (hm_row_i == fr1_q[ROW_IDX_W-1:0]);
+    assign av_a0  = (|av_g0) || av_h0;
+    assign av_a1  = (|av_g1) || av_h1;
+    assign av_run = !rst && (state_q == S_RUN) && !fin_ok && !fin_abort;
+    assign av_rel = !rst && releasing && (arr_o0 || (hm_valid_i && (wb_q != pb_q)
+                                                     && hm_row_i == {ROW_IDX_W{1'b0}}));
+    assign               av_nx   = (av_run && (fetch ? av_a1 : av_a0)) || av_rel;
     always @(posedge clk) av_q <= av_nx;
     // synthesis translate_off
     reg chk_rst_q;                            // a reset was seen (the checks below after it)
@@ -1286,6 +1309,7 @@ module fmt_blob #(
     always @(posedge clk) begin
         if (!rst && chk_rst_q && (av_q !== ((state_q == S_RUN) && fr_in && arr_p[fr_row])
                      || fr_oh_q !== (fr_in ? {{(ROWS-1){1'b0}}, 1'b1} << fr_row : {ROWS{1'b0}})
+                     || fr1_q !== fr_q + 1'b1
                      || avc_q !== {NG{av_q}} || f1vc_q !== {NG{f1_v_q}} || f2vc_q !== {NG{f2_v_q}})) begin
             $display("fmt_blob: av_q %b or an enable copy differs (fr_oh_q %h fr_q %0d) at %0t", av_q, fr_oh_q, fr_q, $time);
             $finish;
@@ -1390,6 +1414,7 @@ module fmt_blob #(
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
             fr_oh_q  <= {{(ROWS-1){1'b0}}, 1'b1};
+            fr1_q    <= {{ROW_IDX_W{1'b0}}, 1'b1};
             lastc_q  <= {COLS{1'b0}};
             f1_v_q   <= 1'b0;
             f2_v_q   <= 1'b0;
@@ -1466,6 +1491,7 @@ module fmt_blob #(
             // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
             if (fetch) fr_oh_q <= {fr_oh_q[ROWS-2:0], 1'b0};
+            if (fetch) fr1_q <= fr1_q + 1'b1;
             if (fetch) lastc_q <= on_f;
             if (fetch) f1_v_q <= 1'b1;
             else if (f1_mv) f1_v_q <= 1'b0;
@@ -1600,6 +1626,7 @@ module fmt_blob #(
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};
                 fr_oh_q      <= {{(ROWS-1){1'b0}}, 1'b1};
+                fr1_q        <= {{ROW_IDX_W{1'b0}}, 1'b1};
                 lastc_q      <= {COLS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
