@@ -8,6 +8,9 @@
 // arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
 // prefix of rows is present:
 //   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
+//       the fetch is decided from registers (av_q: the next row is present, registered
+//       from its next value), the block RAM is one memory per 8 columns, and the wide
+//       enables of the block RAMs, F2 and E are per 8 columns from kept copies;
 //       against the previous row's on-cells P (A = C & P) the row's events are found:
 //       each C run gives a RUN event at its first column, with its first A column
 //       (found by one addition: the carry from the run's start runs through its C-only
@@ -76,11 +79,12 @@
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
 // not continue, its close record; one stage later every run start of the row gets its
-// label's status, and the runs whose start has status 1 are filled by one addition
-// (on + starts: the carry runs through the run), a row of the mask (mask_mem, LUT RAM,
-// ROWS x COLS bits: every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed).
-// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word one cycle later ->
-// mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
+// label's status, stored with the row's on-cells (mask_mem, LUT RAM, ROWS x 2 COLS
+// bits); the query fills the runs whose start has status 1 by one addition (on + starts:
+// the carry runs through the run), a row of the mask (every blob, also those beyond
+// MAX_BLOBS: blobs.blob_mask_fixed).
+// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word (read and filled) one
+// cycle later -> mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
 // pipelined.  mask_ready_o
 // (with mask_frame_o) marks the mask written; it stays readable until the next frame's
 // pass starts (that frame is labelled; never before its last row), queries in between
