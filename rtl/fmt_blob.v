@@ -8,6 +8,9 @@
 // arrives) in a LUT RAM (on_mem).  The frame is labelled in raster order as soon as a
 // prefix of rows is present:
 //   F1, F2: fetch the next row (block-RAM read and output register) and its on-cells C;
+//       the fetch is decided from registers (av_q: the next row is present, registered
+//       from its next value), the block RAM is one memory per 8 columns, and the wide
+//       enables of the block RAMs, F2 and E are per 8 columns from kept copies;
 //       against the previous row's on-cells P (A = C & P) the row's events are found:
 //       each C run gives a RUN event at its first column, with its first A column
 //       (found by one addition: the carry from the run's start runs through its C-only
@@ -76,11 +79,12 @@
 // the last row up gives, one row per cycle, the status of every label of row r: the
 // status of its continuation in row r+1 (known from the previous step) or, when it did
 // not continue, its close record; one stage later every run start of the row gets its
-// label's status, and the runs whose start has status 1 are filled by one addition
-// (on + starts: the carry runs through the run), a row of the mask (mask_mem, LUT RAM,
-// ROWS x COLS bits: every blob, also those beyond MAX_BLOBS: blobs.blob_mask_fixed).
-// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word one cycle later ->
-// mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
+// label's status, stored with the row's on-cells (mask_mem, LUT RAM, ROWS x 2 COLS
+// bits); the query fills the runs whose start has status 1 by one addition (on + starts:
+// the carry runs through the run), a row of the mask (every blob, also those beyond
+// MAX_BLOBS: blobs.blob_mask_fixed).
+// Query port: (mask_q_row_i, mask_q_col_i) -> the row's mask word (read and filled) one
+// cycle later -> mask_q_data_o = the cell's bit two cycles after the address; one query per cycle,
 // pipelined.  mask_ready_o
 // (with mask_frame_o) marks the mask written; it stays readable until the next frame's
 // pass starts (that frame is labelled; never before its last row), queries in between
@@ -258,8 +262,8 @@ module fmt_blob #(
     endfunction
 
     // ---- frame buffers and arrival bookkeeping (as fmt_localmax) ----------------------
-    (* ram_style = "block" *)                 // one write, one read port: block RAM
-    reg [RW-1:0]         mem [0:2*ROWS-1];
+    // (the heat-map block RAM is one memory per GS columns, each read with its own
+    // copy of the fetch enable: see g_mem)
     reg [ROWS-1:0]       arr_q [0:1];
     reg [1:0]            eofs_q;
     reg [FRAME_W-1:0]    frm_q [0:1];
@@ -277,10 +281,8 @@ module fmt_blob #(
             hm_on[i] = (hm_data_i[i*HM_W +: HM_W] >= blob_threshold_i);
     end
     always @(posedge clk) begin
-        if (hm_valid_i) begin
-            mem[wr_addr]    <= hm_data_i;
+        if (hm_valid_i)
             on_mem[{wb_q, hm_row_i}] <= hm_on;
-        end
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
 
@@ -292,6 +294,8 @@ module fmt_blob #(
     // prepares the row's event starts against the previous row's on-cells ---------------
     wire                 f2_take;             // E takes the row in F2
     reg  [ROW_IDX_W:0]   fr_q;                // next row to fetch (ROWS = all fetched)
+    reg  [ROWS-1:0]      fr_oh_q;             // fr_q one-hot (0: all fetched), for av_q
+    reg  [ROW_IDX_W:0]   fr1_q;               // fr_q + 1, for av_q
     reg                  f1_v_q, f2_v_q;
     reg  [ROW_IDX_W-1:0] f1_row_q, f2_row_q;
     reg  [RW-1:0]        f1_z_q, f2_z_q;
@@ -302,7 +306,22 @@ module fmt_blob #(
     wire                 f1_mv = f1_v_q && (!f2_v_q || f2_take);
     wire                 fr_in = (fr_q < ROWS_R);
     wire [ROW_IDX_W-1:0] fr_row = fr_q[ROW_IDX_W-1:0];
-    wire                 fetch = (state_q == S_RUN) && fr_in && arr_p[fr_row] && (!f1_v_q || f1_mv);
+    // The fetch decision from registers only: av_q = the next row is present (state
+    // S_RUN, fr_q < ROWS, arr_p[fr_row]), registered from its next value (below, beside
+    // the state machine); E takes F2's row this cycle (etk) from E's registers.  The wide
+    // enables are per GS columns: fetch_g (the group's block-RAM read), mv_g (F2's
+    // registers), take_g (E's registers), each from a kept copy of av_q, f1_v_q, f2_v_q
+    // (no register drives hundreds of loads across the die).
+    reg                  av_q;
+    reg  [NG-1:0]        avc_q, f1vc_q, f2vc_q;
+    wire                 etk;                 // E takes a row (f2_take = f2_v_q && etk)
+    wire                 av_nx;
+    wire                 fetch = av_q && (!f1_v_q || !f2_v_q || etk);
+    wire [NG-1:0]        fetch_g = avc_q & {NG{!f1_v_q || !f2_v_q || etk}};
+    wire [NG-1:0]        mv_g    = f1vc_q & {NG{!f2_v_q || etk}};
+    wire [NG-1:0]        take_g  = f2vc_q & {NG{etk}};
+    wire                 f1_v_nx = !rst && (fetch || (f1_v_q && !f1_mv));
+    wire                 f2_v_nx = !rst && (f1_mv || (f2_v_q && !f2_take));
     wire [ADDR_W-1:0]    rd_addr = (pb_q ? ROWS_A : {ADDR_W{1'b0}})
                                  + {{(ADDR_W-ROW_IDX_W){1'b0}}, fr_row};
     // Events of a row (C: its on-cells, P: the previous row's): A = C & P; each C run
@@ -322,20 +341,13 @@ module fmt_blob #(
     wire [COLS-1:0]      es_neg = ~f1_es_q + 1'b1;    // the first event: lowest bit and up
     always @(posedge clk) begin
         if (fetch) begin
-            f1_z_q   <= mem[rd_addr];
             f1_c_q   <= on_f;
             f1_es_q  <= es_f;
             f1_fa_q  <= fa_f;
             f1_row_q <= fr_row;
         end
         if (f1_mv) begin
-            f2_z_q   <= f1_z_q;
-            f2_c_q   <= f1_c_q;
-            f2_es_q  <= f1_es_q;
-            f2_fa_q  <= f1_fa_q;
-            f2_b_q   <= f1_es_q & es_neg;
             f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
-            f2_ge_q  <= f1_es_q | es_neg;
             f2_row_q <= f1_row_q;
         end
     end
@@ -385,6 +397,7 @@ module fmt_blob #(
     wire                 ev_last = e1_last_q;
     wire                 ev_go   = e1_v_q && !res_q[FP_W];   // res_q < FD
     assign               f2_take = f2_v_q && (!e1_v_q || (ev_go && ev_last));
+    assign               etk     = !e1_v_q || (!res_q[FP_W] && e1_last_q);
     wire [COLS-1:0]      e1_remr = e1_rem_q & ~e1_b_q;
     wire [COLS-1:0]      e1_neg  = ~e1_remr + 1'b1;      // lowest bit and up: one carry
     wire [COLS-1:0]      e1_cs   = e1_c_q & ~{e1_c_q[COLS-2:0], 1'b0};
@@ -395,6 +408,47 @@ module fmt_blob #(
     // (no OR over the columns on these paths: ev_run is for the flags only)
     wire [COLS-1:0]      ev_m    = cge & ~(cge + (e1_b_q & e1_cs));
     wire [COLS-1:0]      ev_lc   = (e1_fa_q & ev_m) | (e1_b_q & ~e1_cs);
+
+    // F2's and E's column registers and the heat-map block RAM, per GS columns
+    genvar gm;
+    generate
+        for (gm = 0; gm < NG; gm = gm + 1) begin : g_mem
+            localparam MW = ((gm + 1) * GS <= COLS) ? GS * HM_W : (COLS - gm * GS) * HM_W;
+            (* ram_style = "block" *)         // one write, one read port: block RAM
+            reg [MW-1:0] mem [0:2*ROWS-1];
+            always @(posedge clk) begin
+                if (hm_valid_i)
+                    mem[wr_addr] <= hm_data_i[gm*GS*HM_W +: MW];
+                if (fetch_g[gm])
+                    f1_z_q[gm*GS*HM_W +: MW] <= mem[rd_addr];
+            end
+            (* keep *) always @(posedge clk) avc_q[gm]  <= av_nx;
+            (* keep *) always @(posedge clk) f1vc_q[gm] <= f1_v_nx;
+            (* keep *) always @(posedge clk) f2vc_q[gm] <= f2_v_nx;
+            always @(posedge clk) begin
+                if (mv_g[gm]) begin
+                    f2_z_q[gm*GS*HM_W +: MW] <= f1_z_q[gm*GS*HM_W +: MW];
+                    f2_c_q[gm*GS +: MW/HM_W]  <= f1_c_q[gm*GS +: MW/HM_W];
+                    f2_es_q[gm*GS +: MW/HM_W] <= f1_es_q[gm*GS +: MW/HM_W];
+                    f2_fa_q[gm*GS +: MW/HM_W] <= f1_fa_q[gm*GS +: MW/HM_W];
+                    f2_b_q[gm*GS +: MW/HM_W]  <= f1_es_q[gm*GS +: MW/HM_W] & es_neg[gm*GS +: MW/HM_W];
+                    f2_ge_q[gm*GS +: MW/HM_W] <= f1_es_q[gm*GS +: MW/HM_W] | es_neg[gm*GS +: MW/HM_W];
+                end
+                if (take_g[gm]) begin
+                    e1_z_q[gm*GS*HM_W +: MW] <= f2_z_q[gm*GS*HM_W +: MW];
+                    e1_c_q[gm*GS +: MW/HM_W]  <= f2_c_q[gm*GS +: MW/HM_W];
+                    e1_fa_q[gm*GS +: MW/HM_W] <= f2_fa_q[gm*GS +: MW/HM_W];
+                    e1_rem_q[gm*GS +: MW/HM_W] <= f2_es_q[gm*GS +: MW/HM_W];
+                    e1_b_q[gm*GS +: MW/HM_W]   <= f2_b_q[gm*GS +: MW/HM_W];
+                    e1_ge_q[gm*GS +: MW/HM_W]  <= f2_ge_q[gm*GS +: MW/HM_W];
+                end else if (ev_go) begin
+                    e1_rem_q[gm*GS +: MW/HM_W] <= e1_remr[gm*GS +: MW/HM_W];
+                    e1_b_q[gm*GS +: MW/HM_W]   <= e1_remr[gm*GS +: MW/HM_W] & e1_neg[gm*GS +: MW/HM_W];
+                    e1_ge_q[gm*GS +: MW/HM_W]  <= e1_remr[gm*GS +: MW/HM_W] | e1_neg[gm*GS +: MW/HM_W];
+                end
+            end
+        end
+    endgenerate
 
     // ---- X1..X5: the run's sums (X1: masked cells; X2: 8-column groups; X3: totals;
     // X4, X5: sum z*r = r * sum z by shift and add) -------------------------------------
@@ -1161,12 +1215,6 @@ module fmt_blob #(
     reg [LR_W-1:0]       mk_lr_q;
     reg [NLP-1:0]        mk_s_pad;
     reg [COLS-1:0]       mk_on, mk_st;
-    /* verilator lint_off UNUSEDSIGNAL */     // mk_fill[COLS]: a carry beyond the last column
-    wire [COLS:0]        mk_fill = {1'b0, mk_on} + {1'b0, mk_st};
-    /* verilator lint_on UNUSEDSIGNAL */
-    // a run's cells get the status of its label, from its start: the status bit added at
-    // the start carries through the run (its cells become 0) and stops after it
-    wire [COLS-1:0]      mk_bits = mk_on & ~mk_fill[COLS-1:0];
     always @(*) begin : c_mk
         integer c;
         mk_s_pad = {NLP{1'b0}};
@@ -1176,10 +1224,12 @@ module fmt_blob #(
             mk_st[c] = mk_on[c] && (c == 0 || !mk_on[(c > 0) ? c - 1 : 0])
                     && mk_s_pad[mk_lr_q[(c/2)*LBL_W +: LBL_W]];
     end
+    // the mask row is stored as its on-cells and its blob run starts (the status select
+    // and the fill's carry chain in different cycles); the query fills the row it reads
     (* ram_style = "distributed" *)
-    reg [COLS-1:0]       mask_mem [0:ROWS-1];
+    reg [2*COLS-1:0]     mask_mem [0:ROWS-1];
     always @(posedge clk) begin
-        if (mk_v_q) mask_mem[mk_row_q] <= mk_bits;
+        if (mk_v_q) mask_mem[mk_row_q] <= {mk_st, mk_on};
         mk_s_q   <= bw_s;
         mk_lr_q  <= lr_rd_q;
         mk_row_q <= bw_row_q;
@@ -1190,8 +1240,14 @@ module fmt_blob #(
     reg [COLS-1:0]       q_w_q;               // mask word of the queried row
     reg [COL_IDX_W-1:0]  q_col_q;
     reg [NCP-1:0]        q_w_pad;             // columns >= COLS read 0
+    wire [2*COLS-1:0]    q_rd = mask_mem[mask_q_row_i];
+    /* verilator lint_off UNUSEDSIGNAL */     // q_fill[COLS]: a carry beyond the last column
+    wire [COLS:0]        q_fill = {1'b0, q_rd[0 +: COLS]} + {1'b0, q_rd[COLS +: COLS]};
+    /* verilator lint_on UNUSEDSIGNAL */
     always @(posedge clk) begin
-        q_w_q   <= mask_mem[mask_q_row_i];
+        // a run's cells get the status of its label, from its start: the status bit added
+        // at the start carries through the run (its cells become 0) and stops after it
+        q_w_q   <= q_rd[0 +: COLS] & ~q_fill[COLS-1:0];
         q_col_q <= mask_q_col_i;
     end
     always @(*) begin
@@ -1208,27 +1264,74 @@ module fmt_blob #(
     reg  abort_q;                             // incomplete frame, pipeline idle (one cycle late)
     wire fin_abort = (state_q == S_RUN) && abort_q;
     assign releasing = (state_q == S_WAIT) && (out_tok || tok_q) && !bw_busy_q;
+    // av_q's next value: in S_RUN (not finishing) row fr_q or, after a fetch, fr_q + 1 of
+    // bank pb_q; after the release row 0 of the other bank; the arrivals of this cycle
+    // counted (both candidates looked up beside fetch, which only picks one)
+    // (by the one-hot fr_oh_q: an AND-OR over the rows in groups of 3, no index select;
+    // this cycle's row by one compare with fr_q, fr1_q = fr_q + 1; the parts are kept
+    // wires, so synthesis maps a balanced tree and not a LUT chain: 11 xc5v levels else)
+    localparam AVG = (ROWS + 2) / 3;
+    wire                 arr_o0  = pb_q ? arr_q[0][0] : arr_q[1][0];   // the other bank's row 0
+    wire                 hm_p    = hm_valid_i && (wb_q == pb_q);
+    wire                 fr1_in  = (fr1_q < ROWS_R);
+    reg  [3*AVG-1:0]     av_ap, av_o0, av_o1;
+    reg  [AVG-1:0]       av_s0, av_s1;
+    always @(*) begin : c_av_g
+        integer j;
+        av_ap = {(3*AVG){1'b0}};
+        av_o0 = {(3*AVG){1'b0}};
+        av_o1 = {(3*AVG){1'b0}};
+        av_ap[ROWS-1:0] = arr_p;
+        av_o0[ROWS-1:0] = fr_oh_q;
+        av_o1[ROWS-1:0] = {fr_oh_q[ROWS-2:0], 1'b0};
+        for (j = 0; j < AVG; j = j + 1) begin
+            av_s0[j] = |(av_ap[3*j +: 3] & av_o0[3*j +: 3]);
+            av_s1[j] = |(av_ap[3*j +: 3] & av_o1[3*j +: 3]);
+        end
+    end
+    // (kept wires; assigned below)
+    (* keep *) wire [AVG-1:0] av_g0;           // row fr_q arrived (per group of 3 rows)
+    (* keep *) wire [AVG-1:0] av_g1;           // row fr_q + 1
+    (* keep *) wire           av_h0, av_h1;    // ... arriving this cycle
+    (* keep *) wire           av_a0, av_a1;    // row fr_q, fr_q + 1 present next cycle
+    (* keep *) wire           av_run, av_rel;  // S_RUN stays; the release
+    assign av_g0  = av_s0;
+    assign av_g1  = av_s1;
+    assign av_h0  = hm_p && fr_in && (hm_row_i == fr_row);
+    assign av_h1  = hm_p && fr1_in && (hm_row_i == fr1_q[ROW_IDX_W-1:0]);
+    assign av_a0  = (|av_g0) || av_h0;
+    assign av_a1  = (|av_g1) || av_h1;
+    assign av_run = !rst && (state_q == S_RUN) && !fin_ok && !fin_abort;
+    assign av_rel = !rst && releasing && (arr_o0 || (hm_valid_i && (wb_q != pb_q)
+                                                     && hm_row_i == {ROW_IDX_W{1'b0}}));
+    assign               av_nx   = (av_run && (fetch ? av_a1 : av_a0)) || av_rel;
+    always @(posedge clk) av_q <= av_nx;
+    // synthesis translate_off
+    reg chk_rst_q;                            // a reset was seen (the checks below after it)
+    initial chk_rst_q = 1'b0;
+    always @(posedge clk) if (rst) chk_rst_q <= 1'b1;
+    always @(posedge clk) begin
+        if (!rst && chk_rst_q && (av_q !== ((state_q == S_RUN) && fr_in && arr_p[fr_row])
+                     || fr_oh_q !== (fr_in ? {{(ROWS-1){1'b0}}, 1'b1} << fr_row : {ROWS{1'b0}})
+                     || fr1_q !== fr_q + 1'b1
+                     || avc_q !== {NG{av_q}} || f1vc_q !== {NG{f1_v_q}} || f2vc_q !== {NG{f2_v_q}})) begin
+            $display("fmt_blob: av_q %b or an enable copy differs (fr_oh_q %h fr_q %0d) at %0t", av_q, fr_oh_q, fr_q, $time);
+            $finish;
+        end
+    end
+    // synthesis translate_on
     wire over      = (found_q > MB_A);
 
     always @(posedge clk) begin : s_main
         integer i;
         // ---- datapath registers (no reset needed) ----
-        if (f2_take) begin
-            e1_z_q   <= f2_z_q;
-            e1_c_q   <= f2_c_q;
-            e1_fa_q  <= f2_fa_q;
+        // (E's and F2's column registers: per GS columns in g_mem)
+        if (f2_take)
             e1_row_q <= f2_row_q;
-        end
         if (f2_take) begin
-            e1_rem_q <= f2_es_q;
-            e1_b_q   <= f2_b_q;
-            e1_ge_q  <= f2_ge_q;
             e1_last_q <= f2_one_q;
             e1_first_q <= 1'b1;
         end else if (ev_go) begin
-            e1_rem_q <= e1_remr;
-            e1_b_q   <= e1_remr & e1_neg;
-            e1_ge_q  <= e1_remr | e1_neg;
             e1_last_q <= le2(e1_rem_q);             // = ((e1_remr & ~e1_neg) == 0): b is in rem
             e1_first_q <= 1'b0;
         end
@@ -1316,6 +1419,8 @@ module fmt_blob #(
             pb_q     <= 1'b0;
             state_q  <= S_RUN;
             fr_q     <= {(ROW_IDX_W+1){1'b0}};
+            fr_oh_q  <= {{(ROWS-1){1'b0}}, 1'b1};
+            fr1_q    <= {{ROW_IDX_W{1'b0}}, 1'b1};
             lastc_q  <= {COLS{1'b0}};
             f1_v_q   <= 1'b0;
             f2_v_q   <= 1'b0;
@@ -1391,6 +1496,8 @@ module fmt_blob #(
 
             // ---- fetch, extraction, sums, FIFO ----
             if (fetch) fr_q <= fr_q + 1'b1;
+            if (fetch) fr_oh_q <= {fr_oh_q[ROWS-2:0], 1'b0};
+            if (fetch) fr1_q <= fr1_q + 1'b1;
             if (fetch) lastc_q <= on_f;
             if (fetch) f1_v_q <= 1'b1;
             else if (f1_mv) f1_v_q <= 1'b0;
@@ -1444,7 +1551,7 @@ module fmt_blob #(
             if (pk_fill) pk_v_q <= |pend_q;     // (pk_q <= pk_nx above)
             idle_q <= !pipe_busy && !fetch;
             abort_q <= (state_q == S_RUN) && eofs_q[pb_q] && !lab_done_q && !pipe_busy
-                     && !fetch && fr_in && !arr_p[fr_row] && !releasing;
+                     && !fetch && fr_in && !av_q && !releasing;
             if (x4_v_q && x4_last_q) lab_done_q <= 1'b1;
             cl_v_q <= cl_go;
 
@@ -1524,6 +1631,8 @@ module fmt_blob #(
                 found_q      <= {AREA_W{1'b0}};
                 lab_done_q   <= 1'b0;
                 fr_q         <= {(ROW_IDX_W+1){1'b0}};
+                fr_oh_q      <= {{(ROWS-1){1'b0}}, 1'b1};
+                fr1_q        <= {{ROW_IDX_W{1'b0}}, 1'b1};
                 lastc_q      <= {COLS{1'b0}};
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
