@@ -10,6 +10,7 @@
 #   make generate  write every generated file (python -m fmt.generate)
 #   make synth   Yosys synth_xilinx -family xc5v of each RTL top -> build/synth/report.json
 #   make synth-core  the whole default core in one Yosys run -> build/synth/core_default.json
+#   make reset-proof  one reset clock fixes every block's state (bounded proofs, Yosys sat)
 #   make timing  routed ECP5 Fmax and xc5v logic depth of every block -> build/timing/report.json
 #   make board-xc5v  write the XC5VSX95T board's ISE project (fpga/xc5vsx95t; ISE not here)
 # Every target installs what it needs the first time (iverilog from Debian, a pinned
@@ -37,7 +38,7 @@ FUZZ_BYTES   ?= 1000000
 SIM          ?=
 export SIM
 
-.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz mutate random-scenes test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
+.PHONY: board-xc5v all setup sim sim-serve sim-model fuzz mutate random-scenes reset-proof test test-model test-rtl test-long lint synth synth-core timing timing-smoke formal report bench-model fft-accuracy interp-accuracy dds-purity generate clean distclean iverilog ccache
 
 all: test
 
@@ -103,12 +104,18 @@ test-long: setup
 	  $(VPY) -m pytest -q -n $(JOBS) sim/tests tb
 	$(VPY) scripts/mutate.py
 	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --reset --quiet
+	$(VPY) scripts/reset_proof.py --jobs $(JOBS)
 
 # random scenes through the fixed-point model with invariants, the first 200 also
 # through the RTL (small and medium builds) after a busy core was reset at a random
 # cycle, issue #15 items 3-4; about 10 min here
 random-scenes: setup
 	$(VPY) scripts/random_scenes.py --count 10000 --seed 7 --rtl 200 --reset
+
+# two copies of each block from free states, one reset, the same inputs: equal outputs
+# (issue #15 item 3; tb/common/test_reset_proof.py runs the quick ones in make test)
+reset-proof: setup
+	$(VPY) scripts/reset_proof.py --jobs $(JOBS)
 
 lint: setup
 	@bash scripts/lint.sh
