@@ -317,8 +317,22 @@ module fmt_localmax #(
     // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
     // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
     // below-left, below-right; all of them when w1_q holds the last row)
-    wire [COLS-1:0] cu = cg_q & ({COLS{!moore_i}} | (d1[COLS-1:0] & d2[COLS:1]));
-    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & ({COLS{!moore_i}} | (~d1[COLS:1] & ~d2[COLS-1:0])));
+    // (moore_i from registered copies, one per quarter of the columns: no net from one
+    // flip-flop to the 80 mask LUTs; a change takes effect a cycle later)
+    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_i copies
+    reg  [NMC-1:0]  moo_q;
+    wire [COLS-1:0] moo;                       // the copy of column c
+    genvar gm;
+    generate
+        for (gm = 0; gm < NMC; gm = gm + 1) begin : g_moo
+            (* keep *) always @(posedge clk) moo_q[gm] <= moore_i;
+        end
+        for (gm = 0; gm < COLS; gm = gm + 1) begin : g_mooc
+            assign moo[gm] = moo_q[(gm * NMC) / COLS];
+        end
+    endgenerate
+    wire [COLS-1:0] cu = cg_q & (~moo | (d1[COLS-1:0] & d2[COLS:1]));
+    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & (~moo | (~d1[COLS:1] & ~d2[COLS-1:0])));
     // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
     wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu | {COLS{t3_q}});
 
@@ -333,10 +347,57 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
-    // adv's next value: rem_q's next value is 0, and no finishing step with a partial
-    // mask (a superset of its final mask: the stall for a row whose maxima the row below
-    // all removes is one cycle, with no capture)
-    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !(|rem_nx));
+    // rem_q holds two bits or more (a balanced tree of 4-bit groups: any, two or more;
+    // rem_q's own bits only, not rem_e: no mask logic and no carry chain before adv)
+    localparam NT1 = (COLS + 3) / 4;           // 4-bit groups
+    localparam NT2 = (NT1 + 3) / 4;            // groups of 4 groups
+    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, rem_q};
+    wire [4*NT2-1:0] t1_a, t1_t;               // level 1: any, two or more (padded)
+    wire [4*NT2-1:0] t2_a, t2_t;               // level 2
+    genvar gt;
+    generate
+        for (gt = 0; gt < 4 * NT2; gt = gt + 1) begin : g_two1
+            if (gt < NT1) begin : g_v
+                wire [3:0] b = two_r[4*gt +: 4];
+                assign t1_a[gt] = |b;
+                assign t1_t[gt] = (b[0] & (b[1] | b[2] | b[3])) | (b[1] & (b[2] | b[3])) | (b[2] & b[3]);
+            end else begin : g_z
+                assign t1_a[gt] = 1'b0;
+                assign t1_t[gt] = 1'b0;
+            end
+        end
+        for (gt = 0; gt < 4 * NT2; gt = gt + 1) begin : g_two2
+            if (gt < NT2) begin : g_v
+                wire [3:0] a = t1_a[4*gt +: 4];
+                assign t2_a[gt] = |a;
+                assign t2_t[gt] = (|t1_t[4*gt +: 4])
+                                | (a[0] & (a[1] | a[2] | a[3])) | (a[1] & (a[2] | a[3])) | (a[2] & a[3]);
+            end else begin : g_z
+                assign t2_a[gt] = 1'b0;
+                assign t2_t[gt] = 1'b0;
+            end
+        end
+    endgenerate
+    // level 3: pairs of the NT2 groups
+    reg rem_two;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_two
+        integer i, j;
+        rem_two = 1'b0;
+        for (i = 0; i < NT2; i = i + 1) begin
+            rem_two = rem_two | t2_t[i];
+            for (j = i + 1; j < NT2; j = j + 1)
+                rem_two = rem_two | (t2_a[i] & t2_a[j]);
+        end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
+    // adv's next value: rem_q holds at most one bit (so rem_q's next value is 0), and no
+    // finishing step with a partial mask (a superset of its final mask: the stall for a
+    // row whose maxima the row below all removes is one cycle, with no capture).  In the
+    // first serialising cycle of a row rem_q is its partial mask, not yet ANDed with the
+    // down mask: a row with two partial-mask cells or more and at most one maximum holds
+    // the window one cycle more (two cycles; the last one takes nothing)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !rem_two);
     // the window shifts next cycle: adv then, and a step in s2 then
     wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
 

@@ -315,7 +315,8 @@ async def latency(dut):
         plus those of these rows with a partial mask and no maximum (a stall cycle each)."""
         mm = maxima_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
         pm = partial_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
-        return int(mm.sum()) + int((pm.any(axis=1) & ~mm.any(axis=1)).sum())
+        km, kp = mm.sum(axis=1), pm.sum(axis=1)
+        return int(km.sum()) + int(((kp >= 1) & (km == 0)).sum()) + int(((kp >= 2) & (km <= 1)).sum())
 
     hms = [random_hm(nrng, tb.rows, tb.cols, "fingers") for _ in range(4)]
     lat = await tb.run_frames(rng, hms, 100, order=order)
