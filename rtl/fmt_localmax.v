@@ -594,6 +594,9 @@ module fmt_localmax #(
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
     reg             ptop_q, pbot_q;            // first / last row
     reg [IDX_W-1:0] pidx_q;                    // raster index
+    reg [HM_W-1:0]  pc_q;                      // the centre cell (= z9's centre below) in a
+                                               // register of its own: the list's early
+                                               // compare does not wait on the rotation
     wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
     wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
     wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
@@ -624,12 +627,12 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
-    // and pidx_q in every cycle
+    // (= pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
                       .HAS_POP(1), .EARLY(1)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
-        .nxt_key_i(z9[4*HM_W +: HM_W]), .nxt_tie_i(pidx_q),
+        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -709,6 +712,11 @@ module fmt_localmax #(
         p1bot_q   <= mbot_q;
         p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
+        case (p1m_q)                           // z9's centre (row b, rotated)
+            2'd1:    pc_q <= s2[5*HM_W +: HM_W];
+            2'd2:    pc_q <= s2[3*HM_W +: HM_W];
+            default: pc_q <= s2[4*HM_W +: HM_W];
+        endcase
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
         pbot_q    <= p1bot_q;
