@@ -34,9 +34,11 @@
 //        (loaded at the shift) AND its down mask; the lowest maximum is registered
 //        one-hot and decoded in the next cycle (the sweep waits: a row with k maxima
 //        holds the window k cycles, a row with none but a non-empty partial mask one
-//        cycle; the stall enable is a register, computed a cycle early from the partial
-//        mask and the serialiser's mask, in copies per column group: no comparator and
-//        no gate before the window's clock enables)
+//        cycle, a row with two partial-mask cells or more and at most one maximum two
+//        cycles; the stall enable is a register, computed a cycle early from the partial
+//        mask and the serialiser's own bits (two or more left: the first cycle of a row
+//        counts its partial mask, not its maxima), in copies per column group: no
+//        comparator and no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
 //        each quarter of a group (its select decoded per quarter from the one-hot
@@ -44,30 +46,33 @@
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
-//        early); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
+//        early with the centre cell from a register of its own, rotated in the capture's
+//        second step); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
 //        list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
 // then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
-// between frames (limit_i is registered: it takes effect two cycles later).
+// between frames (limit_i is registered: it takes effect two cycles later; moore_i, in
+// registered copies, one cycle later).
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
 // candidate <= 15 + n + m + e for n candidates, m maxima in the rows completed by the
-// last beat (its row and the rows next to it) and e (<= 3) of those rows with a partial
-// mask but no maximum: the sweep starts over (up to 5 reads: rows r - 2 .. r + 2) on
-// one-cycle-old ready flags, each maximum holds it one cycle (a row with a partial
-// mask and no maximum one cycle), the last one is captured (3 registers) and
+// last beat (its row and the rows next to it) and e (<= 6) the extra stall cycles of
+// those rows: one for a row with a partial mask but no maximum, one more for a row with
+// two partial-mask cells or more and at most one maximum: the sweep starts over (up to
+// 5 reads: rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one
+// cycle (plus the extra cycles above), the last one is captured (3 registers) and
 // inserted, and the finish test is registered, before the emission starts.  30 x 40,
 // FFT row order: 12 + n + e without maxima in those rows (3..5 candidates: 15, 16, 15,
 // 18); 20 maxima in the last row, 16 candidates: 51 (= 15 + n + m).  hm_eof -> last
 // candidate is one cycle less; cand_eof follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
-// per row in a run) plus the virtual step (121), one cycle per maximum and at least one
-// per row with a partial mask (at most COLS / 2 = 20 per row, 600: Von Neumann
-// checkerboard; Moore at most 300), 11 of pipeline and finish, n + 3 of emission (19):
-// 751 < 768.
+// per row in a run) plus the virtual step (121), per row max(k, min(p, 2)) for k
+// maxima and p partial-mask cells (k <= p <= COLS / 2 = 20: no two neighbours in a
+// partial mask; 600: Von Neumann checkerboard, 20 maxima a row), 11 of pipeline and
+// finish, n + 3 of emission (19): 751 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
