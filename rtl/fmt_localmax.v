@@ -34,9 +34,11 @@
 //        (loaded at the shift) AND its down mask; the lowest maximum is registered
 //        one-hot and decoded in the next cycle (the sweep waits: a row with k maxima
 //        holds the window k cycles, a row with none but a non-empty partial mask one
-//        cycle; the stall enable is a register, computed a cycle early from the partial
-//        mask and the serialiser's mask, in copies per column group: no comparator and
-//        no gate before the window's clock enables)
+//        cycle, a row with two partial-mask cells or more and at most one maximum two
+//        cycles; the stall enable is a register, computed a cycle early from the partial
+//        mask and the serialiser's own bits (two or more left: the first cycle of a row
+//        counts its partial mask, not its maxima), in copies per column group: no
+//        comparator and no gate before the window's clock enables)
 //   SW5  capture the maximum's 3x3 from the window (by column mod 3: three
 //        ceil((COLS+2)/3):1 selects per row, in two registered steps: a select within
 //        each quarter of a group (its select decoded per quarter from the one-hot
@@ -44,30 +46,33 @@
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
-//        early); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
+//        early with the centre cell from a register of its own, rotated in the capture's
+//        second step); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
 //        list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
 // then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
-// between frames (limit_i is registered: it takes effect two cycles later).
+// between frames (limit_i is registered: it takes effect two cycles later; moore_i, in
+// registered copies, one cycle later).
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
 // candidate <= 15 + n + m + e for n candidates, m maxima in the rows completed by the
-// last beat (its row and the rows next to it) and e (<= 3) of those rows with a partial
-// mask but no maximum: the sweep starts over (up to 5 reads: rows r - 2 .. r + 2) on
-// one-cycle-old ready flags, each maximum holds it one cycle (a row with a partial
-// mask and no maximum one cycle), the last one is captured (3 registers) and
+// last beat (its row and the rows next to it) and e (<= 6) the extra stall cycles of
+// those rows: one for a row with a partial mask but no maximum, one more for a row with
+// two partial-mask cells or more and at most one maximum: the sweep starts over (up to
+// 5 reads: rows r - 2 .. r + 2) on one-cycle-old ready flags, each maximum holds it one
+// cycle (plus the extra cycles above), the last one is captured (3 registers) and
 // inserted, and the finish test is registered, before the emission starts.  30 x 40,
 // FFT row order: 12 + n + e without maxima in those rows (3..5 candidates: 15, 16, 15,
 // 18); 20 maxima in the last row, 16 candidates: 51 (= 15 + n + m).  hm_eof -> last
 // candidate is one cycle less; cand_eof follows the last candidate.
 // Worst-case cycles per frame (30 x 40, M = 1): at most 4 steps per row (a start: one
 // idle cycle for the one-cycle-old lowest ready row, reads s - 1, s, s + 1; one read
-// per row in a run) plus the virtual step (121), one cycle per maximum and at least one
-// per row with a partial mask (at most COLS / 2 = 20 per row, 600: Von Neumann
-// checkerboard; Moore at most 300), 11 of pipeline and finish, n + 3 of emission (19):
-// 751 < 768.
+// per row in a run) plus the virtual step (121), per row max(k, min(p, 2)) for k
+// maxima and p partial-mask cells (k <= p <= COLS / 2 = 20: no two neighbours in a
+// partial mask; 600: Von Neumann checkerboard, 20 maxima a row), 11 of pipeline and
+// finish, n + 3 of emission (19): 751 < 768.
 // A frame must be finished (cand_eof) before the frame after the next one starts to
 // arrive, else overrun_o is set (sticky).
 //
@@ -317,8 +322,22 @@ module fmt_localmax #(
     // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
     // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
     // below-left, below-right; all of them when w1_q holds the last row)
-    wire [COLS-1:0] cu = cg_q & ({COLS{!moore_i}} | (d1[COLS-1:0] & d2[COLS:1]));
-    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & ({COLS{!moore_i}} | (~d1[COLS:1] & ~d2[COLS-1:0])));
+    // (moore_i from registered copies, one per quarter of the columns: no net from one
+    // flip-flop to the 80 mask LUTs; a change takes effect a cycle later)
+    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_i copies
+    reg  [NMC-1:0]  moo_q;
+    wire [COLS-1:0] moo;                       // the copy of column c
+    genvar gm;
+    generate
+        for (gm = 0; gm < NMC; gm = gm + 1) begin : g_moo
+            (* keep *) always @(posedge clk) moo_q[gm] <= moore_i;
+        end
+        for (gm = 0; gm < COLS; gm = gm + 1) begin : g_mooc
+            assign moo[gm] = moo_q[(gm * NMC) / COLS];
+        end
+    endgenerate
+    wire [COLS-1:0] cu = cg_q & (~moo | (d1[COLS-1:0] & d2[COLS:1]));
+    wire [COLS-1:0] dm = {COLS{mbot_q}} | (~cg_q & (~moo | (~d1[COLS:1] & ~d2[COLS-1:0])));
     // N's partial mask (earlier neighbours: left strict, the row above), of w0_q's row
     wire [COLS-1:0] part_c = ct_q & cl[COLS-1:0] & ~cl[COLS:1] & (cu | {COLS{t3_q}});
 
@@ -333,10 +352,57 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_m1  = rem_e - 1'b1;
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
-    // adv's next value: rem_q's next value is 0, and no finishing step with a partial
-    // mask (a superset of its final mask: the stall for a row whose maxima the row below
-    // all removes is one cycle, with no capture)
-    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !(|rem_nx));
+    // rem_q holds two bits or more (a balanced tree of 4-bit groups: any, two or more;
+    // rem_q's own bits only, not rem_e: no mask logic and no carry chain before adv)
+    localparam NT1 = (COLS + 3) / 4;           // 4-bit groups
+    localparam NT2 = (NT1 + 3) / 4;            // groups of 4 groups
+    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, rem_q};
+    wire [4*NT2-1:0] t1_a, t1_t;               // level 1: any, two or more (padded)
+    wire [4*NT2-1:0] t2_a, t2_t;               // level 2
+    genvar gt;
+    generate
+        for (gt = 0; gt < 4 * NT2; gt = gt + 1) begin : g_two1
+            if (gt < NT1) begin : g_v
+                wire [3:0] b = two_r[4*gt +: 4];
+                assign t1_a[gt] = |b;
+                assign t1_t[gt] = (b[0] & (b[1] | b[2] | b[3])) | (b[1] & (b[2] | b[3])) | (b[2] & b[3]);
+            end else begin : g_z
+                assign t1_a[gt] = 1'b0;
+                assign t1_t[gt] = 1'b0;
+            end
+        end
+        for (gt = 0; gt < 4 * NT2; gt = gt + 1) begin : g_two2
+            if (gt < NT2) begin : g_v
+                wire [3:0] a = t1_a[4*gt +: 4];
+                assign t2_a[gt] = |a;
+                assign t2_t[gt] = (|t1_t[4*gt +: 4])
+                                | (a[0] & (a[1] | a[2] | a[3])) | (a[1] & (a[2] | a[3])) | (a[2] & a[3]);
+            end else begin : g_z
+                assign t2_a[gt] = 1'b0;
+                assign t2_t[gt] = 1'b0;
+            end
+        end
+    endgenerate
+    // level 3: pairs of the NT2 groups
+    reg rem_two;
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_two
+        integer i, j;
+        rem_two = 1'b0;
+        for (i = 0; i < NT2; i = i + 1) begin
+            rem_two = rem_two | t2_t[i];
+            for (j = i + 1; j < NT2; j = j + 1)
+                rem_two = rem_two | (t2_a[i] & t2_a[j]);
+        end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
+    // adv's next value: rem_q holds at most one bit (so rem_q's next value is 0), and no
+    // finishing step with a partial mask (a superset of its final mask: the stall for a
+    // row whose maxima the row below all removes is one cycle, with no capture).  In the
+    // first serialising cycle of a row rem_q is its partial mask, not yet ANDed with the
+    // down mask: a row with two partial-mask cells or more and at most one maximum holds
+    // the window one cycle more (two cycles; the last one takes nothing)
+    wire            adv_d   = rst || (advs_q ? !(v2_q && f2_q && (|part_c)) : !rem_two);
     // the window shifts next cycle: adv then, and a step in s2 then
     wire            wsh_d   = !rst && adv_d && (advs_q ? v1_q : v2_q);
 
@@ -533,6 +599,9 @@ module fmt_localmax #(
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
     reg             ptop_q, pbot_q;            // first / last row
     reg [IDX_W-1:0] pidx_q;                    // raster index
+    reg [HM_W-1:0]  pc_q;                      // the centre cell (= z9's centre below) in a
+                                               // register of its own: the list's early
+                                               // compare does not wait on the rotation
     wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
     wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
     wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
@@ -563,12 +632,12 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
-    // and pidx_q in every cycle
+    // (= pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
                       .HAS_POP(1), .EARLY(1)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
-        .nxt_key_i(z9[4*HM_W +: HM_W]), .nxt_tie_i(pidx_q),
+        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -648,6 +717,11 @@ module fmt_localmax #(
         p1bot_q   <= mbot_q;
         p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
+        case (p1m_q)                           // z9's centre (row b, rotated)
+            2'd1:    pc_q <= s2[5*HM_W +: HM_W];
+            2'd2:    pc_q <= s2[3*HM_W +: HM_W];
+            default: pc_q <= s2[4*HM_W +: HM_W];
+        endcase
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
         pbot_q    <= p1bot_q;

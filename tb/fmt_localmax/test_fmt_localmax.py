@@ -9,8 +9,9 @@ corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
 neighbourhoods, a reset in the middle of a frame, undefined row, data and frame inputs
 (X under Icarus, garbage under Verilator) between beats.  The latency from the last row beat
 (and from hm_eof) to the last candidate is measured and bounded: 15 + n + m + e for n
-candidates, m maxima in the rows completed by the last beat and e of those rows with a
-partial mask but no maximum (rtl/fmt_localmax.v).
+candidates, m maxima in the rows completed by the last beat and e their extra stall
+cycles: one for a row with a partial mask but no maximum, one more for a row with two
+partial-mask cells or more and at most one maximum (rtl/fmt_localmax.v).
 """
 from __future__ import annotations
 
@@ -32,8 +33,9 @@ from fmt.localmax import local_maxima_fixed, maxima_mask, offsets
 
 
 # latency bound, last row beat -> last candidate (rtl/fmt_localmax.v header): LAT_C + n + m + e
-# for n candidates, m maxima in the rows completed by the last beat and e of those rows
-# with a partial mask (every test but the row below) and no maximum (one stall cycle each)
+# for n candidates, m maxima in the rows completed by the last beat and e their extra
+# stall cycles: one for a row with a partial mask (every test but the row below) and no
+# maximum, one more for a row with two partial-mask cells or more and at most one maximum
 LAT_C = 15
 
 
@@ -312,10 +314,12 @@ async def latency(dut):
 
     def late(hm):
         """Maxima in the rows the last beat completes (its row and the rows next to it),
-        plus those of these rows with a partial mask and no maximum (a stall cycle each)."""
+        plus the extra stall cycles of these rows: one for a partial mask and no maximum,
+        one more for two partial-mask cells or more and at most one maximum."""
         mm = maxima_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
         pm = partial_mask(hm, tb.thr, tb.nb)[max(0, lastr - 1):lastr + 2]
-        return int(mm.sum()) + int((pm.any(axis=1) & ~mm.any(axis=1)).sum())
+        km, kp = mm.sum(axis=1), pm.sum(axis=1)
+        return int(km.sum()) + int(((kp >= 1) & (km == 0)).sum()) + int(((kp >= 2) & (km <= 1)).sum())
 
     hms = [random_hm(nrng, tb.rows, tb.cols, "fingers") for _ in range(4)]
     lat = await tb.run_frames(rng, hms, 100, order=order)
@@ -323,7 +327,7 @@ async def latency(dut):
         m = late(hm)
         dut._log.info(f"latency: last row -> last candidate {from_row} cycles, "
                       f"hm_eof -> last candidate {from_eof} cycles, {n} candidates, "
-                      f"m + e = {m} (maxima, and rows with a partial mask only, in the rows "
+                      f"m + e = {m} (maxima, and the extra stall cycles, in the rows "
                       f"completed by the last beat)")
         assert from_row <= LAT_C + n + m, "latency bound"
     # worst case for the model: all 16 candidates in the last rows
