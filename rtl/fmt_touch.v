@@ -33,7 +33,7 @@
 // Latency, processing-clock cycles from the frame's last heat-map row beat (hm_eof on
 // the next cycle) to its last event on ev_*, dial 0, consumer ready: flatten 5,
 // localmax <= 15 + n + m + e (n candidates, m maxima in the rows next to the last one,
-// e <= 3 of them with a partial mask only; 12 + n without them), interp 24, tracker m + l + n + 7 after tp_eof for m moves, l
+// e <= 6 of them with a partial mask only; 12 + n without them), interp 24, tracker m + l + n + 7 after tp_eof for m moves, l
 // lifts, n news without stale picks (see fmt_tracker's header; stale picks only when
 // touches compete for a slot), event port 5 -- measured by tb/fmt_touch (see its
 // docstring and the README for the numbers).
