@@ -353,7 +353,7 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
     // rem_q holds two bits or more (a balanced tree of 4-bit groups: any, two or more;
-    // rem_q's own bits only, not rem_e: no mask logic and no carry chain before adv)
+    // rem_q's own bits only, not rem_e: no mask gates and no carry chain before adv)
     localparam NT1 = (COLS + 3) / 4;           // 4-bit groups
     localparam NT2 = (NT1 + 3) / 4;            // groups of 4 groups
     wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, rem_q};
