@@ -111,8 +111,9 @@
 // unchanged by the L0/L1 and X3/X4 splits of 2026-11-27).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
-// Settings are used live: change them between frames (the threshold applies to a row
-// when it arrives, min-cells when its region closes).
+// Settings are taken with the rows: the threshold applies to a row when it arrives,
+// min-cells (held per frame buffer) to the regions of the frame its rows arrived with;
+// hold both constant over a frame's rows (fmt_touch does).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -285,6 +286,23 @@ module fmt_blob #(
             on_mem[{wb_q, hm_row_i}] <= hm_on;
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
+
+    // min-cells per frame buffer: taken with every row that arrives into a buffer (the
+    // caller holds it constant over a frame's rows: fmt_touch does); the close engine
+    // uses the value of the buffer being labelled (mc_p_q, a register: a region closes
+    // many cycles after its rows arrived, and after the release of the other buffer).
+    reg  [MINC_W-1:0]    mc0_q, mc1_q, mc_p_q;
+    always @(posedge clk) begin
+        if (rst) begin
+            mc0_q  <= {MINC_W{1'b0}};
+            mc1_q  <= {MINC_W{1'b0}};
+            mc_p_q <= {MINC_W{1'b0}};
+        end else begin
+            if (hm_valid_i && !wb_q) mc0_q <= blob_min_cells_i;
+            if (hm_valid_i &&  wb_q) mc1_q <= blob_min_cells_i;
+            mc_p_q <= pb_q ? mc1_q : mc0_q;
+        end
+    end
 
     localparam [1:0] S_RUN = 2'd0, S_EMIT = 2'd1, S_WAIT = 2'd2;
     reg [1:0] state_q;
@@ -1039,7 +1057,7 @@ module fmt_blob #(
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
     localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
-    wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
+    wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, mc_p_q});
     wire              cl_blob = cl_v_q && cl_isblob;
 
     // The list holds the sort keys (area, raster index of the first cell) and a slot

@@ -51,9 +51,10 @@
 //        list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
-// then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
-// between frames (limit_i is registered: it takes effect two cycles later; moore_i, in
-// registered copies, one cycle later).
+// then cand_eof.  Settings (threshold_i, moore_i, limit_i) are taken with the rows, per
+// frame buffer: a frame is processed with the values its rows arrived with (hold them
+// constant over a frame's rows; fmt_touch gives every frame the settings of its first
+// row), also while the next frame arrives.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
@@ -161,6 +162,32 @@ module fmt_localmax #(
     always @(posedge clk) begin
         if (hm_valid_i) mem[{wb_q, hm_row_i}] <= hm_data_i;
     end
+
+    // ---- settings, per frame buffer ----------------------------------------------------
+    // threshold_i, moore_i and limit_i are taken with every row that arrives into a buffer
+    // (the caller holds them constant over a frame's rows: fmt_touch does) and the sweep
+    // and the finish use the values of the buffer being processed, from a register
+    // (set_p_q = the set of buffer pb_q, one cycle old: a row is compared 4 cycles after
+    // its arrival at the earliest, and the sweep of a buffer starts after the release of
+    // the other one).  So a frame is processed with the settings it arrived with, also
+    // while the next frame arrives.
+    localparam SET_W = HM_W + 1 + LIM_W;       // {threshold, moore, limit}
+    reg  [SET_W-1:0]  set0_q, set1_q;          // per buffer
+    reg  [SET_W-1:0]  set_p_q;                 // the processing buffer's
+    always @(posedge clk) begin
+        if (rst) begin
+            set0_q  <= {SET_W{1'b0}};
+            set1_q  <= {SET_W{1'b0}};
+            set_p_q <= {SET_W{1'b0}};
+        end else begin
+            if (hm_valid_i && !wb_q) set0_q <= {threshold_i, moore_i, limit_i};
+            if (hm_valid_i &&  wb_q) set1_q <= {threshold_i, moore_i, limit_i};
+            set_p_q <= pb_q ? set1_q : set0_q;
+        end
+    end
+    wire [HM_W-1:0]   thr_p   = set_p_q[SET_W-1 -: HM_W];    // threshold of the frame
+    wire              moore_p = set_p_q[LIM_W];              // moore of the frame
+    wire [LIM_W-1:0]  limit_p = set_p_q[LIM_W-1:0];          // limit of the frame
 
     // the processing buffer's arrival bitmap, kept as its own register (= pb_q ? arr1_q :
     // arr0_q in every cycle; updated below with arr0_q / arr1_q)
@@ -308,7 +335,7 @@ module fmt_localmax #(
             if (c < COLS - 1) begin : g_r
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
-            assign thr_n[c] = (n >= threshold_i);
+            assign thr_n[c] = (n >= thr_p);
         end
     endgenerate
     reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
@@ -322,15 +349,15 @@ module fmt_localmax #(
     // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
     // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
     // below-left, below-right; all of them when w1_q holds the last row)
-    // (moore_i from registered copies, one per quarter of the columns: no net from one
-    // flip-flop to the 80 mask LUTs; a change takes effect a cycle later)
-    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_i copies
+    // (moore_p from registered copies, one per quarter of the columns: no net from one
+    // flip-flop to the 80 mask LUTs)
+    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_p copies
     reg  [NMC-1:0]  moo_q;
     wire [COLS-1:0] moo;                       // the copy of column c
     genvar gm;
     generate
         for (gm = 0; gm < NMC; gm = gm + 1) begin : g_moo
-            (* keep *) always @(posedge clk) moo_q[gm] <= moore_i;
+            (* keep *) always @(posedge clk) moo_q[gm] <= moore_p;
         end
         for (gm = 0; gm < COLS; gm = gm + 1) begin : g_mooc
             assign moo[gm] = moo_q[(gm * NMC) / COLS];
@@ -667,9 +694,9 @@ module fmt_localmax #(
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
     end
 
-    // the limit and the counts of the finish, registered: limit_i two cycles old, found_q
+    // the limit and the counts of the finish, registered: limit_p a cycle old, found_q
     // one (it does not change in the cycle before finish: fin_pre_q waits for no capture)
-    wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
+    wire [LIM_W-1:0] lim_eff  = (limit_p > K_L) ? K_L : limit_p;
     reg  [LIM_W-1:0] lim_q;
     wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_q};
     wire             over_d   = (found_q > lim_ext);
