@@ -37,8 +37,9 @@
 // frames are in flight (each stage finishes a frame before the next-but-one arrives,
 // else its overrun flag), so four table entries, by frame number mod 4, never meet.
 // delay_i and report_period_i act on the event port as events pass (events keep their
-// order, a frame is admitted or skipped whole); a calibration write takes effect for
-// the rows that arrive after it (a frame may see part of a calibration upload).
+// order, a frame is admitted or skipped whole); a calibration write that comes during
+// a frame's rows waits for its hm_eof (fmt_flatten: a frame is flattened with one
+// calibration; cal_late_o if its queue overflows).
 //
 // Latency, processing-clock cycles from the frame's last heat-map row beat (hm_eof on
 // the next cycle) to its last event on ev_*, dial 0, consumer ready: flatten 5,
@@ -122,6 +123,7 @@ module fmt_touch #(
     // monitor
     output wire [TIME_W-1:0]     now_o,              // time-stamp counter
     output wire                  sat_flag_o,         // flattening saturated (sticky)
+    output wire                  cal_late_o,         // a calibration write went into a frame (sticky)
     output wire [CNT_W-1:0]      sat_count_o,        // saturated cells
     output wire                  lm_overflow_o,      // a frame had more maxima than the limit (sticky)
     output wire [CNT_W-1:0]      lm_drop_count_o,    // candidates dropped by the limit
@@ -220,6 +222,7 @@ module fmt_touch #(
         .cal_we_i(cal_we_i), .cal_sel_i(cal_sel_i), .cal_row_i(cal_row_i),
         .cal_col_i(cal_col_i), .cal_data_i(cal_data_i),
         .cal_re_i(cal_re_i), .cal_rvalid_o(cal_rvalid_o), .cal_rdata_o(cal_rdata_o),
+        .cal_late_o(cal_late_o),
         .sat_clr_i(sat_clr_i), .sat_flag_o(sat_flag_o), .sat_count_o(sat_count_o));
 
     // ---- local maxima -------------------------------------------------------------
