@@ -297,7 +297,9 @@ def pn_chip_first(scene: _scene.Scene, cps: int) -> int:
 
 
 def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings, cal,
-                    cps: int = 3) -> Reference:
+                    cps: int = 3, m_frames=None) -> Reference:
+    """The model's heat maps and events of the run; ``m_frames``: M of each frame when
+    WINDOWS_M changes during the run (default: the scene's M throughout)."""
     from fmt import touch as _touch
     cfg = scene.cfg
     spf = scene.samples_per_frame
@@ -311,7 +313,8 @@ def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings
     adc = np.zeros_like(adc_ch)
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
-    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m=scene.m)
+    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg,
+                                               m=scene.m if m_frames is None else m_frames)
     evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
                                 frame_period_s=scene.frame_period_s)
     return Reference(hm, evs, clipped)
