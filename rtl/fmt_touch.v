@@ -327,10 +327,23 @@ module fmt_touch #(
     endgenerate
     assign blob_flag_o = b_ovf_flag | b_overrun;
     // the blob path is in use for the frame of each stream (blob_en of that frame)
+    localparam INTERP_LAT = 24;                        // fmt_interp: candidate -> touch, fixed
     wire bon_c = ben_v[c_frame[1:0]];                  // candidates
-    wire bon_t = ben_v[t_frame[1:0]];                  // fine touches
+    wire bon_t;                                        // fine touches: bon_c INTERP_LAT cycles
+    fmt_interp_dly #(.W(1), .N(INTERP_LAT), .RST(1)) u_bon_t (   // old, from a flip-flop (no
+        .clk(clk), .rst(rst), .d_i(bon_c), .q_o(bon_t));         // table read before the tracker)
     wire bon_m = ben_v[m_frame[1:0]];                  // the blob mask
     wire bon_b = ben_v[b_frame[1:0]];                  // the blob list
+    // synthesis translate_off
+    reg [INTERP_LAT-1:0] chk_v_q;                      // fmt_interp's latency is INTERP_LAT
+    always @(posedge clk) begin
+        chk_v_q <= rst ? {INTERP_LAT{1'b0}} : {chk_v_q[INTERP_LAT-2:0], c_valid | c_eof};
+        if (!rst && (chk_v_q[INTERP_LAT-1] != (t_valid | t_eof))) begin
+            $display("fmt_touch: fmt_interp's latency is not INTERP_LAT = %0d", INTERP_LAT);
+            $finish;
+        end
+    end
+    // synthesis translate_on
 
     // ---- finger removal: hold the touch beats until the mask is written --------------
     reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index
@@ -438,12 +451,14 @@ module fmt_touch #(
     reg  [1:0]             tsi_q;                      // table index of that frame
     reg                    tsp_q;                      // a load is pending
     reg                    tin_q;                      // the tracker takes a frame's touches
+    reg                    bk_q;                       // blob_en of the tracker's frame
     always @(posedge clk) begin
         if (rst) begin
             trk_set_q <= {TRK_W{1'b0}};
             tsi_q     <= 2'd0;
             tsp_q     <= 1'b0;
             tin_q     <= 1'b0;
+            bk_q      <= 1'b0;
         end else begin
             if (c_eof) begin
                 tsi_q <= c_frame[1:0];
@@ -454,6 +469,8 @@ module fmt_touch #(
             end
             if (g_eof)        tin_q <= 1'b0;
             else if (g_valid) tin_q <= 1'b1;
+            // blob_en of the frame the tracker works on (for its events' ev_last)
+            if ((g_valid || g_eof) && !tin_q) bk_q <= ben_v[g_frame[1:0]];
         end
     end
     wire [15:0]            max_jump_f  = trk_set_q[TRK_W-1 -: 16];
@@ -532,7 +549,7 @@ module fmt_touch #(
     wire [7:0]         p_angle    = em_q ? 8'd0      : k_angle;
     wire [7:0]         p_flags    = em_q ? 8'd0      : k_flags;
     wire               p_last     = em_q ? (bi_q + 1'b1 == bn_q)
-                                  : (k_last && !(ben_v[k_frame[1:0]] && bn_q != {BCNT_W{1'b0}}));
+                                  : (k_last && !(bk_q && bn_q != {BCNT_W{1'b0}}));
 
     // ---- event port -----------------------------------------------------------------
     fmt_event_port #(.HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W), .TIME_W(TIME_W),
