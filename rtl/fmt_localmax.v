@@ -210,17 +210,18 @@ module fmt_localmax #(
     reg [NWC-1:0]       wsh_q;                 // adv and v2_q: the window shifts, by column group
     wire                adv = advc_q;          // (rem_q == 0)
 
-    reg [ROWS-1:0] ready;                      // present with its neighbours, not finished
+    // ready: present with its neighbours, not finished -- a register of its own (rdy_q,
+    // loaded from the next values of arrp_q and done_q: equal to the same function of
+    // arr_p and done_q in every cycle), so the lowest-ready-row carry starts at a
+    // flip-flop, not after arr_p's fan-out and a gate
+    reg  [ROWS-1:0] rdy_q;
+    wire [ROWS-1:0] ready = rdy_q;
     reg [ROWS-1:0] fin_ok;                     // not finished and the row below present
     reg [ROWS-1:0] nxt_ok;                     // row i + 1 ready
     always @(*) begin : c_ready
         integer i;
-        for (i = 0; i < ROWS; i = i + 1) begin
-            ready[i]  = arr_p[i] & ~done_q[i]
-                      & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
-                      & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
+        for (i = 0; i < ROWS; i = i + 1)
             fin_ok[i] = ~done_q[i] & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
-        end
         for (i = 0; i < ROWS; i = i + 1)
             nxt_ok[i] = (i == ROWS - 1) ? 1'b0 : ready[(i == ROWS - 1) ? i : i + 1];
     end
@@ -684,6 +685,21 @@ module fmt_localmax #(
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
     wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped_q};
 
+    // the next values of arrp_q and done_q (reset aside) and the ready flags of them
+    wire [ROWS-1:0] arrp_d = releasing         // pb_q flips; arr_p clears
+                           ? ((pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}}))
+                           : (arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}}));
+    wire [ROWS-1:0] done_d = releasing ? {ROWS{1'b0}}
+                           : (done_q | ((issue && rule_a) ? cur1h_q : {ROWS{1'b0}}));
+    reg  [ROWS-1:0] ready_d;
+    always @(*) begin : c_ready_d
+        integer i;
+        for (i = 0; i < ROWS; i = i + 1)
+            ready_d[i] = arrp_d[i] & ~done_d[i]
+                       & ((i == 0)        ? 1'b1 : arrp_d[(i == 0) ? 0 : i - 1])
+                       & ((i == ROWS - 1) ? 1'b1 : arrp_d[(i == ROWS - 1) ? i : i + 1]);
+    end
+
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
         lim_q     <= lim_eff;
@@ -746,6 +762,7 @@ module fmt_localmax #(
             cp_q     <= 1'b0;
             rule_c_q <= 1'b0;
             arrp_q   <= {ROWS{1'b0}};
+            rdy_q    <= {ROWS{1'b0}};
             rule_a_q <= 1'b0;
             rule_b_q <= 1'b0;
             state_q  <= S_RUN;
@@ -779,10 +796,9 @@ module fmt_localmax #(
                 if (wb_q) arr1_q[hm_row_i] <= 1'b1;
                 else      arr0_q[hm_row_i] <= 1'b1;
             end
-            if (releasing)                       // pb_q flips; arr_p clears
-                arrp_q <= (pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}});
-            else
-                arrp_q <= arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}});
+            arrp_q <= arrp_d;
+            done_q <= done_d;
+            rdy_q  <= ready_d;
             if (hm_eof_i) begin
                 eofs_q[wb_q] <= 1'b1;
                 if (wb_q) frm1_q <= hm_frame_i;
@@ -810,7 +826,6 @@ module fmt_localmax #(
                 rule_b_q <= cv_q && b_hold;
             end
             if (issue) begin
-                if (rule_a) done_q <= done_q | cur1h_q;
                 if (rule_a && last_c) begin
                     cv_q <= 1'b0;                      // virtual step after the last row
                 end else begin
@@ -864,7 +879,6 @@ module fmt_localmax #(
             if (releasing) begin
                 state_q      <= S_RUN;      // the list is cleared
                 found_q      <= {FOUND_W{1'b0}};
-                done_q       <= {ROWS{1'b0}};
                 cv_q         <= 1'b0;
                 rule_a_q     <= 1'b0;
                 rule_b_q     <= 1'b0;
