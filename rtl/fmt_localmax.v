@@ -46,9 +46,9 @@
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
-//        early with the centre cell from a register of its own, rotated in the capture's
-//        second step); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
-//        list's free slot.
+//        early with the centre cell from registers of its own, rotated in the capture's
+//        second step, in four copies for the list's comparators); the 3x3 goes to a
+//        (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
 // then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
@@ -600,9 +600,25 @@ module fmt_localmax #(
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
     reg             ptop_q, pbot_q;            // first / last row
     reg [IDX_W-1:0] pidx_q;                    // raster index
-    reg [HM_W-1:0]  pc_q;                      // the centre cell (= z9's centre below) in a
-                                               // register of its own: the list's early
-                                               // compare does not wait on the rotation
+    // the centre cell (= z9's centre below) in registers of its own: the list's early
+    // compare does not wait on the rotation; in NLC copies (keep), each for K / NLC of
+    // the list's comparators (no one register drives all K)
+    localparam NLC = (K >= 4) ? 4 : 1;
+    reg  [NLC*HM_W-1:0] pc_q;
+    reg  [HM_W-1:0]     pc_d;
+    always @(*) begin
+        case (p1m_q)                           // z9's centre (row b, rotated)
+            2'd1:    pc_d = s2[5*HM_W +: HM_W];
+            2'd2:    pc_d = s2[3*HM_W +: HM_W];
+            default: pc_d = s2[4*HM_W +: HM_W];
+        endcase
+    end
+    genvar gpc;
+    generate
+        for (gpc = 0; gpc < NLC; gpc = gpc + 1) begin : g_pc
+            (* keep *) always @(posedge clk) pc_q[gpc*HM_W +: HM_W] <= pc_d;
+        end
+    endgenerate
     wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
     wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
     wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
@@ -633,9 +649,9 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
-    // (= pc_q) and pidx_q in every cycle
+    // (= each copy of pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1), .EARLY(1)) u_list (
+                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
         .nxt_key_i(pc_q), .nxt_tie_i(pidx_q),
@@ -733,11 +749,6 @@ module fmt_localmax #(
         p1bot_q   <= mbot_q;
         p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
-        case (p1m_q)                           // z9's centre (row b, rotated)
-            2'd1:    pc_q <= s2[5*HM_W +: HM_W];
-            2'd2:    pc_q <= s2[3*HM_W +: HM_W];
-            default: pc_q <= s2[4*HM_W +: HM_W];
-        endcase
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
         pbot_q    <= p1bot_q;
