@@ -148,7 +148,9 @@ module fmt_touch #(
     //     the cycle before the frame's first flattened row (the first-row marker moves
     //     along fmt_flatten's FLAT_LAT cycles), constant over its flattened rows;
     //   fits and blob glue: moore, bias and blob_en by the frame number of the
-    //     candidate, touch, blob and event streams;
+    //     candidate, blob-list and blob-mask streams; the fine touches' blob_en is the
+    //     candidates' delayed by fmt_interp's latency, the events' is registered at the
+    //     tracker frame's first beat (no table read in front of the tracker);
     //   tracker: its five settings in a register, loaded after the frame's cand_eof
     //     once the tracker is idle (before the frame's first touch reaches it).
     localparam FLAT_LAT = 5;                           // fmt_flatten's fixed latency
