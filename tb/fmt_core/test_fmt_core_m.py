@@ -23,6 +23,17 @@ from fmt.settings import TouchSettings
 M = 3
 
 
+def _run_job(sim, cfg, cps, d) -> dict:
+    """The job folder d (rsr.prepare) through the cocotb engine; its result.json."""
+    run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
+               test_module="core_cocotb", test_dir=rsr.BENCH, testcase="run_scene",
+               parameters=rsr.sim_parameters(cfg, cps, d),
+               extra_env={"FMT_CORE_JOB": str(d / "job.json"), "FMT_CORE_UART": 0,
+                          "FMT_CORE_CFG": cfg.name, "FMT_QUIET": 1},
+               build_args=rsr.build_args(sim, fast_sim=False), tag=f"c{cps}")
+    return json.loads((d / "result.json").read_text())
+
+
 def test_fmt_core_m3(sim):
     frames, cps = 5, 3
     scene = _scene.small_scene().replace(frames=frames, m=M)
@@ -31,13 +42,7 @@ def test_fmt_core_m3(sim):
     st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
     d, ref, cal, _n_upd = rsr.prepare(scene, frames, cps, st, cal=None, tag=f"tbm{M}_{sim}")
     assert ref.heatmaps.shape[0] == frames
-    run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
-               test_module="core_cocotb", test_dir=rsr.BENCH, testcase="run_scene",
-               parameters=rsr.sim_parameters(cfg, cps, d),
-               extra_env={"FMT_CORE_JOB": str(d / "job.json"), "FMT_CORE_UART": 0,
-                          "FMT_CORE_CFG": cfg.name, "FMT_QUIET": 1},
-               build_args=rsr.build_args(sim, fast_sim=False), tag=f"c{cps}")
-    res = json.loads((d / "result.json").read_text())
+    res = _run_job(sim, cfg, cps, d)
     rep = rsr.analyse(scene, ref, d, cps, res["status"], frames, res["wall_s"], None, False, cal)
     assert rep["frames_dropped"] == 0, rep
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
@@ -92,13 +97,7 @@ def test_fmt_core_m_written_during_run(sim):
         vals.append([int(t), "WINDOWS_M", cur])
     job["mid_regs"] = vals
     (d / "job.json").write_text(json.dumps(job))
-    run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=rsr.sim_sources(),
-               test_module="core_cocotb", test_dir=rsr.BENCH, testcase="run_scene",
-               parameters=rsr.sim_parameters(cfg, cps, d),
-               extra_env={"FMT_CORE_JOB": str(d / "job.json"), "FMT_CORE_UART": 0,
-                          "FMT_CORE_CFG": cfg.name, "FMT_QUIET": 1},
-               build_args=rsr.build_args(sim, fast_sim=False), tag=f"c{cps}")
-    res = json.loads((d / "result.json").read_text())
+    res = _run_job(sim, cfg, cps, d)
     writes = [(c, v) for c, _n, v in res["mid_regs"]]
     assert len(writes) == len(vals)
     hm_rows, _eof, evs, fend = rsr.parse_logs(d, cfg)
