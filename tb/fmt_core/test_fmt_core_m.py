@@ -35,6 +35,9 @@ def _run_job(sim, cfg, cps, d) -> dict:
 
 
 def test_fmt_core_m3(sim):
+    import os
+    if sim == "verilator" and os.environ.get("FMT_LONG", "0") in ("", "0"):
+        pytest.skip("the Verilator build runs in make test-long (FMT_LONG=1); Icarus here")
     frames, cps = 5, 3
     scene = _scene.small_scene().replace(frames=frames, m=M)
     cfg = scene.cfg

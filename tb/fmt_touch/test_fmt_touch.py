@@ -292,8 +292,22 @@ def test_fmt_touch(sim, cfg_name):
     _run_touch(sim, cfg_name)
 
 
+# cocotb tests of this module; settings_midframe runs under Verilator only in make
+# test-long (FMT_LONG=1): Icarus covers it in make test (for make test's time)
+COCOTB_TESTS = ["random_heatmaps", "scene_heatmaps", "many_fingers", "blobs", "settings_midframe"]
+
+
+def test_cocotb_test_list():
+    """COCOTB_TESTS names every cocotb test of this module (a new one is never left out)."""
+    names = [n for n, v in globals().items() if type(v).__module__.startswith("cocotb._decorators")]
+    assert sorted(names) == sorted(COCOTB_TESTS), names
+
+
 def _run_touch(sim, cfg_name):
     p = params.get(cfg_name).verilog_params()
+    tests = COCOTB_TESTS
+    if sim == "verilator" and os.environ.get("FMT_LONG", "0") in ("", "0"):
+        tests = [t for t in COCOTB_TESTS if t != "settings_midframe"]
     run_cocotb(
         sim=sim,
         toplevel="fmt_touch",
@@ -302,7 +316,7 @@ def _run_touch(sim, cfg_name):
         test_dir=Path(__file__).parent,
         parameters={**{k: p[k] for k in ("ROWS", "COLS", "HM_W", "MAX_TOUCHES")}, "EV_DEPTH": 256},
         extra_env={"CFG": cfg_name, "SEED": 1},
-        build_args=build_args(sim), tag=cfg_name,
+        build_args=build_args(sim), tag=cfg_name, testcase=tests,
     )
 
 
