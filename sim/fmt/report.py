@@ -58,8 +58,8 @@ window end -> event = receive chain (last ADC sample of the frame's last window 
 heat-map row beat: ``rx_clk`` processing-clock cycles at 3 x fs, the figure measured and
 asserted by tb/fmt_rx_array ``latency_and_slow_ce``; computed here from its formula and
 compared with ``build/rx_latency_default_postclk1_cps3.txt`` when that file exists) + touch processing
-(last row beat -> last event on the event port: ``--touch-clk``, default 120 cycles = the
-bound tb/fmt_touch asserts on scene heat maps (``BUDGET``); the header of rtl/fmt_touch.v
+(last row beat -> last event on the event port: ``--touch-clk``, default 140 cycles = the
+bound tb/fmt_touch asserts on scene heat maps and 16 fingers (``BUDGET``); the header of rtl/fmt_touch.v
 gives the per-stage figures 4 + (6 + n) + 23 + (events + 5) + 3).  Plus (M - 1) N / fs.
 """
 from __future__ import annotations
@@ -87,7 +87,7 @@ from .settings import TouchSettings
 
 ROOT = Path(__file__).resolve().parents[2]
 CLK_PER_SAMPLE = 3                  # processing clock = 3 x fs (docs/ARCHITECTURE.md)
-TOUCH_CLK_DEFAULT = 120             # tb/fmt_touch BUDGET (last row beat -> last event)
+TOUCH_CLK_DEFAULT = 140             # tb/fmt_touch BUDGET (last row beat -> last event)
 BASE_THRESHOLD = 2000               # TouchSettings().threshold at HM_W = 16
 INTERPS = (("vn", False), ("vn", True), ("moore", False), ("moore", True))
 PAPER_RATE_HZ, PAPER_LAT_US = 4000.0, 40.0
