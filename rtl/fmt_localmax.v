@@ -371,8 +371,6 @@ module fmt_localmax #(
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
     reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
-    reg [COLS-1:0]      remt_q;                // rem_q's copy for adv's two-or-more tree (keep
-                                               // below): the tree's inputs have no other load
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
@@ -383,11 +381,10 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
     // rem_q holds two bits or more (a balanced tree of 4-bit groups: any, two or more;
-    // rem_q's own bits only (its copy remt_q), not rem_e: no mask gates and no carry chain
-    // before adv)
+    // rem_q's own bits only, not rem_e: no mask gates and no carry chain before adv)
     localparam NT1 = (COLS + 3) / 4;           // 4-bit groups
     localparam NT2 = (NT1 + 3) / 4;            // groups of 4 groups
-    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, remt_q};
+    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, rem_q};
     wire [4*NT2-1:0] t1_a, t1_t;               // level 1: any, two or more (padded)
     wire [4*NT2-1:0] t2_a, t2_t;               // level 2
     genvar gt;
@@ -414,11 +411,6 @@ module fmt_localmax #(
             end
         end
     endgenerate
-    // remt_q: loaded as rem_q (keep: not merged with it by synthesis)
-    (* keep *) always @(posedge clk)
-        if (rst)                remt_q <= {COLS{1'b0}};
-        else if (!advs_q)       remt_q <= rem_nx;
-        else if (v2_q && f2_q)  remt_q <= part_c;
     // level 3: pairs of the NT2 groups
     reg rem_two;
     /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
@@ -524,9 +516,9 @@ module fmt_localmax #(
     reg                 iv_q;                  // a maximum to capture
     // The capture selects a cell of each group in two registered steps: one cell in each
     // quarter of the group (NQ quarters of NL cells), by its number within the quarter
-    // decoded from the bits of the quarter's columns (a select local to the quarter's
-    // columns, registered from rem_low), then the quarter, by the high HI_W bits of the
-    // cell number decoded from low_q.  (Before:
+    // decoded from the low_q bits of the quarter's columns (a select local to the
+    // quarter's columns), then the quarter, by the high HI_W bits of the cell number
+    // decoded from low_q.  (Before:
     // the select bits encoded from the lowest bit and registered in copies per quarter,
     // the encoder's fan-out to the copies critical at 84.1 MHz.)
     localparam LO_W = (QI_W > 2) ? 2 : 1;
@@ -586,45 +578,26 @@ module fmt_localmax #(
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
             // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g: its
-            // number within the quarter, from the bits of the quarter's columns (0 when
-            // the maximum is in another quarter: step 2 does not pick this one), decoded
-            // a cycle early from rem_low (low_q's next value: equal to the decode of
-            // low_q) into registers, one copy per row of the 3x3 (keep), so neither
-            // low_q's fan-out nor a decoder is in front of the 3 x 48 cell selects
-            reg [LO_W-1:0] l0_d, l1_d, l2_d;   // group 0, 1, 2 cell, low bits (next)
+            // number within the quarter, from the low_q bits of the quarter's columns (0
+            // when the maximum is in another quarter: step 2 does not pick this one)
+            reg [LO_W-1:0] l0, l1, l2;         // group 0, 1, 2 cell, low bits
             reg [Z9_W-1:0] s_q;
             /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
             always @(*) begin : c_sel
                 integer i, j0, j1, j2;
-                l0_d = {LO_W{1'b0}};  l1_d = {LO_W{1'b0}};  l2_d = {LO_W{1'b0}};
+                l0 = {LO_W{1'b0}};  l1 = {LO_W{1'b0}};  l2 = {LO_W{1'b0}};
                 for (i = 0; i < COLS; i = i + 1) begin
                     j0 = (i + 2) / 3;  j1 = (i + 1) / 3;  j2 = i / 3;
-                    if (j0 / NL == gq) l0_d = l0_d | ({LO_W{rem_low[i]}} & j0[LO_W-1:0]);
-                    if (j1 / NL == gq) l1_d = l1_d | ({LO_W{rem_low[i]}} & j1[LO_W-1:0]);
-                    if (j2 / NL == gq) l2_d = l2_d | ({LO_W{rem_low[i]}} & j2[LO_W-1:0]);
+                    if (j0 / NL == gq) l0 = l0 | ({LO_W{low_q[i]}} & j0[LO_W-1:0]);
+                    if (j1 / NL == gq) l1 = l1 | ({LO_W{low_q[i]}} & j1[LO_W-1:0]);
+                    if (j2 / NL == gq) l2 = l2 | ({LO_W{low_q[i]}} & j2[LO_W-1:0]);
                 end
             end
             /* verilator lint_on UNUSEDSIGNAL */
-            wire [3*LO_W-1:0] l0, l1, l2;     // copy r: row r (a, b, c) of the 3x3
-            genvar gr;
-            for (gr = 0; gr < 3; gr = gr + 1) begin : g_lcp
-                reg [LO_W-1:0] l0_q, l1_q, l2_q;
-                (* keep *) always @(posedge clk) begin
-                    l0_q <= l0_d;
-                    l1_q <= l1_d;
-                    l2_q <= l2_d;
-                end
-                assign l0[gr*LO_W +: LO_W] = l0_q;
-                assign l1[gr*LO_W +: LO_W] = l1_q;
-                assign l2[gr*LO_W +: LO_W] = l2_q;
-            end
             always @(posedge clk)
-                s_q <= {gc2[gq*NL + l2[2*LO_W +: LO_W]], gc1[gq*NL + l1[2*LO_W +: LO_W]],
-                        gc0[gq*NL + l0[2*LO_W +: LO_W]],
-                        gb2[gq*NL + l2[LO_W +: LO_W]], gb1[gq*NL + l1[LO_W +: LO_W]],
-                        gb0[gq*NL + l0[LO_W +: LO_W]],
-                        ga2[gq*NL + l2[0 +: LO_W]], ga1[gq*NL + l1[0 +: LO_W]],
-                        ga0[gq*NL + l0[0 +: LO_W]]};
+                s_q <= {gc2[gq*NL + l2], gc1[gq*NL + l1], gc0[gq*NL + l0],
+                        gb2[gq*NL + l2], gb1[gq*NL + l1], gb0[gq*NL + l0],
+                        ga2[gq*NL + l2], ga1[gq*NL + l1], ga0[gq*NL + l0]};
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
     endgenerate
@@ -660,36 +633,11 @@ module fmt_localmax #(
     localparam NLC = (K >= 4) ? 4 : 1;
     reg  [NLC*HM_W-1:0] pc_q;
     reg  [HM_W-1:0]     pc_d;
-    // pc_d from row b of the quarters' cells with copies of the quarter and rotation
-    // selects of its own (keep): p1h*_q drive the 144 bits of s2, so a select through
-    // them put their fan-out in front of the centre, pc_q and cap_ahd_q's compare
-    (* fsm_encoding = "none" *)
-    reg [HI_W-1:0]  p1h0c_q, p1h1c_q, p1h2c_q; // copies of p1h0_q, p1h1_q, p1h2_q
-    (* fsm_encoding = "none" *)
-    reg [1:0]       p1mc_q;                    // copy of p1m_q
-    (* keep *) always @(posedge clk) begin
-        p1h0c_q <= lo_g0[QI_W-1:LO_W];
-        p1h1c_q <= lo_g1[QI_W-1:LO_W];
-        p1h2c_q <= lo_q[QI_W-1:LO_W];
-        p1mc_q  <= lo_m;
-    end
-    reg [3*HM_W-1:0] s2b;                      // s2's row b (groups 0, 1, 2)
-    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
-    always @(*) begin : c_s2b
-        integer h;
-        s2b = {(3*HM_W){1'b0}};
-        for (h = 0; h < NQ; h = h + 1) begin
-            if (p1h0c_q == h[HI_W-1:0]) s2b[0*HM_W +: HM_W] = s1_q[h*Z9_W + 3*HM_W +: HM_W];
-            if (p1h1c_q == h[HI_W-1:0]) s2b[1*HM_W +: HM_W] = s1_q[h*Z9_W + 4*HM_W +: HM_W];
-            if (p1h2c_q == h[HI_W-1:0]) s2b[2*HM_W +: HM_W] = s1_q[h*Z9_W + 5*HM_W +: HM_W];
-        end
-    end
-    /* verilator lint_on UNUSEDSIGNAL */
     always @(*) begin
-        case (p1mc_q)                          // z9's centre (row b, rotated)
-            2'd1:    pc_d = s2b[2*HM_W +: HM_W];
-            2'd2:    pc_d = s2b[0*HM_W +: HM_W];
-            default: pc_d = s2b[1*HM_W +: HM_W];
+        case (p1m_q)                           // z9's centre (row b, rotated)
+            2'd1:    pc_d = s2[5*HM_W +: HM_W];
+            2'd2:    pc_d = s2[3*HM_W +: HM_W];
+            default: pc_d = s2[4*HM_W +: HM_W];
         endcase
     end
     genvar gpc;
@@ -714,11 +662,6 @@ module fmt_localmax #(
     reg              cap_v_q;                  // one maximum captured
     reg [Z9_W-1:0]   cap_z_q;                  // its 3x3
     reg [IDX_W-1:0]  cap_idx_q;                // its raster index {row, col}
-    // cap_z_q's centre and cap_idx_q rank ahead of the next cycle's (pc_q, pidx_q): the
-    // list's comparison of an insert with the insert after it, made a cycle early from
-    // (pc_q, pidx_q) and their next values (pc_d, p1idx_q), so the one result that goes
-    // to all K entries leaves a flip-flop (fmt_sorted_list AHEAD_IN)
-    reg              cap_ahd_q;
 
     // ---- the sorted list of (z, raster index), payload = slot of the 3x3 store --------------
     wire releasing;
@@ -735,10 +678,10 @@ module fmt_localmax #(
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
     // (= each copy of pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC), .AHEAD_IN(1)) u_list (
+                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
-        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q), .ins_ahead_i(cap_ahd_q),
+        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q), .ins_ahead_i(1'b0),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -839,7 +782,6 @@ module fmt_localmax #(
         pidx_q    <= p1idx_q;
         cap_z_q   <= z9;
         cap_idx_q <= pidx_q;
-        cap_ahd_q <= ({pc_q[0 +: HM_W], ~pidx_q} > {pc_d, ~p1idx_q});
         cand_z_o       <= z9_rd_q;
         cand_missing_o <= miss9;
         cand_row_o     <= em_row_q;
