@@ -703,6 +703,11 @@ module fmt_blob #(
     reg                  l0_v_q;
     reg [FE_W-1:0]       l0_e_q;
     reg [COLS-1:0]       l0_oh_q;             // the label column, one-hot
+    reg                  lg_v_q;              // LG: the label gathered from the groups
+    reg [FE_W-1:0]       lg_e_q;
+    reg [COLS-1:0]       lg_oh_q;
+    reg [NG*LBL_W-1:0]   lg_yg_q;             // per GS columns: the label (0 off its group)
+    reg                  lg_hp_q;             // LG's label column under that step's run
     reg                  l1_v_q;
     reg [FE_W-1:0]       l1_e_q;
     reg [COLS-1:0]       l1_oh_q;
@@ -712,6 +717,7 @@ module fmt_blob #(
     /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
     reg [FE_W-1:0]       l2_e_q;
     wire [EF_W-1:0]      l0_f  = l0_e_q[F_FL +: EF_W];    // L0, L1 use the first flag only
+    wire [EF_W-1:0]      lg_f  = lg_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
     wire             new_wait /* verilator public_flat_rd */;   // a NEW waits for a free label
@@ -754,40 +760,56 @@ module fmt_blob #(
             rbit[i] = (lrun == i[LBL_W-1:0]);
         end
     end
-    // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
-    // this cycle (C becomes P); this cycle's step forwarded
-    // L0 reads C when its event is the first of its row, or when L1 holds that first
-    // event (L2 may end the previous row this cycle); the step of this cycle is applied,
-    // L1 applies the next one
-    wire             bnd = l0_f[3] || (l1_v_q && l1_f[3]);
-    // (one-hot select, the compares with the victim done per column beside it)
-    reg  [LBL_W-1:0] raw_p, raw_c;
+    // L0 looks up the event's label column in P, or in C when L2 may end the previous row
+    // before the event's own row starts (C becomes P): C when its event is the first of
+    // its row, or when LG or L1 holds that first event.  L0 selects per GS columns only
+    // (the one-hot select beside each group of P and C, registered per group: lg_yg_q);
+    // the step of that cycle is registered (s_*) and applied in LG, which gathers the
+    // groups; the step of LG's cycle is applied in L1, the step of L1's cycle in L2's load.
+    wire             bnd = l0_f[3] || (lg_v_q && lg_f[3]) || (l1_v_q && l1_f[3]);
+    reg  [NG*LBL_W-1:0] y0g;                  // per group: the label under the column, or 0
     reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
-    reg  [COLS-1:0]  l1_m, t_p, t_c;
-    always @(*) begin : c_l1
-        integer i, b;
-        for (b = 0; b < LBL_W; b = b + 1) begin
-            for (i = 0; i < COLS; i = i + 1) begin
-                t_p[i] = l0_oh_q[i] && p_q[i*LBL_W + b];
-                t_c[i] = l0_oh_q[i] && c_q[i*LBL_W + b];
+    reg  [COLS-1:0]  l1_m;
+    reg  [GS-1:0]    t_p, t_c;
+    always @(*) begin : c_l0
+        integer g, i, b;
+        for (g = 0; g < NG; g = g + 1)
+            for (b = 0; b < LBL_W; b = b + 1) begin
+                for (i = 0; i < GS; i = i + 1) begin
+                    t_p[i] = (g * GS + i < COLS) && l0_oh_q[(g * GS + i < COLS) ? g * GS + i : 0]
+                             && p_q[((g * GS + i < COLS) ? g * GS + i : 0) * LBL_W + b];
+                    t_c[i] = (g * GS + i < COLS) && l0_oh_q[(g * GS + i < COLS) ? g * GS + i : 0]
+                             && c_q[((g * GS + i < COLS) ? g * GS + i : 0) * LBL_W + b];
+                end
+                y0g[g * LBL_W + b] = bnd ? |t_c : |t_p;
             end
-            raw_p[b] = |t_p;
-            raw_c[b] = |t_c;
-        end
         for (i = 0; i < COLS; i = i + 1) begin
             ren_p[i] = (p_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
             ren_c[i] = (c_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
-            l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
-                   && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
+            l1_m[i] = (i[COL_IDX_W-1:0] >= lg_e_q[F_CMN +: COL_IDX_W])
+                   && (i[COL_IDX_W-1:0] <= lg_e_q[F_CMX +: COL_IDX_W]);
         end
     end
-    // L0 selects only (no forwarding); the step of this cycle is registered (s_*) and
-    // applied in L1, one cycle later, together with the step of that cycle
-    wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
     wire             l0_hp  = bnd && |(l0_oh_q & l2_m_q);  // under this cycle's run, if any
     reg              s_mrg_q, s_run_q;        // the step of the cycle before: a merge, a run
     reg  [LBL_W-1:0] s_v_q, s_x_q, s_lrun_q;  // its victim, survivor, run label
     reg              l1_hp_q;                 // L1's label column under that step's run
+    // LG: the groups gathered (one is nonzero at most), the step of the cycle before
+    // applied (yga); LG's label column under this cycle's run (only when LG reads C: its
+    // event is the first of its row or L1 holds that first event)
+    reg  [LBL_W-1:0] lg_y;
+    wire             sg_run = lg_hp_q && s_run_q;
+    wire             sg_mrg = s_mrg_q && (lg_y == s_v_q);
+    wire [LBL_W-1:0] yga = sg_run ? s_lrun_q : (sg_mrg ? s_x_q : lg_y);
+    reg  [NG*LBL_W-1:0] yga_g;                // yga in group 0 (LG held)
+    always @(*) begin : c_lg
+        integer g;
+        lg_y = {LBL_W{1'b0}};
+        for (g = 0; g < NG; g = g + 1) lg_y = lg_y | lg_yg_q[g*LBL_W +: LBL_W];
+        yga_g = {(NG*LBL_W){1'b0}};
+        yga_g[LBL_W-1:0] = yga;
+    end
+    wire             lg_hp = (lg_f[3] || (l1_v_q && l1_f[3])) && |(lg_oh_q & l2_m_q);
     // L1's label after the step of the cycle before (ya), and whether it is this
     // cycle's merge victim (eqa: the three candidates compared beside the select)
     wire             sa_run = l1_hp_q && s_run_q;
@@ -799,7 +821,8 @@ module fmt_blob #(
     wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     wire             l2_ld = l1_v_q && (!l2_v_q || step);
-    wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    wire             l1_ld = lg_v_q && (!l1_v_q || l2_ld);
+    wire             lg_ld = l0_v_q && (!lg_v_q || l1_ld);
     // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
     // (l1_hit: x becomes lrun) or x_q (a merge now: x stays), or else ya
     wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
@@ -848,7 +871,7 @@ module fmt_blob #(
         end
     end
     // synthesis translate_on
-    assign           l0_free = !l0_v_q || l1_ld;
+    assign           l0_free = !l0_v_q || lg_ld;
 
     // next label vectors and live masks of this cycle's step
     reg [COLS*LBL_W-1:0] p_nx, c_nx;
@@ -1256,7 +1279,7 @@ module fmt_blob #(
     end
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
-                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
+                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || lg_v_q || l1_v_q || l2_v_q || x4_v_q
                    || w_wr || cl_v_q || (|pend_q) || pk_v_q;
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
@@ -1352,12 +1375,21 @@ module fmt_blob #(
         y5_e_q <= y4_ev;
         if (fpop) l0_e_q <= f_rd;
         if (fpop) l0_oh_q <= lc_oh;
+        if (lg_ld) begin                      // (LG holds only while L2 waits: no step)
+            lg_e_q  <= l0_e_q;
+            lg_oh_q <= l0_oh_q;
+            lg_yg_q <= y0g;
+            lg_hp_q <= l0_hp;
+        end else begin                        // (held: the pending step applied now)
+            lg_yg_q <= yga_g;
+            lg_hp_q <= 1'b0;
+        end
         if (l1_ld) begin                      // (L1 holds only while L2 waits: no step)
-            l1_e_q  <= l0_e_q;
-            l1_oh_q <= l0_oh_q;
+            l1_e_q  <= lg_e_q;
+            l1_oh_q <= lg_oh_q;
             l1_m_q  <= l1_m;
-            l1_y_q  <= y0_raw;
-            l1_hp_q <= l0_hp;
+            l1_y_q  <= yga;
+            l1_hp_q <= lg_hp;
         end else begin                        // (held: no step this cycle; the pending
             l1_y_q  <= ya;                    //  one applied now)
             l1_hp_q <= 1'b0;
@@ -1432,6 +1464,7 @@ module fmt_blob #(
             fcnt_q   <= {(FP_W+1){1'b0}};
             res_q    <= {(FP_W+1){1'b0}};
             l0_v_q   <= 1'b0;
+            lg_v_q   <= 1'b0;
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
@@ -1515,7 +1548,9 @@ module fmt_blob #(
             fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
             res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
             if (fpop) l0_v_q <= 1'b1;
-            else if (l1_ld) l0_v_q <= 1'b0;
+            else if (lg_ld) l0_v_q <= 1'b0;
+            if (lg_ld) lg_v_q <= 1'b1;
+            else if (l1_ld) lg_v_q <= 1'b0;
             if (l1_ld) l1_v_q <= 1'b1;
             else if (l2_ld) l1_v_q <= 1'b0;
             if (l2_ld) l2_v_q <= 1'b1;
