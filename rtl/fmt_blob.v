@@ -749,6 +749,8 @@ module fmt_blob #(
     localparam VC  = NG + NAG;
     reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
     reg  [NYC-1:0]       dmc_q;               // copies of dm_q
+    reg  [NYC-1:0]       clrc_q;              // clear P, C, alias, live masks (copies)
+    wire                 releasing;           // the frame is released (S_WAIT -> S_RUN)
     wire             row_done = rd_q;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
     assign           new_wait = l2_stall;
@@ -852,6 +854,7 @@ module fmt_blob #(
             // the copies of l2_y_q are read only for a merge, which L2 loaded the cycle before)
             (* keep *) always @(posedge clk) yc_q[gy*LBL_W +: LBL_W] <= y1;
             (* keep *) always @(posedge clk) xc_q[gy*LBL_W +: LBL_W] <= x_nx;
+            (* keep *) always @(posedge clk) clrc_q[gy] <= rst || releasing;
         end
     endgenerate
     // synthesis translate_off
@@ -890,7 +893,6 @@ module fmt_blob #(
     end
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
-    wire        releasing;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
     reg  [LBL_W-1:0] f_enc;
     reg  [NL:1]      f_t;
@@ -1018,7 +1020,11 @@ module fmt_blob #(
     // the slices' registers, assembled
     wire [E_W-1:0]   w_x, w_yy, cl_e_q;
     wire [E_W-1:0]   w_res = combine(w_x, w_yy);     // (a NEW writes w_yy: per slice)
-    genvar ga;
+    localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
+    localparam CFI  = 4;                      // cf_mem labels per copy of the blob test
+    localparam NCF  = (NL + CFI - 1) / CFI;
+    reg  [NCF:0]     cl_isb_q;                // the blob test of cl_e_q (copy NCF: the list)
+    genvar ga, gk;
     generate
         for (ga = 0; ga < NAS; ga = ga + 1) begin : g_acc
             localparam LO = (ga == 0) ? O_AREA : (ga == 1) ? O_SX : (ga == 2) ? O_SY
@@ -1050,6 +1056,16 @@ module fmt_blob #(
                 if (we_q) acc_q[wa_q] <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
                 if (pkv_q && !mrg_q) cl_q <= rd_b;          // cl_go
             end
+            if (ga == 0) begin : g_isb
+                // the closed label's blob test (area >= min-cells), registered with cl_q,
+                // in copies: one for the list, one per CFI labels of cf_mem's write data
+                wire [AREA_W-1:0] rb_area = rd_b[O_AREA - LO +: AREA_W];
+                wire isb_nx = ({{(AM_W-AREA_W){1'b0}}, rb_area}
+                               >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
+                for (gk = 0; gk <= NCF; gk = gk + 1) begin : g_k
+                    (* keep *) always @(posedge clk) cl_isb_q[gk] <= isb_nx;   // (read after cl_go)
+                end
+            end
             assign w_x[LO +: SW]     = fa_q ? wr_q : ra_d_q;
             assign w_yy[LO +: SW]    = fb_q ? wr_q : y_q;
             assign cl_e_q[LO +: SW]  = cl_q;
@@ -1061,8 +1077,7 @@ module fmt_blob #(
     reg [LBL_W-1:0]     cl_lbl_q;
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
-    localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
-    wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
+    wire              cl_isblob = cl_isb_q[NCF];
     wire              cl_blob = cl_v_q && cl_isblob;
 
     // The list holds the sort keys (area, raster index of the first cell) and a slot
@@ -1197,7 +1212,7 @@ module fmt_blob #(
         integer l;
         for (l = 1; l <= NL; l = l + 1)
             if (cl_v_q && cl_lbl_q == l[LBL_W-1:0])
-                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isblob}};
+                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isb_q[(l-1)/CFI]}};
         cf_rd1_q <= cf_mem[cf_row_nx];        // with fr_rd1_q (row bw_r_q)
         for (l = 1; l <= NL; l = l + 1)
             cf_rd_q[l] <= cf_rd1_q[(l-1)*CFB]; // the output register, with fr_rd_q
@@ -1473,12 +1488,7 @@ module fmt_blob #(
             pk_v_q   <= 1'b0;
             idle_q   <= 1'b0;
             abort_q  <= 1'b0;
-            p_q      <= {(COLS*LBL_W){1'b0}};
-            c_q      <= {(COLS*LBL_W){1'b0}};
-            livep_q  <= {NL{1'b0}};
-            livec_q  <= {NL{1'b0}};
             free_q   <= {NL{1'b1}};
-            alias_q  <= alias_id;
             pend_q   <= {NL{1'b0}};
             x1_v_q   <= 1'b0;
             x2_v_q   <= 1'b0;
@@ -1672,15 +1682,25 @@ module fmt_blob #(
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
                 pb_q         <= ~pb_q;
-                // an aborted frame leaves labels behind: start clean
-                p_q     <= {(COLS*LBL_W){1'b0}};
-                c_q     <= {(COLS*LBL_W){1'b0}};
-                livep_q <= {NL{1'b0}};
-                livec_q <= {NL{1'b0}};
+                // an aborted frame leaves labels behind: start clean (P, C, the live
+                // masks and alias by clrc_q, one cycle later)
                 free_q  <= {NL{1'b1}};
                 n0v_q   <= 1'b0;
-                alias_q <= alias_id;
             end
+        end
+        // the label vectors cleared one cycle after a reset or a release (no event is
+        // in L0..L2 then, nor in the cycle after), by registered copies per GS columns,
+        // per alias group and for the live masks
+        for (i = 0; i < COLS; i = i + 1)
+            if (clrc_q[i/GS]) begin
+                p_q[i*LBL_W +: LBL_W] <= {LBL_W{1'b0}};
+                c_q[i*LBL_W +: LBL_W] <= {LBL_W{1'b0}};
+            end
+        for (i = 1; i <= NL; i = i + 1)
+            if (clrc_q[NG + (i-1)/ALG]) alias_q[(i-1)*LBL_W +: LBL_W] <= alias_id[(i-1)*LBL_W +: LBL_W];
+        if (clrc_q[VC]) begin
+            livep_q <= {NL{1'b0}};
+            livec_q <= {NL{1'b0}};
         end
     end
 
