@@ -178,7 +178,7 @@ module fmt_blob #(
     localparam SY_W   = SZ_W + ROW_IDX_W;            // sum z*r
     localparam IDXMX  = (ROW_IDX_W > COL_IDX_W) ? ROW_IDX_W : COL_IDX_W;
     localparam QW     = IDXMX + 8;                   // centroid quotient bits (Q8.8)
-    localparam DL     = QW + 1;                      // fmt_div latency
+    localparam DL     = QW + 3;                      // emission: slot, numerator, fmt_div (QW + 1)
     localparam NUM_W  = ((SX_W > SY_W) ? SX_W : SY_W) + 9;
     localparam GS     = 8;                           // columns per partial-sum group
     localparam NG     = (COLS + GS - 1) / GS;
@@ -1137,9 +1137,14 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    // the sums of list entry em_i_q (an index >= MB reads entry 0)
+    // the sums of list entry em_i_q (an index >= MB reads entry 0): the slot registered
+    // (EA), the sums read and the numerator registered (EB), then the divider
     wire [SL_W-1:0]  em_slot = (em_i_q < MB_C) ? l_slot_q[em_i_q[MBI_W-1:0]] : l_slot_q[0];
-    wire [PE_W-1:0]  em_p    = pe_mem[em_slot];
+    reg  [SL_W-1:0]  ea_slot_q;
+    reg              ea_v_q, ea_ph_q, eb_v_q;
+    reg  [NUM_W-1:0] eb_num_q;
+    reg  [SZ_W-1:0]  eb_den_q;
+    wire [PE_W-1:0]  em_p    = pe_mem[ea_slot_q];
     wire [SZ_W-1:0]  em_sz   = em_p[0 +: SZ_W];
     wire [SX_W-1:0]  em_sx   = em_p[SZ_W +: SX_W];
     wire [SY_W-1:0]  em_sy   = em_p[SZ_W + SX_W +: SY_W];
@@ -1157,8 +1162,16 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [QW-1:0] dq;
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_ph_q ? num_y : num_x),
-        .den_i(em_sz), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+        .clk(clk), .rst(rst), .valid_i(eb_v_q), .num_i(eb_num_q),
+        .den_i(eb_den_q), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+    always @(posedge clk) begin
+        ea_slot_q <= em_slot;
+        ea_ph_q   <= em_ph_q;
+        ea_v_q    <= em_issue && !rst;
+        eb_num_q  <= ea_ph_q ? num_y : num_x;
+        eb_den_q  <= em_sz;
+        eb_v_q    <= ea_v_q && !rst;
+    end
     // index, phase and end token travel beside the divider
     reg [DL-1:0]       dl_v_q, dl_x_q, dl_t_q;
     reg [CNT_W-1:0]    dl_i_q [0:DL-1];
