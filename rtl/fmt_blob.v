@@ -26,11 +26,13 @@
 //       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
 //       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
 //       extraction runs ahead of the labelling by up to the FIFO depth.
-//   L0, L1: the label under the event's label column: L0 selects it from the previous
-//       row's labels P (one per column, 0 = background), or from the current row's
-//       labels C when the step in L2 may end the previous row first; the step of that
-//       cycle is registered (its victim, survivor, run label) and applied in L1,
-//       together with the step of L1's own cycle (its rename, its run).
+//   L0, LG, L1: the label under the event's label column: L0 selects it, per 8 columns,
+//       from the previous row's labels P (one per column, 0 = background), or from the
+//       current row's labels C when the step in L2 may end the previous row first
+//       (registered per group); the step of that cycle is registered (its victim,
+//       survivor, run label) and applied in LG, which gathers the groups; the step of
+//       LG's cycle is applied in L1, together with the step of L1's own cycle (its
+//       rename, its run).
 //   L2: one step per cycle (x = the label of the current C run, y = L1's label):
 //         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
@@ -64,8 +66,9 @@
 //       slot number; the entries sit in LUT RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
-// same for cy) by one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8) shared
-// by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
+// same for cy): the entry's slot registered (EA), its sums read and the numerator
+// registered (EB), then one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8)
+// shared by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
 // then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the labels
@@ -99,16 +102,16 @@
 // Latency (processing-clock cycles, measured by tb/fmt_blob): a row is fetched as soon
 // as rows 0..r are present; the extraction and the labelling take max(1, events)
 // cycles per row each (no bubble between rows: L1 forwards the step of L2), the
-// extraction ahead; from a row's fetch to its first step 12 cycles; after the last
+// extraction ahead; from a row's fetch to its first step 13 cycles; after the last
 // row's last step: 3 cycles to the close engine, one cycle per closed label, then the emission
-// (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
+// (QW + 5 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 47..56 cycles, -> mask_ready_o 64..71 cycles.  Worst case per frame: at most
+// 50..59 cycles, -> mask_ready_o 65..72 cycles.  Worst case per frame: at most
 // ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
-// first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
-// combs 652, weave (the most merges with the most runs) 652 cycles: within the
+// first row beat to the end: checkerboard (600 RUN events, every label slot live) 693,
+// combs 653, weave (the most merges with the most runs) 654 cycles: within the
 // 768-cycle frame period at 3 x fs (python -m pytest -q -s tb/fmt_blob -k default;
-// unchanged by the L0/L1 and X3/X4 splits of 2026-11-27).  A frame must be finished (blob_eof_o and the
+// 2026-11-28: LG +1 cycle, EA/EB +2 cycles to blob_eof_o).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
 // Settings are used live: change them between frames (the threshold applies to a row
@@ -672,8 +675,8 @@ module fmt_blob #(
     reg [FE_W-1:0]  fmem [0:FD-1];
     reg [FP_W-1:0]  fwp_q, frp_q;
     reg [FP_W:0]    fcnt_q;
-    wire            l0_free;
-    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l0_free;
+    wire            adv;                      // L0..L2 advance (L2 does not wait)
+    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && adv;
     always @(posedge clk) begin
         if (y5_v_q) fmem[fwp_q] <= y5_e_q;
     end
@@ -750,6 +753,8 @@ module fmt_blob #(
     reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
     reg  [NYC-1:0]       dmc_q;               // copies of dm_q
     reg  [NYC-1:0]       clrc_q;              // clear P, C, alias, live masks (copies)
+    localparam NAD = 11;                      // copies of adv: 2 for L0, 3 each LG, L1, L2
+    reg  [NAD-1:0]       advc_q;
     wire                 releasing;           // the frame is released (S_WAIT -> S_RUN)
     wire             row_done = rd_q;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
@@ -822,9 +827,11 @@ module fmt_blob #(
     // L1: this cycle's step (a run of the previous row only for the row's first event)
     wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
-    wire             l2_ld = l1_v_q && (!l2_v_q || step);
-    wire             l1_ld = lg_v_q && (!l1_v_q || l2_ld);
-    wire             lg_ld = l0_v_q && (!lg_v_q || l1_ld);
+    // L0, LG, L1 and L2 advance together (a bubble moves too) unless L2 waits (a NEW
+    // without a free label): adv; the wide loads of the stages' registers take kept
+    // copies of it, registered from its next value (no logic in front of the enables)
+    assign           adv   = !l2_v_q || step;
+    wire             l2_ld = l1_v_q && adv;
     // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
     // (l1_hit: x becomes lrun) or x_q (a merge now: x stays), or else ya
     wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
@@ -837,6 +844,7 @@ module fmt_blob #(
     wire [2:0]       l2f_nx  = l2_ld ? l1_f[2:0] : l2_f[2:0];
     wire             n0v_nx  = !rst && !releasing && (n0_fill ? |free_q : n0v_q);
     wire             st_nx   = l2v_nx && !(l2f_nx[0] && !l2f_nx[1] && !n0v_nx);
+    wire             adv_nx  = !l2v_nx || st_nx;
     wire             run_nx  = st_nx && l2f_nx[0];
     wire             rd_nx   = st_nx && l2f_nx[2];
     always @(posedge clk) begin
@@ -856,6 +864,9 @@ module fmt_blob #(
             (* keep *) always @(posedge clk) xc_q[gy*LBL_W +: LBL_W] <= x_nx;
             (* keep *) always @(posedge clk) clrc_q[gy] <= rst || releasing;
         end
+        for (gy = 0; gy < NAD; gy = gy + 1) begin : g_adv
+            (* keep *) always @(posedge clk) advc_q[gy] <= adv_nx;
+        end
     endgenerate
     // synthesis translate_off
     always @(posedge clk) begin
@@ -867,6 +878,10 @@ module fmt_blob #(
             $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
             $finish;
         end
+        if (!rst && advc_q !== {NAD{adv}}) begin
+            $display("fmt_blob: a copy of adv differs");
+            $finish;
+        end
         if (!rst && (st_q !== (l2_v_q && !l2_stall) || run_q !== (l2_v_q && !l2_stall && l2_isrun)
                      || rd_q !== (l2_v_q && !l2_stall && l2_last))) begin
             $display("fmt_blob: st_q %b run_q %b rd_q %b differ from the step", st_q, run_q, rd_q);
@@ -874,7 +889,6 @@ module fmt_blob #(
         end
     end
     // synthesis translate_on
-    assign           l0_free = !l0_v_q || lg_ld;
 
     // next label vectors and live masks of this cycle's step
     reg [COLS*LBL_W-1:0] p_nx, c_nx;
@@ -1401,25 +1415,30 @@ module fmt_blob #(
         y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
         y4_sx_q <= sx4;
         y5_e_q <= y4_ev;
-        if (fpop) l0_e_q <= f_rd;
-        if (fpop) l0_oh_q <= lc_oh;
-        if (lg_ld) begin                      // (LG holds only while L2 waits: no step)
-            lg_e_q  <= l0_e_q;
-            lg_oh_q <= l0_oh_q;
+        // the stages' wide registers: enables from the copies of adv, in ranges
+        for (i = 0; i < FE_W; i = i + 1) begin
+            if (advc_q[(i * 2) / FE_W])     l0_e_q[i] <= f_rd[i];
+            if (advc_q[2 + (i * 3) / FE_W]) lg_e_q[i] <= l0_e_q[i];
+            if (advc_q[5 + (i * 3) / FE_W]) l1_e_q[i] <= lg_e_q[i];
+            if (advc_q[8 + (i * 3) / FE_W]) l2_e_q[i] <= l1_e_q[i];
+        end
+        for (i = 0; i < COLS; i = i + 1) begin
+            if (advc_q[1])  l0_oh_q[i] <= lc_oh[i];
+            if (advc_q[4])  lg_oh_q[i] <= l0_oh_q[i];
+            if (advc_q[6])  l1_oh_q[i] <= lg_oh_q[i];
+            if (advc_q[7])  l1_m_q[i]  <= l1_m[i];
+            if (advc_q[10]) l2_m_q[i]  <= l1_m_q[i];
+        end
+        if (adv) begin                        // (LG, L1 hold only while L2 waits: no step)
             lg_yg_q <= y0g;
             lg_hp_q <= l0_hp;
+            l1_y_q  <= yga;
+            l1_hp_q <= lg_hp;
+            l2_y_q  <= y1;
         end else begin                        // (held: the pending step applied now)
             lg_yg_q <= yga_g;
             lg_hp_q <= 1'b0;
-        end
-        if (l1_ld) begin                      // (L1 holds only while L2 waits: no step)
-            l1_e_q  <= lg_e_q;
-            l1_oh_q <= lg_oh_q;
-            l1_m_q  <= l1_m;
-            l1_y_q  <= yga;
-            l1_hp_q <= lg_hp;
-        end else begin                        // (held: no step this cycle; the pending
-            l1_y_q  <= ya;                    //  one applied now)
+            l1_y_q  <= ya;
             l1_hp_q <= 1'b0;
         end
         s_mrg_q  <= do_merge;
@@ -1427,11 +1446,6 @@ module fmt_blob #(
         s_v_q    <= l2_y_q;
         s_x_q    <= x_q;
         s_lrun_q <= lrun;
-        if (l2_ld) begin
-            l2_e_q <= l1_e_q;
-            l2_y_q <= y1;
-            l2_m_q <= l1_m_q;
-        end
         if (do_run) x_q <= lrun;
         // (reset: the step registers before it are reset one cycle late for this one)
         x4_op_q  <= rst ? OP_NONE : (do_merge ? OP_MERGE : (do_new ? OP_NEW
@@ -1570,12 +1584,11 @@ module fmt_blob #(
             if (fpop)   frp_q <= frp_q + 1'b1;
             fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
             res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
-            if (fpop) l0_v_q <= 1'b1;
-            else if (lg_ld) l0_v_q <= 1'b0;
-            if (lg_ld) lg_v_q <= 1'b1;
-            else if (l1_ld) lg_v_q <= 1'b0;
-            if (l1_ld) l1_v_q <= 1'b1;
-            else if (l2_ld) l1_v_q <= 1'b0;
+            if (adv) begin
+                l0_v_q <= fpop;
+                lg_v_q <= l0_v_q;
+                l1_v_q <= lg_v_q;
+            end
             if (l2_ld) l2_v_q <= 1'b1;
             else if (step) l2_v_q <= 1'b0;
 
