@@ -869,6 +869,9 @@ module fmt_blob #(
         end
     endgenerate
     // synthesis translate_off
+    reg rst_seen;                             // (the copies are loaded from the reset on)
+    initial rst_seen = 1'b0;
+    always @(posedge clk) if (rst) rst_seen <= 1'b1;
     always @(posedge clk) begin
         if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
             $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
@@ -878,7 +881,7 @@ module fmt_blob #(
             $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
             $finish;
         end
-        if (!rst && advc_q !== {NAD{adv}}) begin
+        if (!rst && rst_seen && advc_q !== {NAD{adv}}) begin
             $display("fmt_blob: a copy of adv differs");
             $finish;
         end
