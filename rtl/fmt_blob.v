@@ -753,7 +753,8 @@ module fmt_blob #(
     reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
     reg  [NYC-1:0]       dmc_q;               // copies of dm_q
     reg  [NYC-1:0]       clrc_q;              // clear P, C, alias, live masks (copies)
-    localparam NAD = 11;                      // copies of adv: 2 for L0, 3 each LG, L1, L2
+    localparam NAD = 12;                      // copies of adv: 2 for L0, 3 each LG, L1, L2,
+                                              // one for the merge decision
     reg  [NAD-1:0]       advc_q;
     wire                 releasing;           // the frame is released (S_WAIT -> S_RUN)
     wire             row_done = rd_q;
@@ -825,7 +826,10 @@ module fmt_blob #(
     wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
                          : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
     // L1: this cycle's step (a run of the previous row only for the row's first event)
-    wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
+    // (l1_ov_q: L1's label column under L2's run mask, registered from its next value:
+    // when the stages advance, LG's column and L1's run)
+    reg              l1_ov_q, l1_mg_q;        // l1_mg_q: L1 holds a merge event with a label
+    wire             l1_hit = l1_f[3] && do_run && l1_ov_q;
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     // L0, LG, L1 and L2 advance together (a bubble moves too) unless L2 waits (a NEW
     // without a free label): adv; the wide loads of the stages' registers take kept
@@ -837,7 +841,7 @@ module fmt_blob #(
     wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
     wire             ne_nx = !l1_hit && !(do_merge && eqa)
                           && (sa_run ? (s_lrun_q != x_nx) : (sa_mrg ? (s_x_q != x_nx) : (l1_y_q != x_nx)));
-    wire             dm_nx = !rst && l2_ld && !l1_f[0] && l1_f[1] && ne_nx;
+    wire             dm_nx = !rst && advc_q[NAD-1] && l1_mg_q && ne_nx;
     always @(posedge clk) dm_q <= dm_nx;
     // next L2 state: valid, flags, and whether a NEW label is ready (n0v_q's next)
     wire             l2v_nx  = !rst && (l2_ld || (l2_v_q && !step));
@@ -879,6 +883,11 @@ module fmt_blob #(
         end
         if (!rst && dm_q && (yc_q !== {NYC{l2_y_q}} || xc_q !== {NYC{x_q}})) begin
             $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
+            $finish;
+        end
+        if (!rst && rst_seen && (l1_mg_q !== (l1_v_q && !l1_f[0] && l1_f[1])
+                                 || (l1_v_q && l1_ov_q !== |(l1_oh_q & l2_m_q)))) begin
+            $display("fmt_blob: l1_mg_q or l1_ov_q differs");
             $finish;
         end
         if (!rst && rst_seen && advc_q !== {NAD{adv}}) begin
@@ -1433,6 +1442,8 @@ module fmt_blob #(
             if (advc_q[10]) l2_m_q[i]  <= l1_m_q[i];
         end
         if (adv) begin                        // (LG, L1 hold only while L2 waits: no step)
+            l1_ov_q <= |(lg_oh_q & l1_m_q);
+            l1_mg_q <= lg_v_q && !lg_f[0] && lg_f[1];
             lg_yg_q <= y0g;
             lg_hp_q <= l0_hp;
             l1_y_q  <= yga;
@@ -1510,6 +1521,7 @@ module fmt_blob #(
             res_q    <= {(FP_W+1){1'b0}};
             l0_v_q   <= 1'b0;
             lg_v_q   <= 1'b0;
+            l1_mg_q  <= 1'b0;
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
