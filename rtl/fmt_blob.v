@@ -1226,10 +1226,8 @@ module fmt_blob #(
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) begin
-            fr_rd1_q <= fr_mem[bw_r_q];
-            lr_rd1_q <= lr_mem[bw_r_q];
-        end
+        fr_rd1_q <= fr_mem[bw_r_q];           // (read every cycle: used only while
+        lr_rd1_q <= lr_mem[bw_r_q];           //  bw_v_q, no enable net of ~550 loads)
         fr_rd_q <= fr_rd1_q;                  // the block RAMs' output registers
         lr_rd_q <= lr_rd1_q;
     end
