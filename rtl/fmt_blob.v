@@ -821,7 +821,10 @@ module fmt_blob #(
     // L1's label after the step of the cycle before (ya), and whether it is this
     // cycle's merge victim (eqa: the three candidates compared beside the select)
     wire             sa_run = l1_hp_q && s_run_q;
-    wire             sa_mrg = s_mrg_q && (l1_y_q == s_v_q);
+    // (l1_sv_q = (l1_y_q == s_v_q), registered beside them: s_v_q is l2_y_q of the cycle
+    // before, compared in LG with L1's next label)
+    reg              l1_sv_q;
+    wire             sa_mrg = s_mrg_q && l1_sv_q;
     wire [LBL_W-1:0] ya  = sa_run ? s_lrun_q : (sa_mrg ? s_x_q : l1_y_q);
     wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
                          : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
@@ -886,8 +889,9 @@ module fmt_blob #(
             $finish;
         end
         if (!rst && rst_seen && (l1_mg_q !== (l1_v_q && !l1_f[0] && l1_f[1])
+                                 || l1_sv_q !== (l1_y_q == s_v_q)
                                  || (l1_v_q && l1_ov_q !== |(l1_oh_q & l2_m_q)))) begin
-            $display("fmt_blob: l1_mg_q or l1_ov_q differs");
+            $display("fmt_blob: l1_mg_q, l1_sv_q or l1_ov_q differs");
             $finish;
         end
         if (!rst && rst_seen && advc_q !== {NAD{adv}}) begin
@@ -1442,6 +1446,7 @@ module fmt_blob #(
         if (adv) begin                        // (LG, L1 hold only while L2 waits: no step)
             l1_ov_q <= |(lg_oh_q & l1_m_q);
             l1_mg_q <= lg_v_q && !lg_f[0] && lg_f[1];
+            l1_sv_q <= (yga == l2_y_q);
             lg_yg_q <= y0g;
             lg_hp_q <= l0_hp;
             l1_y_q  <= yga;
@@ -1451,6 +1456,7 @@ module fmt_blob #(
             lg_yg_q <= yga_g;
             lg_hp_q <= 1'b0;
             l1_y_q  <= ya;
+            l1_sv_q <= (ya == l2_y_q);
             l1_hp_q <= 1'b0;
         end
         s_mrg_q  <= do_merge;
