@@ -809,6 +809,8 @@ module fmt_blob #(
     wire             sg_run = lg_hp_q && s_run_q;
     wire             sg_mrg = s_mrg_q && (lg_y == s_v_q);
     wire [LBL_W-1:0] yga = sg_run ? s_lrun_q : (sg_mrg ? s_x_q : lg_y);
+    wire             eqg = sg_run ? (s_lrun_q == l2_y_q)     // (yga == l2_y_q), the three
+                         : (sg_mrg ? (s_x_q == l2_y_q) : (lg_y == l2_y_q));   // compared beside
     reg  [NG*LBL_W-1:0] yga_g;                // yga in group 0 (LG held)
     always @(*) begin : c_lg
         integer g;
@@ -1041,7 +1043,9 @@ module fmt_blob #(
     end
     // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
     // MERGE, else the close engine's label)
-    wire [LBL_W-1:0] pk_nx  = (pk_fill && !rst) ? p_enc : pk_q;
+    // (pk_hold kept: the merge flag enters at the last select, not through pk_fill)
+    (* keep *) wire  pk_hold = rst || (b_merge && pk_v_q);      // = rst || !pk_fill
+    wire [LBL_W-1:0] pk_nx  = pk_hold ? pk_q : p_enc;
     wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
     wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
     wire [LBL_W-1:0] rb_nx  = do_merge ? l2_y_q : pk_nx;
@@ -1446,7 +1450,7 @@ module fmt_blob #(
         if (adv) begin                        // (LG, L1 hold only while L2 waits: no step)
             l1_ov_q <= |(lg_oh_q & l1_m_q);
             l1_mg_q <= lg_v_q && !lg_f[0] && lg_f[1];
-            l1_sv_q <= (yga == l2_y_q);
+            l1_sv_q <= eqg;
             lg_yg_q <= y0g;
             lg_hp_q <= l0_hp;
             l1_y_q  <= yga;
@@ -1456,7 +1460,7 @@ module fmt_blob #(
             lg_yg_q <= yga_g;
             lg_hp_q <= 1'b0;
             l1_y_q  <= ya;
-            l1_sv_q <= (ya == l2_y_q);
+            l1_sv_q <= eqa;                   // (ya == l2_y_q)
             l1_hp_q <= 1'b0;
         end
         s_mrg_q  <= do_merge;
