@@ -350,7 +350,7 @@ module fmt_blob #(
             f1_row_q <= fr_row;
         end
         if (f1_mv) begin
-            f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
+            f2_one_q <= le1(f1_es_q);         // (not by the carry of es_neg: 9 levels)
             f2_row_q <= f1_row_q;
         end
     end
@@ -366,8 +366,17 @@ module fmt_blob #(
         input [2:0] a, b;
         ucomb = {a[2] | b[2] | (a[1] & b[0]) | (a[0] & b[1]), a[1] | b[1] | (a[0] & b[0]), a[0] | b[0]};
     endfunction
-    function le2;
+    function le2;                             // x has at most two bits set
         input [COLS-1:0] x;
+        le2 = !ucnt(x, 1'b1);
+    endfunction
+    function le1;                             // x has at most one bit set
+        input [COLS-1:0] x;
+        le1 = !ucnt(x, 1'b0);
+    endfunction
+    function ucnt;                            // sel 1: >= 3 bits set, sel 0: >= 2
+        input [COLS-1:0] x;
+        input            sel;
         integer g, k, w;
         reg [3:0]        q;
         reg [3*LE_P-1:0] v;
@@ -384,7 +393,7 @@ module fmt_blob #(
             for (w = LE_P / 2; w >= 1; w = w / 2)
                 for (k = 0; k < w; k = k + 1)
                     v[3 * k +: 3] = ucomb(v[3 * (2 * k) +: 3], v[3 * (2 * k + 1) +: 3]);
-            le2 = !v[2];
+            ucnt = sel ? v[2] : v[1];
         end
     endfunction
 
