@@ -1053,7 +1053,8 @@ module fmt_blob #(
     // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
     // MERGE, else the close engine's label)
     // (pk_hold kept: the merge flag enters at the last select, not through pk_fill)
-    (* keep *) wire  pk_hold = rst || (b_merge && pk_v_q);      // = rst || !pk_fill
+    (* keep *) wire  pk_hold;
+    assign           pk_hold = rst || (b_merge && pk_v_q);      // = rst || !pk_fill
     wire [LBL_W-1:0] pk_nx  = pk_hold ? pk_q : p_enc;
     wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
     wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
