@@ -32,6 +32,9 @@ export CCACHE_DIR := $(abspath build/ccache)
 # pytest-xdist workers (2 cores here); JOBS=1 for a serial run.
 JOBS         ?= 2
 SCENE        ?= sim/scenes/default.json
+# touch settings file for make sim / sim-model / sim-serve (default: the scene's own)
+SETTINGS     ?=
+SETTINGS_ARG  = $(if $(SETTINGS),--settings $(SETTINGS))
 PORT         ?= 5555
 SEED         ?= 1
 FUZZ_BYTES   ?= 1000000
@@ -70,11 +73,11 @@ setup: iverilog ccache $(STAMP)
 # The scene through the RTL (fmt_core under Verilator, the fixed-point model in lockstep).
 # The first full-size Verilator build takes 10-17 minutes; later runs reuse it.
 sim: setup
-	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE)
+	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE) $(SETTINGS_ARG)
 
 # The scene through the floating-point model only (seconds).
 sim-model: setup
-	$(VPY) -m fmt.run_sim --scene $(SCENE)
+	$(VPY) -m fmt.run_sim --scene $(SCENE) $(SETTINGS_ARG)
 
 # Random and mutated bytes into the UART of the small fmt_core (C++ Verilator harness,
 # serve mode), every reply checked against the protocol model and a register shadow
@@ -145,7 +148,7 @@ dds-purity: setup
 # the scene (SCENE=...) through the RTL core, then its UART on socket://127.0.0.1:$(PORT)
 # for scripts/fmtctl until Ctrl-C (or 1 h)
 sim-serve: setup
-	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE) --serve $(PORT) --serve-seconds 3600
+	$(VPY) -m bench.core.run_sim_rtl --scene $(SCENE) $(SETTINGS_ARG) --serve $(PORT) --serve-seconds 3600
 
 synth: setup
 	$(VPY) scripts/synth.py

@@ -114,8 +114,9 @@
 // 2026-11-28: LG +1 cycle, EA/EB +2 cycles to blob_eof_o).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
-// Settings are used live: change them between frames (the threshold applies to a row
-// when it arrives, min-cells when its region closes).
+// Settings are taken with the rows: the threshold applies to a row when it arrives,
+// min-cells (held per frame buffer) to the regions of the frame its rows arrived with;
+// hold both constant over a frame's rows (fmt_touch does).
 `default_nettype none
 `include "fmt_defaults.vh"
 
@@ -288,6 +289,23 @@ module fmt_blob #(
             on_mem[{wb_q, hm_row_i}] <= hm_on;
     end
     wire [ROWS-1:0] arr_p = arr_q[pb_q];
+
+    // min-cells per frame buffer: taken with every row that arrives into a buffer (the
+    // caller holds it constant over a frame's rows: fmt_touch does); the close engine
+    // uses the value of the buffer being labelled (mc_p_q, a register: a region closes
+    // many cycles after its rows arrived, and after the release of the other buffer).
+    reg  [MINC_W-1:0]    mc0_q, mc1_q, mc_p_q;
+    always @(posedge clk) begin
+        if (rst) begin
+            mc0_q  <= {MINC_W{1'b0}};
+            mc1_q  <= {MINC_W{1'b0}};
+            mc_p_q <= {MINC_W{1'b0}};
+        end else begin
+            if (hm_valid_i && !wb_q) mc0_q <= blob_min_cells_i;
+            if (hm_valid_i &&  wb_q) mc1_q <= blob_min_cells_i;
+            mc_p_q <= pb_q ? mc1_q : mc0_q;
+        end
+    end
 
     localparam [1:0] S_RUN = 2'd0, S_EMIT = 2'd1, S_WAIT = 2'd2;
     reg [1:0] state_q;
@@ -1101,11 +1119,12 @@ module fmt_blob #(
                 if (pkv_q && !mrg_q) cl_q <= rd_b;          // cl_go
             end
             if (ga == 0) begin : g_isb
-                // the closed label's blob test (area >= min-cells), registered with cl_q,
+                // the closed label's blob test (area >= min-cells of the labelled buffer,
+                // mc_p_q), registered with cl_q,
                 // in copies: one for the list, one per CFI labels of cf_mem's write data
                 wire [AREA_W-1:0] rb_area = rd_b[O_AREA - LO +: AREA_W];
                 wire isb_nx = ({{(AM_W-AREA_W){1'b0}}, rb_area}
-                               >= {{(AM_W-MINC_W){1'b0}}, blob_min_cells_i});
+                               >= {{(AM_W-MINC_W){1'b0}}, mc_p_q});
                 for (gk = 0; gk <= NCF; gk = gk + 1) begin : g_k
                     (* keep *) always @(posedge clk) cl_isb_q[gk] <= isb_nx;   // (read after cl_go)
                 end

@@ -52,7 +52,7 @@
 // Status: STATUS bits (w1c) are set by the blocks' sticky flags (bit 0 flattening
 // saturation, 1 receiver FFT/cell overflow, 2 event-port drop, 3 latency saturation,
 // 4 control-port error, 5 localmax overflow/overrun, 6 tracker drop/no slot/overrun,
-// 7 blob overflow/overrun);
+// 7 blob overflow/overrun, 8 a calibration write went into a frame);
 // status_o mirrors them for LEDs.  FRAME_COUNT counts heat-map frames (hm_eof).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -117,7 +117,7 @@ module fmt_core #(
     input  wire [31:0]              bus_wdata_i,    // write data
     output wire [31:0]              bus_rdata_o,    // read data, 1 cycle after bus_re_i
     // monitor
-    output wire [7:0]               status_o,       // STATUS register (sticky flags)
+    output wire [8:0]               status_o,       // STATUS register (sticky flags)
     output wire [15:0]              frame_count_o   // heat-map frames since reset (wraps)
 );
     localparam CPS    = CLK_PER_SAMPLE;
@@ -158,7 +158,8 @@ module fmt_core #(
     wire        r_run, r_pn_en;
     wire [9:0]  r_chip_len;
     wire [5:0]  r_rx_delay;
-    wire [7:0]  r_windows_m, r_status;
+    wire [7:0]  r_windows_m;
+    wire [8:0]  r_status;
     wire [4:0]  r_tone_sel, r_limit, r_cal_row;
     wire [5:0]  r_cal_col;
     wire        tone_tw_we, tone_amp_we, tone_tw_re, tone_amp_re;
@@ -295,7 +296,7 @@ module fmt_core #(
     wire [1:0]       ev_type;
     wire             ev_last;
     wire [31:0]      now;
-    wire             flat_sat, lm_ovf, lm_overrun, trk_drop, trk_noslot, trk_overrun, ev_ovf;
+    wire             flat_sat, cal_late, lm_ovf, lm_overrun, trk_drop, trk_noslot, trk_overrun, ev_ovf;
     wire             blob_flag;
     wire [15:0]      flat_sat_cnt, lm_drop_cnt, ev_drop_cnt, ev_skip_cnt;
     wire [LIM_W-1:0] limit = ({27'd0, r_limit} > MAX_TOUCHES) ? MAX_TOUCHES[LIM_W-1:0] : r_limit[LIM_W-1:0];
@@ -351,7 +352,7 @@ module fmt_core #(
         .ev_strength_o(ev_strength_o), .ev_axis_major_o(ev_axis_major_o),
         .ev_axis_minor_o(ev_axis_minor_o), .ev_angle_o(ev_angle_o), .ev_flags_o(ev_flags_o),
         .ev_last_o(ev_last),
-        .now_o(now), .sat_flag_o(flat_sat), .sat_count_o(flat_sat_cnt),
+        .now_o(now), .sat_flag_o(flat_sat), .cal_late_o(cal_late), .sat_count_o(flat_sat_cnt),
         .lm_overflow_o(lm_ovf), .lm_drop_count_o(lm_drop_cnt), .lm_overrun_o(lm_overrun),
         .trk_drop_o(trk_drop), .trk_noslot_o(trk_noslot), .trk_overrun_o(trk_overrun),
         .ev_drop_count_o(ev_drop_cnt), .ev_skip_count_o(ev_skip_cnt), .ev_overflow_o(ev_ovf),
@@ -452,7 +453,7 @@ module fmt_core #(
         else if (hm_eof) frames_q <= frames_q + 1'b1;
     end
     assign frame_count_o = frame_count_q;
-    wire [7:0] status_set = {blob_flag, trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
+    wire [8:0] status_set = {cal_late, blob_flag, trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
                              err_pulse, lat_sat, ev_ovf, rx_ovf, flat_sat};
     assign status_o = r_status;
 

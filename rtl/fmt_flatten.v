@@ -17,8 +17,17 @@
 // (ROWS words of {gain 16, offset HM_W} bits, the halves written separately; block RAM
 // with CAL_BRAM = 1: one RAMB18 (512 x 36 simple dual port) per column at the default
 // size, ~960 LUT6 of RAM32M with CAL_BRAM = 0); written one cell at a time through
-// cal_we_i / cal_sel_i / cal_row_i / cal_col_i / cal_data_i.  A write is seen by beats
-// that arrive at least one cycle after it (read-first RAM).  Power-on / reset does NOT
+// cal_we_i / cal_sel_i / cal_row_i / cal_col_i / cal_data_i.  Writes take effect at
+// frame boundaries: a frame is flattened with one calibration.  A write that comes
+// while a frame arrives (from its first row beat to its hm_eof) waits in a queue of
+// CAL_Q words (LUT RAM) and is written to the column memories after the frame's hm_eof,
+// one per cycle without a row beat (the hm_eof cycle counts); a write between frames
+// is written at once.  The column memories are read-first: a write is seen by the
+// beats of the following cycles.  A write that finds the queue full writes the
+// queue's oldest word at once, inside the frame, and sets cal_late_o (sticky, cleared
+// by rst): at most CAL_Q writes may come during one frame's rows (the core's control
+// port writes one cell per ~10^5 cycles).  The read-back copy (below) takes every
+// write at once.  Power-on / reset does NOT
 // clear the RAM (block RAM has no reset); after configuration load offset 0 / gain
 // 16384 (identity) or a calibration: with INIT_IDENTITY = 1 (default) the memories are
 // initialised to the identity for simulation and FPGA configuration.
@@ -44,6 +53,7 @@ module fmt_flatten #(
     parameter CNT_W         = 16,                // saturation counter width
     parameter INIT_IDENTITY = 1,                 // 1: memories start at offset 0, gain 1.0
     parameter CAL_BRAM      = 1,                 // column calibration memories: 1 block RAM, 0 LUT RAM
+    parameter CAL_Q         = 16,                // calibration writes held during a frame (power of 2, >= 2)
     parameter ROW_IDX_W     = (ROWS > 1) ? $clog2(ROWS) : 1,  // row index width
     parameter COL_IDX_W     = (COLS > 1) ? $clog2(COLS) : 1,  // column index width
     parameter CAL_W         = (HM_W > 16) ? HM_W : 16         // calibration data width
@@ -72,6 +82,7 @@ module fmt_flatten #(
     input  wire                    cal_re_i,     // read back cal_row_i/cal_col_i/cal_sel_i
     output reg                     cal_rvalid_o, // read-back data valid (one cycle)
     output reg  [CAL_W-1:0]        cal_rdata_o,  // read-back value (zero-extended)
+    output reg                     cal_late_o,   // sticky: a write was applied inside a frame (queue full)
     // saturation monitor
     input  wire                    sat_clr_i,    // clear flag and counter
     output reg                     sat_flag_o,   // sticky: some cell saturated
@@ -107,6 +118,59 @@ module fmt_flatten #(
     wire                 rd_serve = rd_pend_q && !hm_valid_i;
     wire [ROW_IDX_W-1:0] rd_addr  = hm_row_i;   // column memories: heat-map beats only
 
+    // synthesis translate_off
+    initial begin
+        if (CAL_Q < 2 || (CAL_Q & (CAL_Q - 1)) != 0) begin
+            $display("fmt_flatten: CAL_Q %0d must be a power of two >= 2", CAL_Q);
+            $finish;
+        end
+    end
+    // synthesis translate_on
+
+    // ---- calibration writes at frame boundaries -------------------------------------------
+    localparam QA = (CAL_Q > 1) ? $clog2(CAL_Q) : 1;         // queue address width
+    localparam QW = 1 + ROW_IDX_W + COL_IDX_W + CAL_W;       // {sel, row, col, data}
+    (* ram_style = "distributed" *)
+    reg  [QW-1:0]        cq_mem [0:CAL_Q-1];
+    reg  [QA-1:0]        cq_wp_q, cq_rp_q;
+    reg  [QA:0]          cq_n_q;                             // words queued
+    reg                  in_q;                               // a frame is arriving
+    wire                 cq_empty = (cq_n_q == {(QA+1){1'b0}});
+    wire                 cq_full  = (cq_n_q[QA] == 1'b1);    // == CAL_Q
+    // no frame's rows can be read in this cycle's column-memory write: between frames,
+    // or the hm_eof cycle (the frame's rows are in; the next frame's come later)
+    wire                 cal_idle = !hm_valid_i && (!in_q || hm_eof_i);
+    wire                 cq_pop   = !cq_empty && (cal_idle || (cal_we_i && cq_full));
+    wire                 cw_now   = cal_we_i && cal_idle && cq_empty;   // written at once
+    wire                 cq_push  = cal_we_i && !cw_now;
+    wire [QW-1:0]        cq_head  = cq_mem[cq_rp_q];
+    // the column memories' write of this cycle: the queue's oldest word, else the input
+    wire                 cw_v     = cq_pop || cw_now;
+    wire                 cw_sel   = cq_pop ? cq_head[QW-1] : cal_sel_i;
+    wire [ROW_IDX_W-1:0] cw_row   = cq_pop ? cq_head[QW-2 -: ROW_IDX_W] : cal_row_i;
+    wire [COL_IDX_W-1:0] cw_col   = cq_pop ? cq_head[CAL_W +: COL_IDX_W] : cal_col_i;
+    wire [CAL_W-1:0]     cw_data  = cq_pop ? cq_head[CAL_W-1:0] : cal_data_i;
+    always @(posedge clk) begin
+        if (cq_push) cq_mem[cq_wp_q] <= {cal_sel_i, cal_row_i, cal_col_i, cal_data_i};
+    end
+    always @(posedge clk) begin
+        if (rst) begin
+            cq_wp_q    <= {QA{1'b0}};
+            cq_rp_q    <= {QA{1'b0}};
+            cq_n_q     <= {(QA+1){1'b0}};
+            in_q       <= 1'b0;
+            cal_late_o <= 1'b0;
+        end else begin
+            if (hm_eof_i)        in_q <= 1'b0;
+            else if (hm_valid_i) in_q <= 1'b1;
+            if (cq_push) cq_wp_q <= cq_wp_q + 1'b1;
+            if (cq_pop)  cq_rp_q <= cq_rp_q + 1'b1;
+            if (cq_push && !cq_pop)      cq_n_q <= cq_n_q + 1'b1;
+            else if (cq_pop && !cq_push) cq_n_q <= cq_n_q - 1'b1;
+            if (cq_pop && !cal_idle) cal_late_o <= 1'b1;      // full: written inside a frame
+        end
+    end
+
     genvar c;
     generate
         for (c = 0; c < COLS; c = c + 1) begin : g_col
@@ -116,8 +180,8 @@ module fmt_flatten #(
             reg  [HM_W+GAIN_W-1:0] cal_rd2_q;        // output register (s2)
             wire [HM_W-1:0]   off_rd_q  = cal_rd2_q[HM_W-1:0];
             wire [GAIN_W-1:0] gain_rd_q = cal_rd2_q[HM_W +: GAIN_W];
-            wire we_off  = cal_we_i && (cal_col_i == c) && !cal_sel_i;
-            wire we_gain = cal_we_i && (cal_col_i == c) &&  cal_sel_i;
+            wire we_off  = cw_v && (cw_col == c) && !cw_sel;
+            wire we_gain = cw_v && (cw_col == c) &&  cw_sel;
             // The two branches below are the same memory and differ only in the
             // ram_style attribute: XST and Yosys read the attribute as a literal string,
             // so it cannot come from a parameter, and one copy per style is the portable
@@ -132,8 +196,8 @@ module fmt_flatten #(
                         mem[i] = {((INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0), {HM_W{1'b0}}};
                 end
                 always @(posedge clk) begin
-                    if (we_off)  mem[cal_row_i][HM_W-1:0]      <= cal_data_i[HM_W-1:0];
-                    if (we_gain) mem[cal_row_i][HM_W +: GAIN_W] <= cal_data_i[GAIN_W-1:0];
+                    if (we_off)  mem[cw_row][HM_W-1:0]      <= cw_data[HM_W-1:0];
+                    if (we_gain) mem[cw_row][HM_W +: GAIN_W] <= cw_data[GAIN_W-1:0];
                     rd_q <= mem[rd_addr];
                 end
                 assign cal_rd = rd_q;
@@ -147,8 +211,8 @@ module fmt_flatten #(
                         mem[i] = {((INIT_IDENTITY != 0) ? (16'd1 << GAIN_FRAC) : 16'd0), {HM_W{1'b0}}};
                 end
                 always @(posedge clk) begin
-                    if (we_off)  mem[cal_row_i][HM_W-1:0]      <= cal_data_i[HM_W-1:0];
-                    if (we_gain) mem[cal_row_i][HM_W +: GAIN_W] <= cal_data_i[GAIN_W-1:0];
+                    if (we_off)  mem[cw_row][HM_W-1:0]      <= cw_data[HM_W-1:0];
+                    if (we_gain) mem[cw_row][HM_W +: GAIN_W] <= cw_data[GAIN_W-1:0];
                     rd_q <= mem[rd_addr];
                 end
                 assign cal_rd = rd_q;

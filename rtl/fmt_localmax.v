@@ -46,14 +46,15 @@
 //        then a rotation per row and the rows outside the sensor, registered)
 //   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
 //        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
-//        early with the centre cell from a register of its own, rotated in the capture's
-//        second step); the 3x3 goes to a (MAX_TOUCHES+1)-slot store (block RAM) at the
-//        list's free slot.
+//        early with the centre cell from registers of its own, rotated in the capture's
+//        second step, in four copies for the list's comparators); the 3x3 goes to a
+//        (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
 // After the frame's hm_eof, once every ready row is finished, the list is emitted, one
 // candidate per cycle: pop entry 0, read its 3x3 from the slot store, output registers;
-// then cand_eof.  Settings (threshold_i, moore_i, limit_i) are used live: change them
-// between frames (limit_i is registered: it takes effect two cycles later; moore_i, in
-// registered copies, one cycle later).
+// then cand_eof.  Settings (threshold_i, moore_i, limit_i) are taken with the rows, per
+// frame buffer: a frame is processed with the values its rows arrived with (hold them
+// constant over a frame's rows; fmt_touch gives every frame the settings of its first
+// row), also while the next frame arrives.
 //
 // Latency (processing-clock cycles, measured by tb/fmt_localmax, rows one per cycle,
 // hm_eof right after the last row, the earlier rows finished): last row beat -> last
@@ -162,6 +163,32 @@ module fmt_localmax #(
         if (hm_valid_i) mem[{wb_q, hm_row_i}] <= hm_data_i;
     end
 
+    // ---- settings, per frame buffer ----------------------------------------------------
+    // threshold_i, moore_i and limit_i are taken with every row that arrives into a buffer
+    // (the caller holds them constant over a frame's rows: fmt_touch does) and the sweep
+    // and the finish use the values of the buffer being processed, from a register
+    // (set_p_q = the set of buffer pb_q, one cycle old: a row is compared 4 cycles after
+    // its arrival at the earliest, and the sweep of a buffer starts after the release of
+    // the other one).  So a frame is processed with the settings it arrived with, also
+    // while the next frame arrives.
+    localparam SET_W = HM_W + 1 + LIM_W;       // {threshold, moore, limit}
+    reg  [SET_W-1:0]  set0_q, set1_q;          // per buffer
+    reg  [SET_W-1:0]  set_p_q;                 // the processing buffer's
+    always @(posedge clk) begin
+        if (rst) begin
+            set0_q  <= {SET_W{1'b0}};
+            set1_q  <= {SET_W{1'b0}};
+            set_p_q <= {SET_W{1'b0}};
+        end else begin
+            if (hm_valid_i && !wb_q) set0_q <= {threshold_i, moore_i, limit_i};
+            if (hm_valid_i &&  wb_q) set1_q <= {threshold_i, moore_i, limit_i};
+            set_p_q <= pb_q ? set1_q : set0_q;
+        end
+    end
+    wire [HM_W-1:0]   thr_p   = set_p_q[SET_W-1 -: HM_W];    // threshold of the frame
+    wire              moore_p = set_p_q[LIM_W];              // moore of the frame
+    wire [LIM_W-1:0]  limit_p = set_p_q[LIM_W-1:0];          // limit of the frame
+
     // the processing buffer's arrival bitmap, kept as its own register (= pb_q ? arr1_q :
     // arr0_q in every cycle; updated below with arr0_q / arr1_q)
     reg  [ROWS-1:0] arrp_q;
@@ -210,17 +237,18 @@ module fmt_localmax #(
     reg [NWC-1:0]       wsh_q;                 // adv and v2_q: the window shifts, by column group
     wire                adv = advc_q;          // (rem_q == 0)
 
-    reg [ROWS-1:0] ready;                      // present with its neighbours, not finished
+    // ready: present with its neighbours, not finished -- a register of its own (rdy_q,
+    // loaded from the next values of arrp_q and done_q: equal to the same function of
+    // arr_p and done_q in every cycle), so the lowest-ready-row carry starts at a
+    // flip-flop, not after arr_p's fan-out and a gate
+    reg  [ROWS-1:0] rdy_q;
+    wire [ROWS-1:0] ready = rdy_q;
     reg [ROWS-1:0] fin_ok;                     // not finished and the row below present
     reg [ROWS-1:0] nxt_ok;                     // row i + 1 ready
     always @(*) begin : c_ready
         integer i;
-        for (i = 0; i < ROWS; i = i + 1) begin
-            ready[i]  = arr_p[i] & ~done_q[i]
-                      & ((i == 0)        ? 1'b1 : arr_p[(i == 0) ? 0 : i - 1])
-                      & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
+        for (i = 0; i < ROWS; i = i + 1)
             fin_ok[i] = ~done_q[i] & ((i == ROWS - 1) ? 1'b1 : arr_p[(i == ROWS - 1) ? i : i + 1]);
-        end
         for (i = 0; i < ROWS; i = i + 1)
             nxt_ok[i] = (i == ROWS - 1) ? 1'b0 : ready[(i == ROWS - 1) ? i : i + 1];
     end
@@ -308,7 +336,7 @@ module fmt_localmax #(
             if (c < COLS - 1) begin : g_r
                 assign gd2[c+1] = (n > w0_q[(c+1)*HM_W +: HM_W]);
             end
-            assign thr_n[c] = (n >= threshold_i);
+            assign thr_n[c] = (n >= thr_p);
         end
     endgenerate
     reg [COLS-1:0]  cl_q;                      // gtl of w0_q's row (cl_q[0] = 1)
@@ -322,15 +350,15 @@ module fmt_localmax #(
     // w0_q's row above its earlier neighbours in w1_q (above, above-left, above-right,
     // strict), and w1_q's row at least equal to its later neighbours in w0_q (below,
     // below-left, below-right; all of them when w1_q holds the last row)
-    // (moore_i from registered copies, one per quarter of the columns: no net from one
-    // flip-flop to the 80 mask LUTs; a change takes effect a cycle later)
-    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_i copies
+    // (moore_p from registered copies, one per quarter of the columns: no net from one
+    // flip-flop to the 80 mask LUTs)
+    localparam NMC = (COLS >= 4) ? 4 : 1;      // moore_p copies
     reg  [NMC-1:0]  moo_q;
     wire [COLS-1:0] moo;                       // the copy of column c
     genvar gm;
     generate
         for (gm = 0; gm < NMC; gm = gm + 1) begin : g_moo
-            (* keep *) always @(posedge clk) moo_q[gm] <= moore_i;
+            (* keep *) always @(posedge clk) moo_q[gm] <= moore_p;
         end
         for (gm = 0; gm < COLS; gm = gm + 1) begin : g_mooc
             assign moo[gm] = moo_q[(gm * NMC) / COLS];
@@ -599,9 +627,25 @@ module fmt_localmax #(
     reg [1:0]       pm_q;                      // their rotation (column mod 3)
     reg             ptop_q, pbot_q;            // first / last row
     reg [IDX_W-1:0] pidx_q;                    // raster index
-    reg [HM_W-1:0]  pc_q;                      // the centre cell (= z9's centre below) in a
-                                               // register of its own: the list's early
-                                               // compare does not wait on the rotation
+    // the centre cell (= z9's centre below) in registers of its own: the list's early
+    // compare does not wait on the rotation; in NLC copies (keep), each for K / NLC of
+    // the list's comparators (no one register drives all K)
+    localparam NLC = (K >= 4) ? 4 : 1;
+    reg  [NLC*HM_W-1:0] pc_q;
+    reg  [HM_W-1:0]     pc_d;
+    always @(*) begin
+        case (p1m_q)                           // z9's centre (row b, rotated)
+            2'd1:    pc_d = s2[5*HM_W +: HM_W];
+            2'd2:    pc_d = s2[3*HM_W +: HM_W];
+            default: pc_d = s2[4*HM_W +: HM_W];
+        endcase
+    end
+    genvar gpc;
+    generate
+        for (gpc = 0; gpc < NLC; gpc = gpc + 1) begin : g_pc
+            (* keep *) always @(posedge clk) pc_q[gpc*HM_W +: HM_W] <= pc_d;
+        end
+    endgenerate
     wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
     wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
     wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
@@ -632,9 +676,9 @@ module fmt_localmax #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
-    // (= pc_q) and pidx_q in every cycle
+    // (= each copy of pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1), .EARLY(1)) u_list (
+                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
         .nxt_key_i(pc_q), .nxt_tie_i(pidx_q),
@@ -667,9 +711,9 @@ module fmt_localmax #(
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
     end
 
-    // the limit and the counts of the finish, registered: limit_i two cycles old, found_q
+    // the limit and the counts of the finish, registered: limit_p a cycle old, found_q
     // one (it does not change in the cycle before finish: fin_pre_q waits for no capture)
-    wire [LIM_W-1:0] lim_eff  = (limit_i > K_L) ? K_L : limit_i;
+    wire [LIM_W-1:0] lim_eff  = (limit_p > K_L) ? K_L : limit_p;
     reg  [LIM_W-1:0] lim_q;
     wire [FOUND_W-1:0] lim_ext = {{(FOUND_W > LIM_W ? FOUND_W - LIM_W : 0){1'b0}}, lim_q};
     wire             over_d   = (found_q > lim_ext);
@@ -683,6 +727,21 @@ module fmt_localmax #(
     wire             finish   = run && fin_pre_q;
     assign           releasing = (state_q == S_EMIT) && (left_q == {LIM_W{1'b0}});
     wire [CNT_W:0]   drop_sum = {1'b0, drop_count_o} + {{(CNT_W + 1 - FOUND_W){1'b0}}, dropped_q};
+
+    // the next values of arrp_q and done_q (reset aside) and the ready flags of them
+    wire [ROWS-1:0] arrp_d = releasing         // pb_q flips; arr_p clears
+                           ? ((pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}}))
+                           : (arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}}));
+    wire [ROWS-1:0] done_d = releasing ? {ROWS{1'b0}}
+                           : (done_q | ((issue && rule_a) ? cur1h_q : {ROWS{1'b0}}));
+    reg  [ROWS-1:0] ready_d;
+    always @(*) begin : c_ready_d
+        integer i;
+        for (i = 0; i < ROWS; i = i + 1)
+            ready_d[i] = arrp_d[i] & ~done_d[i]
+                       & ((i == 0)        ? 1'b1 : arrp_d[(i == 0) ? 0 : i - 1])
+                       & ((i == ROWS - 1) ? 1'b1 : arrp_d[(i == ROWS - 1) ? i : i + 1]);
+    end
 
     always @(posedge clk) begin
         // ---- datapath registers (no reset needed) ----
@@ -717,11 +776,6 @@ module fmt_localmax #(
         p1bot_q   <= mbot_q;
         p1idx_q   <= {mrow_q, lo_col};
         pz_q      <= s2;
-        case (p1m_q)                           // z9's centre (row b, rotated)
-            2'd1:    pc_q <= s2[5*HM_W +: HM_W];
-            2'd2:    pc_q <= s2[3*HM_W +: HM_W];
-            default: pc_q <= s2[4*HM_W +: HM_W];
-        endcase
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
         pbot_q    <= p1bot_q;
@@ -746,6 +800,7 @@ module fmt_localmax #(
             cp_q     <= 1'b0;
             rule_c_q <= 1'b0;
             arrp_q   <= {ROWS{1'b0}};
+            rdy_q    <= {ROWS{1'b0}};
             rule_a_q <= 1'b0;
             rule_b_q <= 1'b0;
             state_q  <= S_RUN;
@@ -779,10 +834,9 @@ module fmt_localmax #(
                 if (wb_q) arr1_q[hm_row_i] <= 1'b1;
                 else      arr0_q[hm_row_i] <= 1'b1;
             end
-            if (releasing)                       // pb_q flips; arr_p clears
-                arrp_q <= (pb_q ? arr0_q : arr1_q) | ((wb_q != pb_q) ? hm_1h : {ROWS{1'b0}});
-            else
-                arrp_q <= arrp_q | ((wb_q == pb_q) ? hm_1h : {ROWS{1'b0}});
+            arrp_q <= arrp_d;
+            done_q <= done_d;
+            rdy_q  <= ready_d;
             if (hm_eof_i) begin
                 eofs_q[wb_q] <= 1'b1;
                 if (wb_q) frm1_q <= hm_frame_i;
@@ -810,7 +864,6 @@ module fmt_localmax #(
                 rule_b_q <= cv_q && b_hold;
             end
             if (issue) begin
-                if (rule_a) done_q <= done_q | cur1h_q;
                 if (rule_a && last_c) begin
                     cv_q <= 1'b0;                      // virtual step after the last row
                 end else begin
@@ -864,7 +917,6 @@ module fmt_localmax #(
             if (releasing) begin
                 state_q      <= S_RUN;      // the list is cleared
                 found_q      <= {FOUND_W{1'b0}};
-                done_q       <= {ROWS{1'b0}};
                 cv_q         <= 1'b0;
                 rule_a_q     <= 1'b0;
                 rule_b_q     <= 1'b0;

@@ -38,6 +38,9 @@
 // cycle: the results (and the inserted entry's own, one more comparator) move with their
 // entries on an insert or pop, so no comparator is between ins_key_i and the entries'
 // enables.  EARLY = 0: ins_key_i is compared in the cycle of the insert (nxt_* unused).
+// NXT_CP (EARLY = 1): nxt_key_i in NXT_CP equal copies (the user's registers): entry i
+// compares with copy i * NXT_CP / K, the inserted entry with copy 0, so no one register
+// drives all K comparators (simulation reports copies that differ).
 //
 // Cost: K comparators of KEY_W + TIE_W bits, a 3:1 (2:1 with HAS_POP = 0) select per
 // entry bit; no arithmetic beyond the comparators.  Against the lists the two blocks
@@ -53,7 +56,8 @@ module fmt_sorted_list #(
                                  // constant 0 bit per entry); >= $clog2(K + 1) with PAY_RST_IDX
     parameter PAY_RST_IDX = 0,   // 1: rst sets payload i = i and drop_pay_o = K; 0: no reset
     parameter HAS_POP     = 1,   // 1: pop_i works; 0: pop_i is ignored (no pop circuit)
-    parameter EARLY       = 0    // 1: compare with nxt_key_i / nxt_tie_i a cycle early
+    parameter EARLY       = 0,   // 1: compare with nxt_key_i / nxt_tie_i a cycle early
+    parameter NXT_CP      = 1    // EARLY = 1: copies of nxt_key_i (>= 1, <= K)
 ) (
     input  wire               clk,
     input  wire               rst,         // synchronous, active high
@@ -62,7 +66,8 @@ module fmt_sorted_list #(
     input  wire [KEY_W-1:0]   ins_key_i,   // its key (descending)
     input  wire [TIE_W-1:0]   ins_tie_i,   // its tie-break key (ascending)
     /* verilator lint_off UNUSEDSIGNAL */  // EARLY = 0: not read
-    input  wire [KEY_W-1:0]   nxt_key_i,   // EARLY = 1: ins_key_i of the next cycle
+    input  wire [NXT_CP*KEY_W-1:0] nxt_key_i,   // EARLY = 1: ins_key_i of the next cycle
+                                           // (copy c at [c*KEY_W +: KEY_W])
     input  wire [TIE_W-1:0]   nxt_tie_i,   // EARLY = 1: ins_tie_i of the next cycle
     /* verilator lint_on UNUSEDSIGNAL */
     input  wire [((PAY_W > 0) ? PAY_W : 1)-1:0]   ins_pay_i,   // its payload
@@ -95,6 +100,10 @@ module fmt_sorted_list #(
             $display("fmt_sorted_list: EARLY %0d must be 0 or 1", EARLY);
             $finish;
         end
+        if (NXT_CP < 1 || NXT_CP > K) begin
+            $display("fmt_sorted_list: NXT_CP %0d must be 1 .. K (%0d)", NXT_CP, K);
+            $finish;
+        end
         if (PAY_RST_IDX == 1 && PAY_W < IW) begin
             $display("fmt_sorted_list: PAY_W %0d < %0d bits of the entry numbers 0..K (K %0d)",
                      PAY_W, IW, K);
@@ -114,13 +123,13 @@ module fmt_sorted_list #(
             // ahead_q[i]: entry i (as it is now) ranks ahead of this cycle's insert
             reg [K-1:0] ahead_q;
             reg [K-1:0] ahead_c;               // entry i now ahead of the next insert
-            wire        ahead_ins = ({ins_key_i, ~ins_tie_i} > {nxt_key_i, ~nxt_tie_i});
+            wire        ahead_ins = ({ins_key_i, ~ins_tie_i} > {nxt_key_i[0 +: KEY_W], ~nxt_tie_i});
             always @(*) begin : c_better
                 integer i;
                 for (i = 0; i < K; i = i + 1) begin
                     better[i]  = valid_o[i] && ahead_q[i];
                     ahead_c[i] = ({key_o[i*KEY_W +: KEY_W], ~tie_o[i*TIE_W +: TIE_W]} >
-                                  {nxt_key_i, ~nxt_tie_i});
+                                  {nxt_key_i[((i * NXT_CP) / K)*KEY_W +: KEY_W], ~nxt_tie_i});
                 end
             end
             // the results move with their entries (as the list below)
@@ -139,12 +148,12 @@ module fmt_sorted_list #(
                 end
             end
             // synthesis translate_off
-            reg [KEY_W-1:0] nk_q;
+            reg [NXT_CP*KEY_W-1:0] nk_q;
             reg [TIE_W-1:0] nt_q;
             always @(posedge clk) begin
                 nk_q <= nxt_key_i;
                 nt_q <= nxt_tie_i;
-                if (!rst && ins_i && (nk_q !== ins_key_i || nt_q !== ins_tie_i))
+                if (!rst && ins_i && (nk_q !== {NXT_CP{ins_key_i}} || nt_q !== ins_tie_i))
                     $display("%m: ERROR: insert differs from the previous nxt_key_i / nxt_tie_i at %0t",
                              $time);
             end

@@ -27,8 +27,19 @@
 // 30 x 40 81..108 cycles on palm scenes, worst 377 on random maps.
 //
 // Twin: sim/fmt/touch.py process_frames(fixed=True, blobs=False): per frame the same
-// events in the same order (time stamps excepted).  The run-time settings are input
-// ports (the core's register file drives them); change them between frames.
+// events in the same order (time stamps excepted).
+//
+// Run-time settings (input ports, driven by the core's register file) may change in
+// any cycle: every frame is processed with the values present in the cycle its first
+// heat-map row enters (twin: process_frames(frame_settings=...)), in every stage, also
+// while the previous frame is still finished and the next one arrives (see "settings
+// per frame" below; fmt_localmax and fmt_blob keep them per frame buffer).  At most two
+// frames are in flight (each stage finishes a frame before the next-but-one arrives,
+// else its overrun flag), so four table entries, by frame number mod 4, never meet.
+// delay_i and report_period_i act on the event port as events pass (events keep their
+// order, a frame is admitted or skipped whole); a calibration write that comes during
+// a frame's rows waits for its hm_eof (fmt_flatten: a frame is flattened with one
+// calibration; cal_late_o if its queue overflows).
 //
 // Latency, processing-clock cycles from the frame's last heat-map row beat (hm_eof on
 // the next cycle) to its last event on ev_*, dial 0, consumer ready: flatten 5,
@@ -112,6 +123,7 @@ module fmt_touch #(
     // monitor
     output wire [TIME_W-1:0]     now_o,              // time-stamp counter
     output wire                  sat_flag_o,         // flattening saturated (sticky)
+    output wire                  cal_late_o,         // a calibration write went into a frame (sticky)
     output wire [CNT_W-1:0]      sat_count_o,        // saturated cells
     output wire                  lm_overflow_o,      // a frame had more maxima than the limit (sticky)
     output wire [CNT_W-1:0]      lm_drop_count_o,    // candidates dropped by the limit
@@ -124,6 +136,74 @@ module fmt_touch #(
     output wire                  ev_overflow_o,      // event port: a frame was dropped (sticky)
     output wire                  blob_flag_o         // blobs: > MAX_BLOBS in a frame or overrun (sticky)
 );
+
+    // ---- settings per frame ---------------------------------------------------------
+    // Every frame is processed with the settings present in the cycle its first row
+    // beat enters (hm_valid_i after the previous hm_eof_i), whatever changes while it
+    // travels: the values are written into a table indexed by the frame number mod 4
+    // (at most two frames are in flight: see the header), and each stage reads the
+    // entry of the frame it works on.
+    //   intake (fmt_localmax and fmt_blob, which keep them per frame buffer): the
+    //     threshold, moore, limit, blob threshold and min-cells, in registers loaded in
+    //     the cycle before the frame's first flattened row (the first-row marker moves
+    //     along fmt_flatten's FLAT_LAT cycles), constant over its flattened rows;
+    //   fits and blob glue: moore, bias and blob_en by the frame number of the
+    //     candidate, blob-list and blob-mask streams; the fine touches' blob_en is the
+    //     candidates' delayed by fmt_interp's latency, the events' is registered at the
+    //     tracker frame's first beat (no table read in front of the tracker);
+    //   tracker: its five settings in a register, loaded after the frame's cand_eof
+    //     once the tracker is idle (before the frame's first touch reaches it).
+    localparam FLAT_LAT = 5;                           // fmt_flatten's fixed latency
+    localparam TRK_W    = 16 + 16 + HOLD_W + 4 + (V_W - 1);   // tracker settings
+    localparam IN_W     = HM_W + 1 + LIM_W + HM_W + 16;       // intake settings
+    reg                    in_q;                       // a frame is arriving (row .. eof)
+    wire                   first_row = hm_valid_i && !in_q;
+    wire [1:0]             fi = hm_frame_i[1:0];       // table index of the arriving frame
+    (* ram_style = "distributed" *)
+    reg  [IN_W-1:0]        sti_mem [0:3];              // intake settings per frame mod 4
+    (* ram_style = "distributed" *)
+    reg  [TRK_W-1:0]       stt_mem [0:3];              // tracker settings per frame mod 4
+    reg  [3:0]             moo_v, bia_v, ben_v;        // moore, bias, blob_en per frame mod 4
+    reg  [FLAT_LAT-2:0]    fp_q;                       // the first-row marker, delayed
+    reg  [2*FLAT_LAT-3:0]  fpi_q;                      // its table index, delayed
+    reg  [IN_W-1:0]        in_set_q;                   // intake settings of the frame
+    wire [1:0]             fpi_l = fpi_q[2*FLAT_LAT-3 -: 2];
+
+    always @(posedge clk) begin
+        if (first_row) begin
+            sti_mem[fi] <= {threshold_i, moore_i, limit_i, blob_threshold_i, blob_min_cells_i};
+            stt_mem[fi] <= {max_jump_i, hold_jump_i, hold_off_i, vel_shift_i, max_speed_i};
+        end
+    end
+
+    always @(posedge clk) begin
+        if (rst) begin
+            in_q     <= 1'b0;
+            moo_v    <= 4'd0;
+            bia_v    <= 4'd0;
+            ben_v    <= 4'd0;
+            fp_q     <= {(FLAT_LAT-1){1'b0}};
+            fpi_q    <= {(2*FLAT_LAT-2){1'b0}};
+            in_set_q <= {IN_W{1'b0}};
+        end else begin
+            if (hm_eof_i)        in_q <= 1'b0;
+            else if (hm_valid_i) in_q <= 1'b1;
+            if (first_row) begin
+                moo_v[fi] <= moore_i;
+                bia_v[fi] <= bias_en_i;
+                ben_v[fi] <= (BLOBS != 0) && blob_en_i;
+            end
+            fp_q  <= {fp_q[FLAT_LAT-3:0], first_row};
+            fpi_q <= {fpi_q[2*FLAT_LAT-5:0], fi};
+            if (fp_q[FLAT_LAT-2])             // the frame's first flattened row is next
+                in_set_q <= sti_mem[fpi_l];
+        end
+    end
+    wire [HM_W-1:0]        thr_f   = in_set_q[IN_W-1 -: HM_W];
+    wire                   moore_f = in_set_q[IN_W-HM_W-1];
+    wire [LIM_W-1:0]       limit_f = in_set_q[HM_W+16+LIM_W-1 -: LIM_W];
+    wire [HM_W-1:0]        bthr_f  = in_set_q[16+HM_W-1 -: HM_W];
+    wire [15:0]            minc_f  = in_set_q[15:0];
 
     // ---- flatten ------------------------------------------------------------------
     wire                   f_valid, f_eof;
@@ -144,6 +224,7 @@ module fmt_touch #(
         .cal_we_i(cal_we_i), .cal_sel_i(cal_sel_i), .cal_row_i(cal_row_i),
         .cal_col_i(cal_col_i), .cal_data_i(cal_data_i),
         .cal_re_i(cal_re_i), .cal_rvalid_o(cal_rvalid_o), .cal_rdata_o(cal_rdata_o),
+        .cal_late_o(cal_late_o),
         .sat_clr_i(sat_clr_i), .sat_flag_o(sat_flag_o), .sat_count_o(sat_count_o));
 
     // ---- local maxima -------------------------------------------------------------
@@ -164,7 +245,7 @@ module fmt_touch #(
     fmt_localmax #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .MAX_TOUCHES(MAX_TOUCHES),
                    .FRAME_W(FRAME_W), .CNT_W(CNT_W)) u_localmax (
         .clk(clk), .rst(rst),
-        .threshold_i(threshold_i), .moore_i(moore_i), .limit_i(limit_i),
+        .threshold_i(thr_f), .moore_i(moore_f), .limit_i(limit_f),
         .hm_valid_i(f_valid), .hm_row_i(f_row), .hm_frame_i(f_frame), .hm_data_i(f_data),
         .hm_eof_i(f_eof),
         .cand_valid_o(c_valid), .cand_frame_o(c_frame), .cand_row_o(c_row),
@@ -187,7 +268,7 @@ module fmt_touch #(
 
     fmt_interp #(.ROWS(ROWS), .COLS(COLS), .HM_W(HM_W), .FRAME_W(FRAME_W), .CNT_W(LIM_W)) u_interp (
         .clk(clk), .rst(rst),
-        .moore_i(moore_i), .bias_en_i(bias_en_i),
+        .moore_i(moo_v[c_frame[1:0]]), .bias_en_i(bia_v[c_frame[1:0]]),
         .cand_valid_i(c_valid), .cand_frame_i(c_frame), .cand_row_i(c_row), .cand_col_i(c_col),
         .cand_z_i(c_z), .cand_missing_i(c_missing), .cand_eof_i(c_eof), .cand_count_i(c_count),
         .cand_overflow_i(c_overflow),
@@ -226,7 +307,7 @@ module fmt_touch #(
                    .FRAME_W(FRAME_W), .ROW_IDX_W(ROW_IDX_W), .COL_IDX_W(COL_IDX_W),
                    .MINC_W(16)) u_blob (
             .clk(clk), .rst(rst),
-            .blob_threshold_i(blob_threshold_i), .blob_min_cells_i(blob_min_cells_i),
+            .blob_threshold_i(bthr_f), .blob_min_cells_i(minc_f),
             .hm_valid_i(f_valid), .hm_row_i(f_row), .hm_frame_i(f_frame), .hm_data_i(f_data),
             .hm_eof_i(f_eof),
             .blob_valid_o(b_valid), .blob_frame_o(b_frame), .blob_area_o(b_area),
@@ -240,14 +321,31 @@ module fmt_touch #(
             .overflow_flag_o(b_ovf_flag), .overrun_o(b_overrun));
         end else begin : g_no_blob
             // the settings and the mask query have no reader without the detector
-            wire unused_blob = &{1'b0, blob_threshold_i, blob_min_cells_i, m_q_row, m_q_col};
+            wire unused_blob = &{1'b0, bthr_f, minc_f, m_q_row, m_q_col};
             assign {b_valid, b_eof, m_ready, m_data, b_ovf_flag, b_overrun} = 6'd0;
             assign {b_frame, b_cx, b_cy, b_peak, m_frame, b_area, b_found, b_rmin, b_rmax,
                     b_prow, b_cmin, b_cmax, b_pcol, b_count, b_ovf, b_inc} = 0;
         end
     endgenerate
     assign blob_flag_o = b_ovf_flag | b_overrun;
-    wire blob_on = (BLOBS != 0) && blob_en_i;          // the blob path is in use
+    // the blob path is in use for the frame of each stream (blob_en of that frame)
+    localparam INTERP_LAT = 24;                        // fmt_interp: candidate -> touch, fixed
+    wire bon_c = ben_v[c_frame[1:0]];                  // candidates
+    wire bon_t;                                        // fine touches: bon_c INTERP_LAT cycles
+    fmt_interp_dly #(.W(1), .N(INTERP_LAT), .RST(1)) u_bon_t (   // old, from a flip-flop (no
+        .clk(clk), .rst(rst), .d_i(bon_c), .q_o(bon_t));         // table read before the tracker)
+    wire bon_m = ben_v[m_frame[1:0]];                  // the blob mask
+    wire bon_b = ben_v[b_frame[1:0]];                  // the blob list
+    // synthesis translate_off
+    reg [INTERP_LAT-1:0] chk_v_q;                      // fmt_interp's latency is INTERP_LAT
+    always @(posedge clk) begin
+        chk_v_q <= rst ? {INTERP_LAT{1'b0}} : {chk_v_q[INTERP_LAT-2:0], c_valid | c_eof};
+        if (!rst && (chk_v_q[INTERP_LAT-1] != (t_valid | t_eof))) begin
+            $display("fmt_touch: fmt_interp's latency is not INTERP_LAT = %0d", INTERP_LAT);
+            $finish;
+        end
+    end
+    // synthesis translate_on
 
     // ---- finger removal: hold the touch beats until the mask is written --------------
     reg  [ROW_IDX_W-1:0]   cr_mem [0:(1<<TI_W)-1];   // candidate cell per touch index
@@ -258,11 +356,11 @@ module fmt_touch #(
     reg                    s0_valid_q, s0_eof_q, s1_valid_q, s1_eof_q;
 
     always @(posedge clk) begin
-        if (c_valid && blob_on && ci_q < MAX_TOUCHES) begin
+        if (c_valid && bon_c && ci_q < MAX_TOUCHES) begin
             cr_mem[ci_q] <= c_row;
             cc_mem[ci_q] <= c_col;
         end
-        if (t_valid && blob_on && ti_q < MAX_TOUCHES)
+        if (t_valid && bon_t && ti_q < MAX_TOUCHES)
             tp_mem[ti_q] <= {t_frame, t_x, t_y, t_major, t_minor, t_strength,
                                        t_angle, t_flags};
     end
@@ -289,18 +387,18 @@ module fmt_touch #(
             s1_valid_q <= s0_valid_q;             // the query's answer comes now
             s1_eof_q   <= s0_eof_q;
             s1_idx_q   <= s0_idx_q;
-            if (c_valid && blob_on && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
+            if (c_valid && bon_c && ci_q < MAX_TOUCHES) ci_q <= ci_q + 1'b1;
             if (c_eof) ci_q <= {TI_W{1'b0}};
-            if (t_valid && blob_on && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
-            if (t_eof && blob_on) begin
+            if (t_valid && bon_t && ti_q < MAX_TOUCHES) ti_q <= ti_q + 1'b1;
+            if (t_eof && bon_t) begin
                 tn_q      <= ti_q + {{(TI_W-1){1'b0}}, t_valid};
                 ti_q      <= {TI_W{1'b0}};
                 have_tp_q <= 1'b1;
             end else if (t_eof) begin
                 ti_q <= {TI_W{1'b0}};
             end
-            if (m_ready && blob_on) have_mask_q <= 1'b1;
-            if (b_eof && blob_on) have_blob_q <= 1'b1;
+            if (m_ready && bon_m) have_mask_q <= 1'b1;
+            if (b_eof && bon_b) have_blob_q <= 1'b1;
             if (!rp_q && have_tp_q && have_mask_q && have_blob_q) begin
                 rp_q        <= 1'b1;                  // replay the frame's touches
                 rj_q        <= {TI_W{1'b0}};
@@ -326,16 +424,18 @@ module fmt_touch #(
     wire [TPD_W-1:0]     s1_beat = tp_mem[s1_idx_q];
     wire                 s1_keep = s1_valid_q && !m_data;
 
-    // tracker input: the chain (blobs off) or the replayed touches (blobs on)
-    wire                   g_valid = blob_on ? s1_keep  : t_valid;
-    wire                   g_eof   = blob_on ? s1_eof_q : t_eof;
+    // tracker input: the chain (a frame with blobs off) or the replayed touches (blobs
+    // on; the replay of a frame ends long before the next frame's touches)
+    wire                   rsel    = s1_valid_q || s1_eof_q;    // a replay beat
+    wire                   g_valid = s1_keep  || (t_valid && !bon_t);
+    wire                   g_eof   = s1_eof_q || (t_eof && !bon_t);
     wire [FRAME_W-1:0]     g_frame;
     wire [15:0]            g_x, g_y, g_major, g_minor;
     wire [HM_W-1:0]        g_strength;
     wire [7:0]             g_angle, g_flags;
     assign {g_frame, g_x, g_y, g_major, g_minor, g_strength, g_angle, g_flags} =
-        blob_on ? (s1_eof_q ? {t_frame, {(TPD_W-FRAME_W){1'b0}}} : s1_beat)
-                  : {t_frame, t_x, t_y, t_major, t_minor, t_strength, t_angle, t_flags};
+        rsel ? (s1_eof_q ? {t_frame, {(TPD_W-FRAME_W){1'b0}}} : s1_beat)
+             : {t_frame, t_x, t_y, t_major, t_minor, t_strength, t_angle, t_flags};
 
     // ---- frame matching -------------------------------------------------------------
     wire                   k_valid, k_last;
@@ -347,11 +447,45 @@ module fmt_touch #(
     wire [7:0]             k_angle, k_flags;
     wire                   k_busy;
 
+    // the tracker's settings: the entry of the frame whose candidates ended last, loaded
+    // once the tracker is idle and not taking a frame's touches
+    reg  [TRK_W-1:0]       trk_set_q;
+    reg  [1:0]             tsi_q;                      // table index of that frame
+    reg                    tsp_q;                      // a load is pending
+    reg                    tin_q;                      // the tracker takes a frame's touches
+    reg                    bk_q;                       // blob_en of the tracker's frame
+    always @(posedge clk) begin
+        if (rst) begin
+            trk_set_q <= {TRK_W{1'b0}};
+            tsi_q     <= 2'd0;
+            tsp_q     <= 1'b0;
+            tin_q     <= 1'b0;
+            bk_q      <= 1'b0;
+        end else begin
+            if (c_eof) begin
+                tsi_q <= c_frame[1:0];
+                tsp_q <= 1'b1;
+            end else if (tsp_q && !k_busy && !tin_q) begin
+                trk_set_q <= stt_mem[tsi_q];
+                tsp_q     <= 1'b0;
+            end
+            if (g_eof)        tin_q <= 1'b0;
+            else if (g_valid) tin_q <= 1'b1;
+            // blob_en of the frame the tracker works on (for its events' ev_last)
+            if ((g_valid || g_eof) && !tin_q) bk_q <= ben_v[g_frame[1:0]];
+        end
+    end
+    wire [15:0]            max_jump_f  = trk_set_q[TRK_W-1 -: 16];
+    wire [15:0]            hold_jump_f = trk_set_q[TRK_W-17 -: 16];
+    wire [HOLD_W-1:0]      hold_off_f  = trk_set_q[4+V_W-1 +: HOLD_W];
+    wire [3:0]             vel_shift_f = trk_set_q[V_W-1 +: 4];
+    wire [V_W-2:0]         max_speed_f = trk_set_q[V_W-2:0];
+
     fmt_tracker #(.MAX_TOUCHES(MAX_TOUCHES), .HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W),
                   .VF(VF), .V_W(V_W), .HOLD_W(HOLD_W)) u_tracker (
         .clk(clk), .rst(rst),
-        .max_jump_i(max_jump_i), .hold_jump_i(hold_jump_i), .hold_off_i(hold_off_i),
-        .vel_shift_i(vel_shift_i), .max_speed_i(max_speed_i),
+        .max_jump_i(max_jump_f), .hold_jump_i(hold_jump_f), .hold_off_i(hold_off_f),
+        .vel_shift_i(vel_shift_f), .max_speed_i(max_speed_f),
         .tp_valid_i(g_valid), .tp_frame_i(g_frame), .tp_x_i(g_x), .tp_y_i(g_y),
         .tp_strength_i(g_strength), .tp_axis_major_i(g_major), .tp_axis_minor_i(g_minor),
         .tp_angle_i(g_angle), .tp_flags_i(g_flags), .tp_eof_i(g_eof),
@@ -369,7 +503,7 @@ module fmt_touch #(
     reg                    wt_q, em_q;
 
     always @(posedge clk) begin
-        if (b_valid && blob_on && bc_q < MAX_BLOBS)
+        if (b_valid && bon_b && bc_q < MAX_BLOBS)
             br_mem[bc_q] <= {b_cx, b_cy, b_peak};
     end
 
@@ -382,15 +516,15 @@ module fmt_touch #(
             wt_q <= 1'b0;
             em_q <= 1'b0;
         end else begin
-            if (b_valid && blob_on && bc_q < MAX_BLOBS) bc_q <= bc_q + 1'b1;
+            if (b_valid && bon_b && bc_q < MAX_BLOBS) bc_q <= bc_q + 1'b1;
             if (b_eof) begin
                 bc_q <= {BCNT_W{1'b0}};
-                if (blob_on) begin
+                if (bon_b) begin
                     bn_q <= bc_q;
                     bf_q <= b_frame;
                 end
             end
-            if (blob_on && s1_eof_q) wt_q <= 1'b1;  // tracker busy from the next cycle
+            if (s1_eof_q) wt_q <= 1'b1;       // tracker busy from the next cycle
             if (wt_q && !k_busy) begin                // its last event is out now
                 wt_q <= 1'b0;
                 em_q <= (bn_q != {BCNT_W{1'b0}});
@@ -405,19 +539,19 @@ module fmt_touch #(
 
     wire [BRD_W-1:0] br_cur = br_mem[bi_q];
     // event port input: the tracker's events, then (blobs on) the frame's blob events
-    wire               p_valid    = (blob_on && em_q) ? 1'b1      : k_valid;
-    wire [FRAME_W-1:0] p_frame    = (blob_on && em_q) ? bf_q      : k_frame;
-    wire [ID_W-1:0]    p_id       = (blob_on && em_q) ? {ID_W{1'b1}} : k_id;
-    wire [1:0]         p_type     = (blob_on && em_q) ? 2'd3      : k_type;
-    wire [15:0]        p_x        = (blob_on && em_q) ? br_cur[BRD_W-1 -: 16] : k_x;
-    wire [15:0]        p_y        = (blob_on && em_q) ? br_cur[HM_W +: 16]    : k_y;
-    wire [HM_W-1:0]    p_strength = (blob_on && em_q) ? br_cur[HM_W-1:0]      : k_strength;
-    wire [15:0]        p_major    = (blob_on && em_q) ? 16'd0     : k_major;
-    wire [15:0]        p_minor    = (blob_on && em_q) ? 16'd0     : k_minor;
-    wire [7:0]         p_angle    = (blob_on && em_q) ? 8'd0      : k_angle;
-    wire [7:0]         p_flags    = (blob_on && em_q) ? 8'd0      : k_flags;
-    wire               p_last     = (blob_on && em_q) ? (bi_q + 1'b1 == bn_q)
-                                  : (k_last && !(blob_on && bn_q != {BCNT_W{1'b0}}));
+    wire               p_valid    = em_q ? 1'b1      : k_valid;
+    wire [FRAME_W-1:0] p_frame    = em_q ? bf_q      : k_frame;
+    wire [ID_W-1:0]    p_id       = em_q ? {ID_W{1'b1}} : k_id;
+    wire [1:0]         p_type     = em_q ? 2'd3      : k_type;
+    wire [15:0]        p_x        = em_q ? br_cur[BRD_W-1 -: 16] : k_x;
+    wire [15:0]        p_y        = em_q ? br_cur[HM_W +: 16]    : k_y;
+    wire [HM_W-1:0]    p_strength = em_q ? br_cur[HM_W-1:0]      : k_strength;
+    wire [15:0]        p_major    = em_q ? 16'd0     : k_major;
+    wire [15:0]        p_minor    = em_q ? 16'd0     : k_minor;
+    wire [7:0]         p_angle    = em_q ? 8'd0      : k_angle;
+    wire [7:0]         p_flags    = em_q ? 8'd0      : k_flags;
+    wire               p_last     = em_q ? (bi_q + 1'b1 == bn_q)
+                                  : (k_last && !(bk_q && bn_q != {BCNT_W{1'b0}}));
 
     // ---- event port -----------------------------------------------------------------
     fmt_event_port #(.HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W), .TIME_W(TIME_W),

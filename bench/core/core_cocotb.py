@@ -179,10 +179,21 @@ async def run_scene(dut):
     step = max(1000, total // 50)
     done = len(job["regs"])
     bar = Progress(total)
+    # register writes during the run: [cycle (counted like `done`), name, value]
+    mid = sorted(job.get("mid_regs", []), key=lambda w: w[0])
+    res_mid = []
     while done < total:
         n = min(step, total - done)
-        await ClockCycles(dut.clk, n)
-        done += n
+        if mid and mid[0][0] - done < n:
+            n = max(0, mid[0][0] - done)
+        if n:
+            await ClockCycles(dut.clk, n)
+            done += n
+        while mid and mid[0][0] <= done:
+            _, name, val = mid.pop(0)
+            await tb.bus_writes([(name, val)])
+            res_mid.append([int(dut.cycle_o.value), name, int(val)])   # the write's edge
+            done += 1
         if not quiet and total > 200000:
             fr = int(dut.frames_o.value)
             rate = fr / max(time.perf_counter() - t0, 1e-9)
@@ -191,6 +202,7 @@ async def run_scene(dut):
         bar.close()
     wall = time.perf_counter() - t0
     res = {"wall_s": wall, "frames": int(dut.frames_o.value), "events": int(dut.events_o.value),
+           "mid_regs": res_mid,
            "upd_late": int(dut.upd_late_o.value), "upd_done": int(dut.upd_done_o.value),
            "clip": int(dut.clip_o.value)}
     # stop the event consumer so that the counters hold still while they are read

@@ -91,7 +91,7 @@ module fmt_core_sim_top #(
     wire [7:0]               ev_id, ev_angle, ev_flags;
     wire [1:0]               ev_type;
     wire [HM_W-1:0]          ev_strength;
-    wire [7:0]               status;
+    wire [8:0]               status;
     wire [15:0]              frame_count;
 
     fmt_core #(

@@ -91,6 +91,7 @@ from fmt import pn_gen as _pn
 from fmt import rx_array as _rx
 from fmt import scene as _scene
 from fmt import sensor as _sensor
+from fmt import settings as _settings
 from fmt.settings import TouchSettings
 from fmt.tracker import TrackParams
 
@@ -297,7 +298,9 @@ def pn_chip_first(scene: _scene.Scene, cps: int) -> int:
 
 
 def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings, cal,
-                    cps: int = 3) -> Reference:
+                    cps: int = 3, m_frames=None) -> Reference:
+    """The model's heat maps and events of the run; ``m_frames``: M of each frame when
+    WINDOWS_M changes during the run (default: the scene's M throughout)."""
     from fmt import touch as _touch
     cfg = scene.cfg
     spf = scene.samples_per_frame
@@ -311,7 +314,8 @@ def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings
     adc = np.zeros_like(adc_ch)
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
-    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg, m=scene.m)
+    hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg,
+                                               m=scene.m if m_frames is None else m_frames)
     evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
                                 frame_period_s=scene.frame_period_s)
     return Reference(hm, evs, clipped)
@@ -475,6 +479,7 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
         "position_error_mm": acc["position_error_mm"],
         "jitter_mm": acc["jitter_mm"],
         "missed": acc["missed"], "false": acc["false"],
+        "tracking": acc["tracking"],
         "golden_mismatches": mism["heatmap_frames"] + mism["event_frames"],
         "golden_detail": mism,
         "sim_frames_per_s": n_rtl / max(wall_s, 1e-9),
@@ -501,6 +506,9 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
                     rep["gif"] = str(od / "heatmap.gif")
             except Exception as exc:          # plots are a convenience, never fatal
                 rep["plot_error"] = repr(exc)
+        _run_sim.write_events(od / "events.jsonl", frame_events)    # the compared frames
+        rep["events_file"] = str(od / "events.jsonl")
+        rep["events_in_file"] = int(sum(len(e) for e in frame_events))
         (od / "report.json").write_text(json.dumps(rep, indent=1) + "\n")
         rep["report"] = str(od / "report.json")
     return rep
@@ -692,7 +700,7 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
     from fmt import run_sim as _run_sim
     cfg = scene.cfg
     eff = check_scene(scene)
-    settings = settings or TouchSettings()
+    settings = settings or scene.touch_settings()
     d = job_dir(cfg, cps, tag)
     d.mkdir(parents=True, exist_ok=True)
     n = frames * scene.samples_per_frame
@@ -825,6 +833,8 @@ def main(argv=None) -> int:
     ap.add_argument("--engine", default="cpp", choices=("cpp", "cocotb"),
                     help="cpp: the standalone C++ Verilator harness (default, Verilator only); "
                          "cocotb: the cocotb test run_scene (Verilator or Icarus, ~40x slower)")
+    ap.add_argument("--settings", default=None,
+                    help="touch settings file (JSON, TouchSettings fields); default the scene's")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     ap.add_argument("--serve", type=int, default=None, metavar="PORT",
@@ -843,6 +853,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     try:
         sc = _scene.load(a.scene)
+        st = _settings.load(a.settings) if a.settings else sc.touch_settings()
     except InputError as exc:
         print(f"run_sim_rtl: {exc}", file=sys.stderr)
         return 2
@@ -861,7 +872,7 @@ def main(argv=None) -> int:
                  "log_clk": -1 if a.serve_log_frames < 0 else a.serve_log_frames * spf_clk}
     try:
         rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
-                  engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
+                  settings=st, engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

@@ -145,11 +145,12 @@ REGISTERS: list[Reg] = [
       f"default {HOST_REPORT_HZ} Hz)."),
     # ---- status -----------------------------------------------------------------------------
     R("FRAME_COUNT", 0x080, 32, "ro", 0, "Frames processed since reset."),
-    R("STATUS", 0x081, 8, "w1c", 0,
+    R("STATUS", 0x081, 9, "w1c", 0,
       "Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT "
       "overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 "
       "control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, "
-      "bit 7 blob overflow (more than 8 blobs in a frame)/overrun."),
+      "bit 7 blob overflow (more than 8 blobs in a frame)/overrun, bit 8 a calibration write "
+      "went into a frame's flattening (more writes during one frame than fmt_flatten's queue holds)."),
     R("CTRL_ERRORS", 0x082, 16, "ro", 0, "Control-port error count, saturating (every ERROR reply and junk burst)."),
     R("CTRL_LAST_ERR", 0x083, 8, "ro", 0, "Control-port code of the last error (docs/PROTOCOL.md)."),
     R("EV_DROP_COUNT", 0x084, 16, "ro", 0, "Event port: frames dropped for lack of room."),

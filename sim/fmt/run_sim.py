@@ -22,6 +22,11 @@ the errors, and a detection of such a contact there counts neither as false nor 
 ``missed`` (true contacts touching the whole frame without a detection) / ``false``
 (detections matching no contact); ``jitter_mm`` (RMS distance about the mean position
 of each stationary, always-touching contact; the worst one and per contact);
+``jitter_mm.largest_deviation`` (the largest distance from that mean); ``tracking``:
+``id_swaps`` / ``ids_lost`` (a contact touching without a break changes its ID to one
+that another contact had / to a new one; ``id_changes`` lists them with their frames),
+``ghosts`` (detections matching no contact, with their IDs and frames),
+``contacts_minus_truth`` (frames by detected minus true contacts);
 ``tap_latency_us`` (tap onset sample -> end of the first frame that reports the contact,
 i.e. the model's window-alignment latency, without the RTL's processing time);
 ``model_frames_per_s`` (the signal chain alone, wall clock; ``model_frames_per_cpu_s``
@@ -43,6 +48,7 @@ import numpy as np
 from . import chain as _chain
 from . import scene as _scene
 from .progress import Progress
+from . import settings as _settings
 from .settings import TouchSettings
 
 MATCH_MM = 10.0          # a detection farther than this from every true contact is false
@@ -130,9 +136,12 @@ def evaluate(scene: _scene.Scene, det: list) -> dict:
     frames = len(det)
     edges = np.arange(frames + 1, dtype=np.int64) * spf
     partial = [np.asarray([(0 < f < 1) for f in c.active_fraction(edges, fs)]) for c in scene.contacts]
+    act = [np.asarray(c.active_fraction(edges, fs)) for c in scene.contacts]
     err_in, err_edge, missed, false = [], [], 0, 0
     pos = {i: [] for i in range(len(scene.contacts))}
     truth_count = []
+    ids = {i: [] for i in range(len(scene.contacts))}   # (frame, ID) matched to contact i
+    ghosts, count_err = [], {}
     for f in range(frames):
         tc = (f + 0.5) * spf / fs
         truth = scene.truth(tc)
@@ -148,20 +157,40 @@ def evaluate(scene: _scene.Scene, det: list) -> dict:
         false += len(det[f]) - len(m)
         matched = {truth[i]["index"] for i, _, _ in m}
         missed += sum(1 for t in truth if not partial[t["index"]][f] and t["index"] not in matched)
+        mj = {j for _, j, _ in m}
+        ghosts += [(f, det[f][j][0]) for j in range(len(det[f])) if j not in mj]
+        # contacts per frame against the truth (contacts in onset / lift frames left out)
+        n_part = sum(1 for i, _, _ in m if partial[truth[i]["index"]][f])
+        k = (len(det[f]) - n_part) - sum(1 for t in truth if not partial[t["index"]][f])
+        count_err[k] = count_err.get(k, 0) + 1
         for i, j, dist in m:
             t = truth[i]
             if partial[t["index"]][f]:
                 continue
+            ids[t["index"]].append((f, det[f][j][0]))
             pos[t["index"]].append((det[f][j][1], det[f][j][2]))
             if t["edge_mm"] > EDGE_HI_MM:
                 err_in.append(dist)
             elif t["edge_mm"] >= EDGE_LO_MM:
                 err_edge.append(dist)
-    jit = {}
+    jit, dev = {}, {}
     for i, c in enumerate(scene.contacts):
         if c.stationary and c.active is None and len(pos[i]) > 1:
             p = np.asarray(pos[i])
-            jit[c.name or str(i)] = float(math.sqrt(np.mean(np.sum((p - p.mean(0)) ** 2, axis=1))))
+            r = np.sqrt(np.sum((p - p.mean(0)) ** 2, axis=1))
+            jit[c.name or str(i)] = float(math.sqrt(np.mean(r ** 2)))
+            dev[c.name or str(i)] = float(r.max())
+    # ID changes of a contact that touched without a break in between: a swap when the
+    # new ID was matched to another contact before, else a lost ID (a new one)
+    changes = []
+    for i, c in enumerate(scene.contacts):
+        seq = ids[i]
+        for (f0, a), (f1, b) in zip(seq, seq[1:]):
+            if a == b or not (act[i][f0:f1 + 1] > 0).all():
+                continue
+            other = any(fo < f1 and idv == b for k, s2 in ids.items() if k != i for fo, idv in s2)
+            changes.append({"frame": f1, "contact": c.name or str(i), "from": a, "to": b,
+                            "kind": "swap" if other else "new_id"})
     # tap latency: onset sample -> end of the first frame with a matched detection
     lat = []
     for i, c in enumerate(scene.contacts):
@@ -182,7 +211,16 @@ def evaluate(scene: _scene.Scene, det: list) -> dict:
             "n_edge": len(err_edge)},
         "missed": missed, "false": false,
         "truth_touches_mean": float(np.mean(truth_count)) if truth_count else 0.0,
-        "jitter_mm": {"max": max(jit.values()) if jit else None, "per_contact": jit},
+        "jitter_mm": {"max": max(jit.values()) if jit else None, "per_contact": jit,
+                      "largest_deviation": max(dev.values()) if dev else None,
+                      "largest_deviation_per_contact": dev},
+        "tracking": {
+            "id_swaps": sum(ch["kind"] == "swap" for ch in changes),
+            "ids_lost": sum(ch["kind"] == "new_id" for ch in changes),
+            "id_changes": changes[:50],
+            "ghosts": len(ghosts), "ghost_ids": sorted({g for _, g in ghosts}),
+            "ghost_frames": sorted({f for f, _ in ghosts})[:50],
+            "contacts_minus_truth": {str(k): v for k, v in sorted(count_err.items())}},
         "tap_latency_us": {"n": len(lat), "mean": float(np.mean(lat)) if lat else None,
                            "max": float(np.max(lat)) if lat else None,
                            "values": [round(v, 3) for v in lat]},
@@ -203,8 +241,9 @@ def tracks(frame_events, cfg) -> dict:
 def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None,
         processor=None, render: bool = False, plot: bool = True, quiet: bool = False,
         frames: int | None = None) -> dict:
-    """Run a scene; returns the report (and writes it under ``out_dir/<name>/``)."""
-    settings = settings or TouchSettings()
+    """Run a scene; returns the report (and writes it, with the events, under
+    ``out_dir/<name>/``).  ``settings``: default the scene's (``settings`` key)."""
+    settings = settings or scene.touch_settings()
     processor = processor or default_processor
     cfg = scene.cfg
     if frames is not None:
@@ -255,9 +294,31 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
             png = d / "heatmap.png"
             _plots.heatmap_with_tracks(flat, scene, tracks(evs, cfg), png)
             rep["png"] = str(png)
+        write_events(d / "events.jsonl", evs)
+        rep["events_file"] = str(d / "events.jsonl")
+        rep["events_in_file"] = int(sum(len(e) for e in evs))
         (d / "report.json").write_text(json.dumps(rep, indent=1) + "\n")
         rep["report"] = str(d / "report.json")
     return rep
+
+
+EVENT_FIELDS = ("frame", "id", "type", "x_q", "y_q", "strength", "axis_major_q",
+                "axis_minor_q", "angle", "flags")
+
+
+def write_events(path, frame_events) -> None:
+    """Every event, one JSON object per line, in frame order (``index`` = the frame's
+    position in the run; ``frame`` = its 16-bit number).  Written to a temporary name and
+    renamed: a failed run never leaves a half file."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    with tmp.open("w") as fh:
+        for k, evs in enumerate(frame_events):
+            for e in evs:
+                rec = {"index": k}
+                rec.update({f: (_ev(e, f) if f == "type" else int(_ev(e, f, 0))) for f in EVENT_FIELDS})
+                fh.write(json.dumps(rec) + "\n")
+    tmp.replace(path)
 
 
 def _summary(rep: dict) -> str:
@@ -287,15 +348,19 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", type=positive, default=None, help="override the scene's length")
     ap.add_argument("--render", action="store_true",
                     help="heat maps by render_heatmaps (no ADC synthesis)")
+    ap.add_argument("--settings", default=None,
+                    help="touch settings file (JSON, TouchSettings fields); default the scene's")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     try:
         sc = _scene.load(a.scene)
+        st = _settings.load(a.settings) if a.settings else sc.touch_settings()
     except InputError as e:
         print(f"run_sim: {e}", file=sys.stderr)
         return 2
-    rep = run(sc, a.out, render=a.render, plot=not a.no_plot, quiet=a.quiet, frames=a.frames)
+    rep = run(sc, a.out, settings=st, render=a.render, plot=not a.no_plot, quiet=a.quiet,
+              frames=a.frames)
     print(_summary(rep))
     print(f"report: {rep['report']}" + (f", plot: {rep['png']}" if "png" in rep else ""))
     return 0

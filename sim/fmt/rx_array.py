@@ -145,13 +145,26 @@ def _windows(m_log2, m):
 def accum_fixed(mags, m_log2: int = 0, hm_w: int = 16, hm_shift: int = HM_SHIFT, m=None):
     """mags (windows, ...) unsigned ints -> (cells (frames, ...), saturated flag).
 
-    M = m windows per frame (or 2^m_log2 when m is None).  Frames are consecutive groups
+    M = m windows per frame (or 2^m_log2 when m is None; a sequence: M of each frame in
+    turn, as when WINDOWS_M is written during a run).  Frames are consecutive groups
     of M windows from window 0; a trailing partial frame is dropped (the RTL never emits
     it).  cell = floor((sum + floor(D/2)) / D), D = M * 2^hm_shift (round half up; for
     M = 2^m bit-identical with (sum + 2^(s-1)) >> s, s = m + hm_shift), then min(cell,
     2^hm_w - 1) with the flag set when that clips.  fmt_rx_array computes the same
     quotient by recip_divide (proved and tested equal)."""
     mags = np.asarray(mags, dtype=np.int64)
+    if m is not None and not np.isscalar(m):
+        # one M per frame (WINDOWS_M changed during a run): frames of m[0], m[1], ...
+        # windows from window 0; frames beyond the windows given are dropped
+        cells, sat, w0 = [], False, 0
+        for mf in m:
+            mf = _windows(0, mf)
+            if w0 + mf > mags.shape[0]:
+                break
+            c, s_ = accum_fixed(mags[w0:w0 + mf], hm_w=hm_w, hm_shift=hm_shift, m=mf)
+            cells.append(c[0])
+            sat, w0 = sat or s_, w0 + mf
+        return np.array(cells, dtype=np.int64).reshape((len(cells),) + mags.shape[1:]), sat
     mm = _windows(m_log2, m)
     frames = mags.shape[0] // mm
     s = mags[:frames * mm].reshape((frames, mm) + mags.shape[1:]).sum(axis=1)

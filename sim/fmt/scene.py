@@ -46,6 +46,11 @@ Effects (every one costs nothing when absent)
   delay: matched).  ``tone_phases``: "zero" (the DDS: every row starts at phase 0, a
   sine) or "schroeder" (low crest factor).  Clipping at the ADC range is always modelled.
 
+Settings: ``settings``, an object of touch settings (the fields of
+fmt.settings.TouchSettings, e.g. ``{"threshold": 1500, "blobs": true}``; those left out
+keep their defaults), used by ``fmt.run_sim`` and ``bench.core.run_sim_rtl`` unless
+``--settings FILE`` is given.
+
 The DEFAULT PHYSICS: a finger is an 8 mm disk-profile contact of strength 1; the ADC
 noise is white Gaussian, set so that a finger centred on a cell gives 30 dB SNR (peak
 cell's noiseless heat-map value over the RMS noise of that cell) in one 6.144 us window
@@ -188,6 +193,7 @@ class Scene:
     seed: int = 1
     duration_s: float | None = None   # alternative to frames (rounded up to whole frames)
     description: str = ""
+    settings: dict = field(default_factory=dict)   # touch settings (fmt.settings.TouchSettings fields)
     cfg_override: SensorConfig | None = field(default=None, repr=False)  # not saved
 
     def with_cfg(self, cfg: SensorConfig | None) -> "Scene":
@@ -209,6 +215,13 @@ class Scene:
         unknown = set(self.effects) - EFFECT_KEYS
         if unknown:
             raise ValueError(f"scene '{self.name}': unknown effects {sorted(unknown)}")
+        self.settings = dict(self.settings or {})
+
+    def touch_settings(self):
+        """The scene's touch settings (``settings`` key; defaults for the fields it leaves
+        out), as fmt.settings.TouchSettings."""
+        from .settings import TouchSettings
+        return TouchSettings.from_dict(self.settings, f"scene '{self.name}': key 'settings'")
 
     # -- sizes and times ------------------------------------------------------------------
     @property
@@ -271,6 +284,8 @@ class Scene:
              "frames": self.frames, "m": self.m, "seed": self.seed,
              "effects": copy.deepcopy(self.effects),
              "contacts": [c.to_dict() for c in self.contacts]}
+        if self.settings:
+            d["settings"] = copy.deepcopy(self.settings)
         return d
 
     @classmethod
@@ -316,7 +331,11 @@ def check_dict(d, where: str = "scene") -> None:
         "name": I.is_str(), "description": I.is_str(), "sensor": I.is_str(tuple(_params.CONFIGS)),
         "frames": I.is_int(1, 10**8), "m": I.is_int(1, 255), "seed": I.is_int(0, 2**63 - 1),
         "duration_s": I.is_num(0, 3600, lo_open=True, none_ok=True),
-        "effects": I.is_type(dict, name="an object"), "contacts": I.is_type(list, name="a list")}, where)
+        "effects": I.is_type(dict, name="an object"), "contacts": I.is_type(list, name="a list"),
+        "settings": I.is_type(dict, name="an object")}, where)
+    if "settings" in d:
+        from .settings import TouchSettings
+        TouchSettings.from_dict(d["settings"], f"{where}: key 'settings'")
     unknown = set(d.get("effects", {})) - EFFECT_KEYS
     if unknown:
         raise I.InputError(f"{where}: key 'effects': unknown effects {sorted(unknown)} "

@@ -57,14 +57,29 @@ class TouchPipeline:
                  fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
                  track_params: TrackParams | None = None, blobs: bool | None = None):
         self.cfg = cfg
-        self.s = settings or TouchSettings()
         self.fixed = fixed
+        self.frame_period_s = frame_period_s
         self.offset, self.gain = flatten_cal if flatten_cal is not None else _flatten.identity(cfg)
-        self.tp = track_params or TrackParams.from_settings(cfg, self.s, frame_period_s)
+        self.tp = track_params or TrackParams.from_settings(cfg, settings or TouchSettings(),
+                                                            frame_period_s)
         self.tracker = Tracker(self.tp)
-        self.blobs = self.s.blobs if blobs is None else blobs
-        self.max_touches = self.s.max_touches if self.s.max_touches is not None else cfg.max_touches
-        self.moore = self.s.neighbourhood == "moore"
+        self._use(settings or TouchSettings(), blobs)
+
+    def _use(self, settings: TouchSettings, blobs: bool | None = None) -> None:
+        """Settings of the next frames (the stage settings and the tracker's)."""
+        self.s = settings
+        self.blobs = settings.blobs if blobs is None else blobs
+        self.max_touches = (settings.max_touches if settings.max_touches is not None
+                            else self.cfg.max_touches)
+        self.moore = settings.neighbourhood == "moore"
+
+    def set_frame_settings(self, settings: TouchSettings) -> None:
+        """Change every setting from the next frame on, as rtl/fmt_touch.v does for a
+        register write before the frame's first row: the stages and the tracker (its
+        parameters converted with this pipeline's frame period; contacts kept)."""
+        self._use(settings)
+        self.tp = TrackParams.from_settings(self.cfg, settings, self.frame_period_s)
+        self.tracker.p = self.tp
 
     def touches(self, hm_flat, frame: int) -> tuple[list, list]:
         """Fine touches (tracker input) and blobs of one flattened heat map."""
@@ -96,11 +111,18 @@ class TouchPipeline:
             return out
         return _flatten.flatten_float(heatmaps, self.offset, self.gain, self.cfg)
 
-    def run(self, heatmaps, first_frame: int = 0) -> list[list[TouchEvent]]:
+    def run(self, heatmaps, first_frame: int = 0,
+            frame_settings=None) -> list[list[TouchEvent]]:
+        """``frame_settings``: one TouchSettings per frame (or None: keep the current)."""
         flat = self.flatten(heatmaps)          # vectorised over the frames
+        if frame_settings is not None and len(frame_settings) != flat.shape[0]:
+            raise ValueError(f"frame_settings: {len(frame_settings)} entries for "
+                             f"{flat.shape[0]} frames")
         out = []
         for k in range(flat.shape[0]):
             fr = (first_frame + k) & 0xFFFF
+            if frame_settings is not None and frame_settings[k] is not None:
+                self.set_frame_settings(frame_settings[k])
             ts, blobs = self.touches(flat[k], fr)
             evs = self.tracker.step(fr, ts)
             for b in blobs:                    # one 'blob' event per reported blob
@@ -111,7 +133,8 @@ class TouchPipeline:
 
 def process_frames(heatmaps, cfg: SensorConfig, settings: TouchSettings | None = None,
                    fixed: bool = True, flatten_cal=None, frame_period_s: float | None = None,
-                   first_frame: int = 0, blobs: bool | None = None) -> list[list[TouchEvent]]:
+                   first_frame: int = 0, blobs: bool | None = None,
+                   frame_settings=None) -> list[list[TouchEvent]]:
     """Heat maps (frames, rows, cols) -> list (per frame) of TouchEvent lists.
 
     ``flatten_cal`` = (offset, gain) arrays (default: identity).  ``frame_period_s``
@@ -121,9 +144,15 @@ def process_frames(heatmaps, cfg: SensorConfig, settings: TouchSettings | None =
     give 'blob' events (type 3, id 0xFF, x/y = centroid Q8.8, strength = peak, other
     fields 0) after the tracker's events.  With ``fixed=True`` the events are
     bit-exact with ``rtl/fmt_touch.v`` (per frame, in the RTL's order; blob_en_i =
-    blobs, blob_threshold >= 1)."""
+    blobs, blob_threshold >= 1).
+
+    ``frame_settings``: settings that change during the run, one TouchSettings per frame
+    (each with its own ``blobs``; ``blobs`` must then be None): the RTL gives every frame
+    the settings present when its first heat-map row enters fmt_touch."""
     hm = np.asarray(heatmaps)
     if hm.ndim == 2:
         hm = hm[None]
+    if frame_settings is not None and blobs is not None:
+        raise ValueError("process_frames: blobs comes from frame_settings; pass blobs=None")
     p = TouchPipeline(cfg, settings, fixed, flatten_cal, frame_period_s, blobs=blobs)
-    return p.run(hm, first_frame)
+    return p.run(hm, first_frame, frame_settings)

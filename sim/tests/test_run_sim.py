@@ -96,3 +96,61 @@ def test_cli(tmp_path, capsys):
                          "--no-plot", "--quiet"]) == 0
     assert "position error" in capsys.readouterr().out
     assert (tmp_path / "small" / "report.json").exists()
+
+
+def test_evaluate_tracking_metrics():
+    """ID swaps, lost IDs, ghosts and the per-frame count error, on hand-made detections
+    (two stationary contacts 20 mm apart on the small sensor, a third one lifting and
+    landing again: its new ID after the break is not an ID change)."""
+    sc = S.Scene(sensor="small", frames=6, m=1, contacts=[
+        {"name": "a", "path": [[0, 3.0, 5.0]]},
+        {"name": "b", "path": [[0, 23.0, 5.0]]}])
+    a, b = (3.0, 5.0), (23.0, 5.0)
+    det = [[(1, *a), (2, *b)],
+           [(1, *a), (2, *b)],
+           [(2, *a), (1, *b)],                   # swap (both contacts)
+           [(2, *a), (7, *b)],                   # b gets a new ID
+           [(2, *a), (7, *b), (9, 13.0, 14.0)],  # a ghost
+           [(2, *a)]]                            # b missed
+    ev = run_sim.evaluate(sc, det)
+    tr = ev["tracking"]
+    assert (tr["id_swaps"], tr["ids_lost"]) == (2, 1), tr["id_changes"]
+    assert [(c["frame"], c["contact"], c["kind"]) for c in tr["id_changes"]] == [
+        (2, "a", "swap"), (2, "b", "swap"), (3, "b", "new_id")]
+    assert (tr["ghosts"], tr["ghost_ids"], tr["ghost_frames"]) == (1, [9], [4])
+    assert tr["contacts_minus_truth"] == {"-1": 1, "0": 4, "1": 1}
+    assert ev["jitter_mm"]["largest_deviation"] == pytest.approx(0.0)
+
+
+def test_scene_settings_and_settings_file(tmp_path, capsys):
+    """A scene's own settings are used; --settings FILE overrides them; both paths write
+    every event to events.jsonl; a bad settings key is one line and exit 2."""
+    pytest.importorskip("fmt.touch")
+    sc = S.load(S.SCENES_DIR / "small.json").replace(settings={"threshold": 60000})
+    assert sc.touch_settings().threshold == 60000
+    p = tmp_path / "s.json"
+    sc.save(p)
+    assert S.load(p).settings == {"threshold": 60000}
+    rep = run_sim.run(S.load(p), tmp_path, plot=False, quiet=True)
+    assert rep["events"] == 0                           # nothing above 60000
+    stf = tmp_path / "st.json"
+    stf.write_text(json.dumps({"threshold": 1500}))
+    assert run_sim.main(["--scene", str(p), "--settings", str(stf), "--out", str(tmp_path / "o"),
+                         "--no-plot", "--quiet"]) == 0
+    lines = (tmp_path / "o" / sc.name / "events.jsonl").read_text().splitlines()
+    evs = [json.loads(x) for x in lines]
+    rep2 = json.loads((tmp_path / "o" / sc.name / "report.json").read_text())
+    assert len(evs) == rep2["events"] > 0
+    assert {"index", "frame", "id", "type", "x_q", "y_q", "strength"} <= set(evs[0])
+    assert [e["index"] for e in evs] == sorted(e["index"] for e in evs)
+    stf.write_text(json.dumps({"threshhold": 1500}))
+    capsys.readouterr()
+    assert run_sim.main(["--scene", str(p), "--settings", str(stf), "--out", str(tmp_path / "o"),
+                         "--no-plot", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "threshhold" in err[0]
+    bad = json.loads(p.read_text())
+    bad["settings"] = {"neighbourhood": "hex"}
+    p.write_text(json.dumps(bad))
+    with pytest.raises(Exception, match="neighbourhood"):
+        S.load(p)

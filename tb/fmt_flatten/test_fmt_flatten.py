@@ -66,15 +66,22 @@ class TB(ClockedTB):
         d.cal_we_i.value = 0
         self.offset, self.gain = np.array(offset), np.array(gain)
 
-    async def run(self, schedule, tail: int = LATENCY + 3):
+    async def run(self, schedule, tail: int = LATENCY + 3, writes=None):
         """Drive ``schedule`` (per cycle: None, ('row', r, frame, values) or ('eof', frame))
-        and return the outputs per cycle: list of (valid, row, frame, data, sat, eof)."""
+        and return the outputs per cycle: list of (valid, row, frame, data, sat, eof).
+        ``writes``: {cycle index: (sel, row, col, value)} calibration writes driven in
+        those cycles of the schedule."""
         d = self.dut
         out = []
-        for item in list(schedule) + [None] * tail:
+        for t, item in enumerate(list(schedule) + [None] * tail):
             await self.writable()
             d.hm_valid_i.value = 0
             d.hm_eof_i.value = 0
+            if writes is not None:
+                w = writes.get(t)
+                d.cal_we_i.value = int(w is not None)
+                if w is not None:
+                    d.cal_sel_i.value, d.cal_row_i.value, d.cal_col_i.value, d.cal_data_i.value = w
             if item is not None and item[0] == "row":
                 _, r, f, vals = item
                 d.hm_valid_i.value = 1
@@ -177,6 +184,98 @@ async def random_calibration_bit_exact(dut):
     dut.sat_clr_i.value = 0
     await ReadOnly()
     assert int(dut.sat_flag_o.value) == 0 and int(dut.sat_count_o.value) == 0
+
+
+CAL_Q = 8                      # the builds' calibration queue depth (parameter CAL_Q)
+
+
+def frame_rows(sched, out):
+    """{frame: {row: (input values, output cells)}} of a run."""
+    fr = {}
+    for t, item in enumerate(sched):
+        if item is not None and item[0] == "row":
+            fr.setdefault(item[2], {})[item[1]] = (np.array(item[3]), out[t + LATENCY - 1][3])
+    return fr
+
+
+def tables_after(off, gain, writes):
+    """The calibration after each prefix of ``writes`` (k = 0 .. len)."""
+    o, g = np.array(off), np.array(gain)
+    tabs = [(o.copy(), g.copy())]
+    for sel, r, c, v in writes:
+        (g if sel else o)[r, c] = v
+        tabs.append((o.copy(), g.copy()))
+    return tabs
+
+
+def explaining(tb, rows, tabs):
+    """The prefixes k whose table gives every row of the frame."""
+    ks = []
+    for k, (o, g) in enumerate(tabs):
+        if all(tb.unpack(data) == flatten_fixed(vals, o[r], g[r], tb.cfg)[0].tolist()
+               for r, (vals, data) in rows.items()):
+            ks.append(k)
+    return ks
+
+
+@cocotb.test()
+async def calibration_frame_boundaries(dut):
+    """Calibration writes at random cycles, in the middle of frames too: every frame is
+    flattened with ONE calibration, the table after the first k writes with k never
+    decreasing from frame to frame; after an idle gap every write has landed; cal_late_o
+    stays 0.  Then CAL_Q + 3 writes inside one frame: cal_late_o is set, no write is lost."""
+    tb = TB(dut)
+    await tb.reset()
+    rng = random.Random(env_int("SEED", 1) + 7)
+    nrng = np.random.default_rng(env_int("SEED", 1) + 7)
+    top = (1 << tb.w) - 1
+    shape = (tb.rows, tb.cols)
+    off0 = nrng.integers(0, top // 8, size=shape)
+    gain0 = nrng.integers(GAIN_ONE // 2, 3 * GAIN_ONE // 2, size=shape)
+    await tb.load(off0, gain0)
+
+    def new_write():
+        sel, r, c = rng.randrange(2), rng.randrange(tb.rows), rng.randrange(tb.cols)
+        v = rng.randrange(GAIN_ONE // 2, 3 * GAIN_ONE // 2) if sel else rng.randrange(top // 8)
+        return (sel, r, c, v)
+
+    hms = [nrng.integers(top // 4, top // 2, size=shape) for _ in range(10)]
+    # two writes per frame on average, three idle cycles between frames: the queue
+    # (drained one word per cycle from the hm_eof cycle on) never fills here
+    sched = []
+    for f in range(len(hms) - 1):
+        sched += tb.frames_schedule(rng, hms[f:f + 1], first_frame=f, gap_p=0.25) + [None] * 3
+    cyc = sorted(rng.sample(range(len(sched)), k=2 * (len(hms) - 1)))
+    sched += [None] * (len(cyc) + 2)                    # idle: the queue drains
+    sched += tb.frames_schedule(rng, hms[-1:], first_frame=len(hms) - 1, gap_p=0.0)
+    wl = [new_write() for _ in cyc]
+    out = await tb.run(sched, writes=dict(zip(cyc, wl)))
+    tabs = tables_after(off0, gain0, wl)
+    fr = frame_rows(sched, out)
+    k_prev, mid = 0, 0
+    for f in sorted(fr):
+        ks = [k for k in explaining(tb, fr[f], tabs) if k >= k_prev]
+        assert ks, f"frame {f}: no single calibration (after >= {k_prev} writes) gives its rows"
+        k_prev = ks[0]
+        first = min(t for t, it in enumerate(sched) if it and it[0] == "row" and it[2] == f)
+        last = max(t for t, it in enumerate(sched) if it and it[0] == "eof" and it[1] == f)
+        mid += sum(first < t <= last for t in cyc)
+    assert len(wl) in explaining(tb, fr[len(hms) - 1], tabs), "a write did not land"
+    assert mid >= len(hms) // 2, f"only {mid} writes inside frames"
+    assert int(dut.cal_late_o.value) == 0            # (run() ends in the read-only phase)
+
+    # more than CAL_Q writes inside one frame: the oldest go in at once, flagged, none lost
+    await tb.writable()
+    wl2 = [new_write() for _ in range(CAL_Q + 3)]
+    hm = nrng.integers(top // 4, top // 2, size=shape)
+    sched2 = [("row", 0, 20, hm[0])] + [None] * (CAL_Q + 3)
+    sched2 += [("row", r, 20, hm[r]) for r in range(1, tb.rows)] + [("eof", 20)]
+    sched2 += [None] * (CAL_Q + 4)
+    sched2 += [("row", r, 21, hm[r]) for r in range(tb.rows)] + [("eof", 21)]
+    out2 = await tb.run(sched2, writes={1 + i: w for i, w in enumerate(wl2)})
+    assert int(dut.cal_late_o.value) == 1
+    tabs2 = tables_after(*tabs[-1], wl2)
+    assert len(wl2) in explaining(tb, frame_rows(sched2, out2)[21], tabs2), "a write was lost"
 
 
 def round_half_up_ref(z: int, off: int, g: int, w: int) -> tuple[int, bool]:
@@ -334,7 +433,7 @@ def sensor_params(cfg) -> dict:
 def test_fmt_flatten(sim, cfg, cal_bram):
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
-               parameters={**sensor_params(cfg), "CAL_BRAM": cal_bram},
+               parameters={**sensor_params(cfg), "CAL_BRAM": cal_bram, "CAL_Q": CAL_Q},
                extra_env={"FMT_CFG": cfg.name, "SEED": 1})
 
 
@@ -346,5 +445,5 @@ def test_fmt_flatten_default(sim):
     cfg = params.DEFAULT
     run_cocotb(sim=sim, toplevel="fmt_flatten", sources=sources("fmt_flatten"),
                test_module="test_fmt_flatten", test_dir=Path(__file__).parent,
-               parameters=sensor_params(cfg),
+               parameters={**sensor_params(cfg), "CAL_Q": CAL_Q},
                extra_env={"FMT_CFG": cfg.name, "SEED": 2})

@@ -8,7 +8,8 @@ model's.  With PAY_RST_IDX = 1 the test inserts with ins_pay_i = drop_pay_o (the
 slot, as fmt_blob does) and checks that the payloads and drop_pay_o stay a permutation
 of 0..K.  Parametrized over K (1, 3, 8), PAY_W = 0 (no payload: outputs 0) and
 HAS_POP = 0 (pop_i is driven and must be ignored), and EARLY = 1 (nxt_key_i / nxt_tie_i
-carry the next cycle's insert key a cycle ahead; an insert always takes them).
+carry the next cycle's insert key a cycle ahead; an insert always takes them), with
+nxt_key_i in NXT_CP copies (1, 2 and 4).
 """
 from __future__ import annotations
 
@@ -128,15 +129,19 @@ async def random_ops(dut):
     n_key = min(1 << tb.kw, 6)                         # few keys: many equal ones
     n_tie = min(1 << tb.tw, 4)
     early = env_int("EARLY", 0)
+    cp = env_int("NXT_CP", 1)
+
+    def nxt(k):                                        # nxt_key_i: cp copies of the key
+        return sum(k << (c * tb.kw) for c in range(cp))
     pend = (rng.randrange(n_key), rng.randrange(n_tie))     # the next insert's key and tie
-    dut.nxt_key_i.value, dut.nxt_tie_i.value = pend
+    dut.nxt_key_i.value, dut.nxt_tie_i.value = nxt(pend[0]), pend[1]
     for _ in range(3000):
         await FallingEdge(tb.clk)
         tb.check()
         d = dut
         d.ins_i.value = d.pop_i.value = d.clear_i.value = 0
         cur, pend = pend, (rng.randrange(n_key), rng.randrange(n_tie))
-        d.nxt_key_i.value, d.nxt_tie_i.value = pend
+        d.nxt_key_i.value, d.nxt_tie_i.value = nxt(pend[0]), pend[1]
         r = rng.random()
         if r < 0.005:
             counts["rst"] += 1
@@ -171,14 +176,17 @@ async def random_ops(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop,early",
-                         [(1, 4, 1, 1, 0), (3, 4, 0, 1, 0), (8, 4, 1, 1, 0), (5, 0, 0, 1, 0),
-                          (4, 3, 1, 0, 0), (1, 4, 1, 1, 1), (8, 4, 1, 1, 1), (5, 3, 0, 1, 1)],
+@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop,early,cp",
+                         [(1, 4, 1, 1, 0, 1), (3, 4, 0, 1, 0, 1), (8, 4, 1, 1, 0, 1),
+                          (5, 0, 0, 1, 0, 1), (4, 3, 1, 0, 0, 1), (1, 4, 1, 1, 1, 1),
+                          (8, 4, 1, 1, 1, 1), (5, 3, 0, 1, 1, 1), (8, 4, 1, 1, 1, 4),
+                          (5, 3, 0, 1, 1, 2)],
                          ids=["k1_idx", "k3", "k8_idx", "k5_nopay", "k4_idx_nopop",
-                              "k1_idx_early", "k8_idx_early", "k5_early"])
-def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early):
+                              "k1_idx_early", "k8_idx_early", "k5_early", "k8_idx_early_cp4",
+                              "k5_early_cp2"])
+def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early, cp):
     p = {"K": k, "KEY_W": 4, "TIE_W": 3, "PAY_W": pay_w, "PAY_RST_IDX": pay_rst_idx,
-         "HAS_POP": has_pop, "EARLY": early}
+         "HAS_POP": has_pop, "EARLY": early, "NXT_CP": cp}
     run_cocotb(sim=sim, toplevel="fmt_sorted_list", sources=sources("fmt_sorted_list"),
                test_module="test_fmt_sorted_list", test_dir=Path(__file__).parent,
                parameters=p, extra_env={**p, "SEED": 1})

@@ -204,6 +204,83 @@ async def blobs(dut):
                   f"{max(l for _, l in lat2)}")
 
 
+def random_settings(cfg, rng) -> TouchSettings:
+    """Settings drawn over their useful ranges (every field that fmt_touch takes)."""
+    return TouchSettings(
+        threshold=int(rng.integers(1500, 4000)),
+        neighbourhood=str(rng.choice(["moore", "vn"])),
+        max_touches=int(rng.integers(1, cfg.max_touches + 1)) if rng.random() < 0.5 else None,
+        bias_correction=bool(rng.random() < 0.5),
+        max_jump_mm=float(rng.uniform(2.0, 30.0)),
+        hold_off_us=float(rng.choice([1000.0, 2000.0, 5000.0])),
+        velocity_window_us=float(rng.choice([1000.0, 4000.0, 16000.0])),
+        max_speed_mm_s=float(rng.uniform(200.0, 5000.0)),
+        blobs=bool(rng.random() < 0.5),
+        blob_threshold=int(rng.integers(1500, 5000)),
+        blob_min_cells=int(rng.integers(1, 16)))
+
+
+@cocotb.test()
+async def settings_midframe(dut):
+    """Issue #15 item 5: every setting (blob_en_i included) rewritten at random cycles,
+    in the middle of frames as well as between them.  Each frame must be processed
+    with the settings present when its first row entered (process_frames with one
+    settings entry per frame): every event bit-exact, no overrun, no frame lost."""
+    tb = TB(dut)
+    cfg = tb.cfg
+    top = (1 << cfg.hm_width) - 1
+    rng = np.random.default_rng(env_int("SEED", 1) + 20)
+    n = 40
+    # palms (blob sizes around min-cells) and random maps (cells on both sides of every
+    # threshold, Moore and Von Neumann maxima differ), in each half
+    q = n // 4
+    maps = np.concatenate([palm_maps(cfg, q, top, rng), random_maps(cfg, rng, q, top),
+                           random_maps(cfg, rng, q, top), palm_maps(cfg, q, top, rng)])
+    cur = {"st": random_settings(cfg, rng)}
+    per_frame = [None] * n
+
+    def apply(st):
+        cur["st"] = st
+        tb.settings(st)
+        tb.dut.blob_en_i.value = int(st.blobs)
+
+    def hook(k, i):
+        # about three changes per frame, anywhere (rows, the eof cycle, the idle cycles)
+        if rng.random() < 3.0 / (3 * cfg.n_fft):
+            apply(random_settings(cfg, rng))
+        if i == 0:
+            per_frame[k] = cur["st"]        # driven with the frame's first row
+
+    apply(cur["st"])
+    await tb.reset()
+    await tb.calibrate(*flatten.identity(cfg))
+    tb.events.clear()
+    # the first half in bursts, the second with the rows spread over the frame period
+    # (the next frame arrives while the previous one is finished, as in the core)
+    await tb.send(maps[:n // 2], random.Random(21), 3 * cfg.n_fft, hook=hook)
+    await tb.send(maps[n // 2:], random.Random(22), 3 * cfg.n_fft, spread=True,
+                  hook=hook, first_frame=n // 2)
+    for _ in range(300):
+        await RisingEdge(tb.clk)
+    exp = process_frames(maps, cfg, per_frame[0], fixed=True, frame_period_s=FRAME_PERIOD_S,
+                         frame_settings=per_frame)
+    got = {fr[0][1][0]: fr for fr in group(tb.events)}
+    changed = sum(a != b for a, b in zip(per_frame, per_frame[1:]))
+    assert changed >= n // 3, f"only {changed} frames with new settings"
+    assert sum(bool(e) for e in exp) >= n // 2, "the scenes give events"
+    for k, evs in enumerate(exp):
+        e = [(x.frame, x.id, x.type_code, x.x_q, x.y_q, x.strength, x.axis_major_q,
+              x.axis_minor_q, x.angle, x.flags) for x in evs]
+        g = [x[1] for x in got.get(k, [])]
+        assert g == e, f"frame {k} ({per_frame[k]}):\nRTL   {g}\nmodel {e}"
+    assert len(got) == sum(1 for x in exp if x)
+    d = tb.dut
+    assert int(d.lm_overrun_o.value) == 0 and int(d.trk_overrun_o.value) == 0
+    assert int(d.ev_overflow_o.value) == 0 and int(d.blob_flag_o.value) == 0
+    dut._log.info(f"settings changed before {changed} of {n} frames; "
+                  f"{sum(len(e) for e in exp)} events bit-exact")
+
+
 # ---- pytest entry ------------------------------------------------------------------
 # medium by default (the Verilator build of the whole chain takes ~1 min per size);
 # FMT_TOUCH_ALL=1 adds the small sensor.
@@ -215,8 +292,22 @@ def test_fmt_touch(sim, cfg_name):
     _run_touch(sim, cfg_name)
 
 
+# cocotb tests of this module; settings_midframe runs under Verilator only in make
+# test-long (FMT_LONG=1): Icarus covers it in make test (for make test's time)
+COCOTB_TESTS = ["random_heatmaps", "scene_heatmaps", "many_fingers", "blobs", "settings_midframe"]
+
+
+def test_cocotb_test_list():
+    """COCOTB_TESTS names every cocotb test of this module (a new one is never left out)."""
+    names = [n for n, v in globals().items() if type(v).__module__.startswith("cocotb._decorators")]
+    assert sorted(names) == sorted(COCOTB_TESTS), names
+
+
 def _run_touch(sim, cfg_name):
     p = params.get(cfg_name).verilog_params()
+    tests = COCOTB_TESTS
+    if sim == "verilator" and os.environ.get("FMT_LONG", "0") in ("", "0"):
+        tests = [t for t in COCOTB_TESTS if t != "settings_midframe"]
     run_cocotb(
         sim=sim,
         toplevel="fmt_touch",
@@ -225,7 +316,7 @@ def _run_touch(sim, cfg_name):
         test_dir=Path(__file__).parent,
         parameters={**{k: p[k] for k in ("ROWS", "COLS", "HM_W", "MAX_TOUCHES")}, "EV_DEPTH": 256},
         extra_env={"CFG": cfg_name, "SEED": 1},
-        build_args=build_args(sim), tag=cfg_name,
+        build_args=build_args(sim), tag=cfg_name, testcase=tests,
     )
 
 

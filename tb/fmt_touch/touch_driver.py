@@ -94,17 +94,27 @@ class TB(ClockedTB):
                     await self.writable()
         d.cal_we_i.value = 0
 
-    async def send(self, frames, rng, period):
+    async def send(self, frames, rng, period, hook=None, spread=False, first_frame=0):
         """Heat maps one row per cycle in random order, hm_eof on the next cycle, one
-        frame every `period` cycles.  Records the edge that takes each last row."""
+        frame every `period` cycles, numbered from ``first_frame``.  Records the edge that
+        takes each last row.
+        ``hook(k, i)``, if given, runs before every cycle is driven (frame k; i = the
+        beat's index in the frame: rows 0..rows-1, then rows for hm_eof and rows + 1 for
+        the idle cycles): it may change the settings in any cycle.  ``spread``: the
+        rows spread over the period as the receive array sends them (idle cycles after
+        each row, the next frame's first row soon after hm_eof), so that a frame is
+        still being finished while the next one arrives."""
         d, cfg = self.dut, self.cfg
         w = cfg.hm_width
+        gap = max(0, (period - cfg.rows - 1) // max(1, cfg.rows - 1)) if spread else 0
         await self.writable()
-        for k, hm in enumerate(frames):
+        for k, hm in enumerate(frames, start=first_frame):
             order = list(range(cfg.rows))
             rng.shuffle(order)
             t0 = self.cycle
-            for r in order:
+            for i, r in enumerate(order):
+                if hook is not None:
+                    hook(k, i)
                 word = 0
                 for c in range(cfg.cols):
                     word |= int(hm[r, c]) << (c * w)
@@ -114,7 +124,16 @@ class TB(ClockedTB):
                 d.hm_data_i.value = word
                 await RisingEdge(self.clk)
                 await self.writable()
+                if gap and r != order[-1]:
+                    d.hm_valid_i.value = 0
+                    for _ in range(gap):
+                        if hook is not None:
+                            hook(k, cfg.rows + 1)
+                        await RisingEdge(self.clk)
+                        await self.writable()
             self.row_cycles[k] = self.cycle          # the edge that took the last row
+            if hook is not None:
+                hook(k, cfg.rows)
             d.hm_valid_i.value = 0
             d.hm_eof_i.value = 1
             d.hm_frame_i.value = k
@@ -122,6 +141,8 @@ class TB(ClockedTB):
             await self.writable()
             d.hm_eof_i.value = 0
             while self.cycle < t0 + period:
+                if hook is not None:
+                    hook(k, cfg.rows + 1)
                 await RisingEdge(self.clk)
                 await self.writable()
 
