@@ -1190,7 +1190,7 @@ module fmt_blob #(
                       .HAS_POP(0)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cl_blob), .ins_key_i(cl_area), .ins_tie_i(cl_key), .ins_pay_i(spare_q),
-        .nxt_key_i({AREA_W{1'b0}}), .nxt_tie_i({IDX_W{1'b0}}),
+        .nxt_key_i({AREA_W{1'b0}}), .nxt_tie_i({IDX_W{1'b0}}), .ins_ahead_i(1'b0),
         .pop_i(1'b0), .valid_o(l_v), .key_o(l_area), .tie_o(l_key), .pay_o(l_slots),
         .drop_pay_o(spare_q));
     reg [AREA_W-1:0] found_q;

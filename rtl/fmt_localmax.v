@@ -371,6 +371,8 @@ module fmt_localmax #(
 
     // ---- serialiser: the maxima of the window's row, lowest column first ---------------------
     reg [COLS-1:0]      rem_q;                 // w1_q's partial mask, less the maxima taken
+    reg [COLS-1:0]      remt_q;                // rem_q's copy for adv's two-or-more tree (keep
+                                               // below): the tree's inputs have no other load
     (* fsm_encoding = "none" *)
     reg [ROW_IDX_W-1:0] mrow_q;                // row of w1_q
     // the maxima of w1_q not yet taken: its partial mask (rem_q, loaded when the window
@@ -381,10 +383,11 @@ module fmt_localmax #(
     wire [COLS-1:0] rem_low = rem_e & ~rem_m1;   // its lowest maximum, one-hot
     wire [COLS-1:0] rem_nx  = rem_e & rem_m1;    // the others
     // rem_q holds two bits or more (a balanced tree of 4-bit groups: any, two or more;
-    // rem_q's own bits only, not rem_e: no mask gates and no carry chain before adv)
+    // rem_q's own bits only (its copy remt_q), not rem_e: no mask gates and no carry chain
+    // before adv)
     localparam NT1 = (COLS + 3) / 4;           // 4-bit groups
     localparam NT2 = (NT1 + 3) / 4;            // groups of 4 groups
-    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, rem_q};
+    wire [4*NT1-1:0] two_r = {{(4*NT1 - COLS){1'b0}}, remt_q};
     wire [4*NT2-1:0] t1_a, t1_t;               // level 1: any, two or more (padded)
     wire [4*NT2-1:0] t2_a, t2_t;               // level 2
     genvar gt;
@@ -411,6 +414,11 @@ module fmt_localmax #(
             end
         end
     endgenerate
+    // remt_q: loaded as rem_q (keep: not merged with it by synthesis)
+    (* keep *) always @(posedge clk)
+        if (rst)                remt_q <= {COLS{1'b0}};
+        else if (!advs_q)       remt_q <= rem_nx;
+        else if (v2_q && f2_q)  remt_q <= part_c;
     // level 3: pairs of the NT2 groups
     reg rem_two;
     /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
@@ -662,6 +670,11 @@ module fmt_localmax #(
     reg              cap_v_q;                  // one maximum captured
     reg [Z9_W-1:0]   cap_z_q;                  // its 3x3
     reg [IDX_W-1:0]  cap_idx_q;                // its raster index {row, col}
+    // cap_z_q's centre and cap_idx_q rank ahead of the next cycle's (pc_q, pidx_q): the
+    // list's comparison of an insert with the insert after it, made a cycle early from
+    // (pc_q, pidx_q) and their next values (pc_d, p1idx_q), so the one result that goes
+    // to all K entries leaves a flip-flop (fmt_sorted_list AHEAD_IN)
+    reg              cap_ahd_q;
 
     // ---- the sorted list of (z, raster index), payload = slot of the 3x3 store --------------
     wire releasing;
@@ -678,10 +691,10 @@ module fmt_localmax #(
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
     // (= each copy of pc_q) and pidx_q in every cycle
     fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
-                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC)) u_list (
+                      .HAS_POP(1), .EARLY(1), .NXT_CP(NLC), .AHEAD_IN(1)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
         .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
-        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q),
+        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q), .ins_ahead_i(cap_ahd_q),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -782,6 +795,7 @@ module fmt_localmax #(
         pidx_q    <= p1idx_q;
         cap_z_q   <= z9;
         cap_idx_q <= pidx_q;
+        cap_ahd_q <= ({pc_q[0 +: HM_W], ~pidx_q} > {pc_d, ~p1idx_q});
         cand_z_o       <= z9_rd_q;
         cand_missing_o <= miss9;
         cand_row_o     <= em_row_q;

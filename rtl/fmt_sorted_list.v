@@ -41,6 +41,11 @@
 // NXT_CP (EARLY = 1): nxt_key_i in NXT_CP equal copies (the user's registers): entry i
 // compares with copy i * NXT_CP / K, the inserted entry with copy 0, so no one register
 // drives all K comparators (simulation reports copies that differ).
+// AHEAD_IN (EARLY = 1): 1 takes the inserted entry's own comparison from ins_ahead_i
+// instead of the comparator: {ins_key_i, ~ins_tie_i} > {nxt_key_i, ~nxt_tie_i}, which the
+// user registers a cycle early (from the keys of the insert after next), so the one
+// result that goes to every entry's enable select leaves a flip-flop, not a carry chain
+// (simulation reports an insert whose ins_ahead_i differs from the comparison).
 //
 // Cost: K comparators of KEY_W + TIE_W bits, a 3:1 (2:1 with HAS_POP = 0) select per
 // entry bit; no arithmetic beyond the comparators.  Against the lists the two blocks
@@ -57,7 +62,9 @@ module fmt_sorted_list #(
     parameter PAY_RST_IDX = 0,   // 1: rst sets payload i = i and drop_pay_o = K; 0: no reset
     parameter HAS_POP     = 1,   // 1: pop_i works; 0: pop_i is ignored (no pop circuit)
     parameter EARLY       = 0,   // 1: compare with nxt_key_i / nxt_tie_i a cycle early
-    parameter NXT_CP      = 1    // EARLY = 1: copies of nxt_key_i (>= 1, <= K)
+    parameter NXT_CP      = 1,   // EARLY = 1: copies of nxt_key_i (>= 1, <= K)
+    parameter AHEAD_IN    = 0    // EARLY = 1: 1 = the inserted entry's comparison is
+                                 // ins_ahead_i (registered by the user); 0 = compared here
 ) (
     input  wire               clk,
     input  wire               rst,         // synchronous, active high
@@ -69,6 +76,7 @@ module fmt_sorted_list #(
     input  wire [NXT_CP*KEY_W-1:0] nxt_key_i,   // EARLY = 1: ins_key_i of the next cycle
                                            // (copy c at [c*KEY_W +: KEY_W])
     input  wire [TIE_W-1:0]   nxt_tie_i,   // EARLY = 1: ins_tie_i of the next cycle
+    input  wire               ins_ahead_i, // AHEAD_IN = 1: the insert ranks ahead of the next
     /* verilator lint_on UNUSEDSIGNAL */
     input  wire [((PAY_W > 0) ? PAY_W : 1)-1:0]   ins_pay_i,   // its payload
     input  wire               pop_i,       // remove entry 0, the rest moves up (HAS_POP = 1)
@@ -100,6 +108,11 @@ module fmt_sorted_list #(
             $display("fmt_sorted_list: EARLY %0d must be 0 or 1", EARLY);
             $finish;
         end
+        if (AHEAD_IN != 0 && (AHEAD_IN != 1 || EARLY != 1)) begin
+            $display("fmt_sorted_list: AHEAD_IN %0d must be 0, or 1 with EARLY = 1 (EARLY %0d)",
+                     AHEAD_IN, EARLY);
+            $finish;
+        end
         if (NXT_CP < 1 || NXT_CP > K) begin
             $display("fmt_sorted_list: NXT_CP %0d must be 1 .. K (%0d)", NXT_CP, K);
             $finish;
@@ -123,7 +136,8 @@ module fmt_sorted_list #(
             // ahead_q[i]: entry i (as it is now) ranks ahead of this cycle's insert
             reg [K-1:0] ahead_q;
             reg [K-1:0] ahead_c;               // entry i now ahead of the next insert
-            wire        ahead_ins = ({ins_key_i, ~ins_tie_i} > {nxt_key_i[0 +: KEY_W], ~nxt_tie_i});
+            wire        ahead_cmp = ({ins_key_i, ~ins_tie_i} > {nxt_key_i[0 +: KEY_W], ~nxt_tie_i});
+            wire        ahead_ins = (AHEAD_IN == 1) ? ins_ahead_i : ahead_cmp;
             always @(*) begin : c_better
                 integer i;
                 for (i = 0; i < K; i = i + 1) begin
@@ -156,6 +170,9 @@ module fmt_sorted_list #(
                 if (!rst && ins_i && (nk_q !== {NXT_CP{ins_key_i}} || nt_q !== ins_tie_i))
                     $display("%m: ERROR: insert differs from the previous nxt_key_i / nxt_tie_i at %0t",
                              $time);
+                if (!rst && ins_i && AHEAD_IN == 1 && ins_ahead_i !== ahead_cmp)
+                    $display("%m: ERROR: ins_ahead_i %b differs from the comparison at %0t",
+                             ins_ahead_i, $time);
             end
             // synthesis translate_on
         end else begin : g_now

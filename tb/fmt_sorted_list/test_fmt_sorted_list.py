@@ -9,7 +9,8 @@ slot, as fmt_blob does) and checks that the payloads and drop_pay_o stay a permu
 of 0..K.  Parametrized over K (1, 3, 8), PAY_W = 0 (no payload: outputs 0) and
 HAS_POP = 0 (pop_i is driven and must be ignored), and EARLY = 1 (nxt_key_i / nxt_tie_i
 carry the next cycle's insert key a cycle ahead; an insert always takes them), with
-nxt_key_i in NXT_CP copies (1, 2 and 4).
+nxt_key_i in NXT_CP copies (1, 2 and 4), and AHEAD_IN = 1 (ins_ahead_i carries the insert's
+comparison with the next insert, as the testbench computes it from the two keys).
 """
 from __future__ import annotations
 
@@ -133,8 +134,10 @@ async def random_ops(dut):
 
     def nxt(k):                                        # nxt_key_i: cp copies of the key
         return sum(k << (c * tb.kw) for c in range(cp))
+    ahead_in = env_int("AHEAD_IN", 0)
     pend = (rng.randrange(n_key), rng.randrange(n_tie))     # the next insert's key and tie
     dut.nxt_key_i.value, dut.nxt_tie_i.value = nxt(pend[0]), pend[1]
+    dut.ins_ahead_i.value = 0
     for _ in range(3000):
         await FallingEdge(tb.clk)
         tb.check()
@@ -142,6 +145,10 @@ async def random_ops(dut):
         d.ins_i.value = d.pop_i.value = d.clear_i.value = 0
         cur, pend = pend, (rng.randrange(n_key), rng.randrange(n_tie))
         d.nxt_key_i.value, d.nxt_tie_i.value = nxt(pend[0]), pend[1]
+        # the insert (cur) ranks ahead of the next one (pend): key above, or equal key and
+        # lower tie; only read with AHEAD_IN = 1 (otherwise driven with noise)
+        ahead = cur[0] > pend[0] or (cur[0] == pend[0] and cur[1] < pend[1])
+        d.ins_ahead_i.value = int(ahead) if ahead_in else rng.randrange(2)
         r = rng.random()
         if r < 0.005:
             counts["rst"] += 1
@@ -176,17 +183,17 @@ async def random_ops(dut):
 
 
 # ---- pytest entry ------------------------------------------------------------------
-@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop,early,cp",
-                         [(1, 4, 1, 1, 0, 1), (3, 4, 0, 1, 0, 1), (8, 4, 1, 1, 0, 1),
-                          (5, 0, 0, 1, 0, 1), (4, 3, 1, 0, 0, 1), (1, 4, 1, 1, 1, 1),
-                          (8, 4, 1, 1, 1, 1), (5, 3, 0, 1, 1, 1), (8, 4, 1, 1, 1, 4),
-                          (5, 3, 0, 1, 1, 2)],
+@pytest.mark.parametrize("k,pay_w,pay_rst_idx,has_pop,early,cp,ahead",
+                         [(1, 4, 1, 1, 0, 1, 0), (3, 4, 0, 1, 0, 1, 0), (8, 4, 1, 1, 0, 1, 0),
+                          (5, 0, 0, 1, 0, 1, 0), (4, 3, 1, 0, 0, 1, 0), (1, 4, 1, 1, 1, 1, 0),
+                          (8, 4, 1, 1, 1, 1, 0), (5, 3, 0, 1, 1, 1, 0), (8, 4, 1, 1, 1, 4, 0),
+                          (5, 3, 0, 1, 1, 2, 0), (8, 4, 1, 1, 1, 4, 1), (1, 4, 1, 1, 1, 1, 1)],
                          ids=["k1_idx", "k3", "k8_idx", "k5_nopay", "k4_idx_nopop",
                               "k1_idx_early", "k8_idx_early", "k5_early", "k8_idx_early_cp4",
-                              "k5_early_cp2"])
-def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early, cp):
+                              "k5_early_cp2", "k8_idx_early_cp4_ahead", "k1_idx_early_ahead"])
+def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early, cp, ahead):
     p = {"K": k, "KEY_W": 4, "TIE_W": 3, "PAY_W": pay_w, "PAY_RST_IDX": pay_rst_idx,
-         "HAS_POP": has_pop, "EARLY": early, "NXT_CP": cp}
+         "HAS_POP": has_pop, "EARLY": early, "NXT_CP": cp, "AHEAD_IN": ahead}
     run_cocotb(sim=sim, toplevel="fmt_sorted_list", sources=sources("fmt_sorted_list"),
                test_module="test_fmt_sorted_list", test_dir=Path(__file__).parent,
                parameters=p, extra_env={**p, "SEED": 1})
