@@ -1070,14 +1070,10 @@ module fmt_blob #(
     end
     // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
     // MERGE, else the close engine's label)
-    // (pk_hold and the encoder's output p_enk kept: the merge flag enters at the last
-    // select; without p_enk synthesis shared pk_fill & p_low, pend_q's update, with the
-    // encoder and put the flag before its OR tree: xc5v 9 levels b_merge -> rb_q)
+    // (pk_hold kept: the merge flag enters at the last select, not through pk_fill)
     (* keep *) wire  pk_hold;
     assign           pk_hold = rst || (b_merge && pk_v_q);      // = rst || !pk_fill
-    (* keep *) wire [LBL_W-1:0] p_enk;
-    assign           p_enk = p_enc;
-    wire [LBL_W-1:0] pk_nx  = pk_hold ? pk_q : p_enk;
+    wire [LBL_W-1:0] pk_nx  = pk_hold ? pk_q : p_enc;
     wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
     wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
     wire [LBL_W-1:0] rb_nx  = do_merge ? l2_y_q : pk_nx;
