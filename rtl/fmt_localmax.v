@@ -524,9 +524,9 @@ module fmt_localmax #(
     reg                 iv_q;                  // a maximum to capture
     // The capture selects a cell of each group in two registered steps: one cell in each
     // quarter of the group (NQ quarters of NL cells), by its number within the quarter
-    // decoded from the low_q bits of the quarter's columns (a select local to the
-    // quarter's columns), then the quarter, by the high HI_W bits of the cell number
-    // decoded from low_q.  (Before:
+    // decoded from the bits of the quarter's columns (a select local to the quarter's
+    // columns, registered from rem_low), then the quarter, by the high HI_W bits of the
+    // cell number decoded from low_q.  (Before:
     // the select bits encoded from the lowest bit and registered in copies per quarter,
     // the encoder's fan-out to the copies critical at 84.1 MHz.)
     localparam LO_W = (QI_W > 2) ? 2 : 1;
@@ -586,26 +586,45 @@ module fmt_localmax #(
     generate
         for (gq = 0; gq < NQ; gq = gq + 1) begin : g_quarter
             // cell j of group g is in the window of the columns 3j + g - 2 .. 3j + g: its
-            // number within the quarter, from the low_q bits of the quarter's columns (0
-            // when the maximum is in another quarter: step 2 does not pick this one)
-            reg [LO_W-1:0] l0, l1, l2;         // group 0, 1, 2 cell, low bits
+            // number within the quarter, from the bits of the quarter's columns (0 when
+            // the maximum is in another quarter: step 2 does not pick this one), decoded
+            // a cycle early from rem_low (low_q's next value: equal to the decode of
+            // low_q) into registers, one copy per row of the 3x3 (keep), so neither
+            // low_q's fan-out nor a decoder is in front of the 3 x 48 cell selects
+            reg [LO_W-1:0] l0_d, l1_d, l2_d;   // group 0, 1, 2 cell, low bits (next)
             reg [Z9_W-1:0] s_q;
             /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
             always @(*) begin : c_sel
                 integer i, j0, j1, j2;
-                l0 = {LO_W{1'b0}};  l1 = {LO_W{1'b0}};  l2 = {LO_W{1'b0}};
+                l0_d = {LO_W{1'b0}};  l1_d = {LO_W{1'b0}};  l2_d = {LO_W{1'b0}};
                 for (i = 0; i < COLS; i = i + 1) begin
                     j0 = (i + 2) / 3;  j1 = (i + 1) / 3;  j2 = i / 3;
-                    if (j0 / NL == gq) l0 = l0 | ({LO_W{low_q[i]}} & j0[LO_W-1:0]);
-                    if (j1 / NL == gq) l1 = l1 | ({LO_W{low_q[i]}} & j1[LO_W-1:0]);
-                    if (j2 / NL == gq) l2 = l2 | ({LO_W{low_q[i]}} & j2[LO_W-1:0]);
+                    if (j0 / NL == gq) l0_d = l0_d | ({LO_W{rem_low[i]}} & j0[LO_W-1:0]);
+                    if (j1 / NL == gq) l1_d = l1_d | ({LO_W{rem_low[i]}} & j1[LO_W-1:0]);
+                    if (j2 / NL == gq) l2_d = l2_d | ({LO_W{rem_low[i]}} & j2[LO_W-1:0]);
                 end
             end
             /* verilator lint_on UNUSEDSIGNAL */
+            wire [3*LO_W-1:0] l0, l1, l2;     // copy r: row r (a, b, c) of the 3x3
+            genvar gr;
+            for (gr = 0; gr < 3; gr = gr + 1) begin : g_lcp
+                reg [LO_W-1:0] l0_q, l1_q, l2_q;
+                (* keep *) always @(posedge clk) begin
+                    l0_q <= l0_d;
+                    l1_q <= l1_d;
+                    l2_q <= l2_d;
+                end
+                assign l0[gr*LO_W +: LO_W] = l0_q;
+                assign l1[gr*LO_W +: LO_W] = l1_q;
+                assign l2[gr*LO_W +: LO_W] = l2_q;
+            end
             always @(posedge clk)
-                s_q <= {gc2[gq*NL + l2], gc1[gq*NL + l1], gc0[gq*NL + l0],
-                        gb2[gq*NL + l2], gb1[gq*NL + l1], gb0[gq*NL + l0],
-                        ga2[gq*NL + l2], ga1[gq*NL + l1], ga0[gq*NL + l0]};
+                s_q <= {gc2[gq*NL + l2[2*LO_W +: LO_W]], gc1[gq*NL + l1[2*LO_W +: LO_W]],
+                        gc0[gq*NL + l0[2*LO_W +: LO_W]],
+                        gb2[gq*NL + l2[LO_W +: LO_W]], gb1[gq*NL + l1[LO_W +: LO_W]],
+                        gb0[gq*NL + l0[LO_W +: LO_W]],
+                        ga2[gq*NL + l2[0 +: LO_W]], ga1[gq*NL + l1[0 +: LO_W]],
+                        ga0[gq*NL + l0[0 +: LO_W]]};
             assign s1_q[gq*Z9_W +: Z9_W] = s_q;
         end
     endgenerate
