@@ -660,11 +660,36 @@ module fmt_localmax #(
     localparam NLC = (K >= 4) ? 4 : 1;
     reg  [NLC*HM_W-1:0] pc_q;
     reg  [HM_W-1:0]     pc_d;
+    // pc_d from row b of the quarters' cells with copies of the quarter and rotation
+    // selects of its own (keep): p1h*_q drive the 144 bits of s2, so a select through
+    // them put their fan-out in front of the centre, pc_q and cap_ahd_q's compare
+    (* fsm_encoding = "none" *)
+    reg [HI_W-1:0]  p1h0c_q, p1h1c_q, p1h2c_q; // copies of p1h0_q, p1h1_q, p1h2_q
+    (* fsm_encoding = "none" *)
+    reg [1:0]       p1mc_q;                    // copy of p1m_q
+    (* keep *) always @(posedge clk) begin
+        p1h0c_q <= lo_g0[QI_W-1:LO_W];
+        p1h1c_q <= lo_g1[QI_W-1:LO_W];
+        p1h2c_q <= lo_q[QI_W-1:LO_W];
+        p1mc_q  <= lo_m;
+    end
+    reg [3*HM_W-1:0] s2b;                      // s2's row b (groups 0, 1, 2)
+    /* verilator lint_off UNUSEDSIGNAL */     // integer temporaries: their low bits are used
+    always @(*) begin : c_s2b
+        integer h;
+        s2b = {(3*HM_W){1'b0}};
+        for (h = 0; h < NQ; h = h + 1) begin
+            if (p1h0c_q == h[HI_W-1:0]) s2b[0*HM_W +: HM_W] = s1_q[h*Z9_W + 3*HM_W +: HM_W];
+            if (p1h1c_q == h[HI_W-1:0]) s2b[1*HM_W +: HM_W] = s1_q[h*Z9_W + 4*HM_W +: HM_W];
+            if (p1h2c_q == h[HI_W-1:0]) s2b[2*HM_W +: HM_W] = s1_q[h*Z9_W + 5*HM_W +: HM_W];
+        end
+    end
+    /* verilator lint_on UNUSEDSIGNAL */
     always @(*) begin
-        case (p1m_q)                           // z9's centre (row b, rotated)
-            2'd1:    pc_d = s2[5*HM_W +: HM_W];
-            2'd2:    pc_d = s2[3*HM_W +: HM_W];
-            default: pc_d = s2[4*HM_W +: HM_W];
+        case (p1mc_q)                          // z9's centre (row b, rotated)
+            2'd1:    pc_d = s2b[2*HM_W +: HM_W];
+            2'd2:    pc_d = s2b[0*HM_W +: HM_W];
+            default: pc_d = s2b[1*HM_W +: HM_W];
         endcase
     end
     genvar gpc;
