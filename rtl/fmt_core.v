@@ -117,7 +117,7 @@ module fmt_core #(
     input  wire [31:0]              bus_wdata_i,    // write data
     output wire [31:0]              bus_rdata_o,    // read data, 1 cycle after bus_re_i
     // monitor
-    output wire [8:0]               status_o,       // STATUS register (sticky flags)
+    output wire [10:0]              status_o,       // STATUS register (sticky flags)
     output wire [15:0]              frame_count_o   // heat-map frames since reset (wraps)
 );
     localparam CPS    = CLK_PER_SAMPLE;
@@ -159,7 +159,7 @@ module fmt_core #(
     wire [9:0]  r_chip_len;
     wire [5:0]  r_rx_delay;
     wire [7:0]  r_windows_m;
-    wire [8:0]  r_status;
+    wire [10:0] r_status;
     wire [4:0]  r_tone_sel, r_limit, r_cal_row;
     wire [5:0]  r_cal_col;
     wire        tone_tw_we, tone_amp_we, tone_tw_re, tone_amp_re;
@@ -250,7 +250,7 @@ module fmt_core #(
             assign m_lim = r_windows_m;          // every 8-bit value is a valid M
         end
     endgenerate
-    wire                  hm_valid, hm_eof, rx_fft_ovf, rx_sat, rx_ovf;
+    wire                  hm_valid, hm_eof, rx_fft_ovf, rx_sat, rx_overrun;
     wire [ROW_W-1:0]      hm_row;
     wire [15:0]           hm_frame;
     wire [COLS*HM_W-1:0]  hm_data;
@@ -262,7 +262,7 @@ module fmt_core #(
     ) u_rx (
         .clk(clk), .rst(rst), .ce(ce), .adc_i(adc_i), .rx_sign_i(rx_sign), .m_i(m_sel),
         .hm_valid_o(hm_valid), .hm_row_o(hm_row), .hm_frame_o(hm_frame), .hm_data_o(hm_data),
-        .hm_eof_o(hm_eof), .fft_ovf_o(rx_fft_ovf), .sat_o(rx_sat), .ovf_o(rx_ovf));
+        .hm_eof_o(hm_eof), .fft_ovf_o(rx_fft_ovf), .sat_o(rx_sat), .overrun_o(rx_overrun));
 
     // frame end of the receive side: the ce edge taking a frame's last ADC sample
     reg [LOG2_N-1:0] samp_q;
@@ -453,8 +453,9 @@ module fmt_core #(
         else if (hm_eof) frames_q <= frames_q + 1'b1;
     end
     assign frame_count_o = frame_count_q;
-    wire [8:0] status_set = {cal_late, blob_flag, trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
-                             err_pulse, lat_sat, ev_ovf, rx_ovf, flat_sat};
+    wire [10:0] status_set = {rx_overrun, rx_sat, cal_late, blob_flag,
+                              trk_drop | trk_noslot | trk_overrun, lm_ovf | lm_overrun,
+                              err_pulse, lat_sat, ev_ovf, rx_fft_ovf, flat_sat};
     assign status_o = r_status;
 
     // ---------------------------------------------------------------- control port
@@ -526,7 +527,7 @@ module fmt_core #(
     // settings the core does not use (documented in the header)
     wire unused_ok = &{1'b0, r_scratch, tone_tw_re, tone_amp_re,
                        cal_off_re, cal_gain_re, r_threshold, r_cal_row, r_cal_col, r_limit,
-                       tone_tw_wdata, tone_amp_wdata, stream_en, now, rx_fft_ovf, rx_sat,
+                       tone_tw_wdata, tone_amp_wdata, stream_en, now,
                        r_tone_sel, blk_addr, r_max_speed};
 endmodule
 

@@ -7,7 +7,10 @@
 //   for i = 0 .. ITER-1:                            (one pipeline stage each)
 //     y >= 0: x += y >>> i, y -= x >>> i
 //     y <  0: x -= y >>> i, y += x >>> i           (>>> = arithmetic shift, floor)
-//   mag = (x * GAIN_C + 2^(GAIN_BITS+GUARD-1)) >> (GAIN_BITS+GUARD)   (round half up)
+//   FRAC = 0: mag = (x * GAIN_C + 2^(GAIN_BITS+GUARD-1)) >> (GAIN_BITS+GUARD)
+//             (round half up to an integer)
+//   FRAC > 0: mag = (x * GAIN_C) >> (GAIN_BITS+GUARD-FRAC)   (|z| with FRAC fractional
+//             bits, truncated: the user rounds once, e.g. fmt_rx_array's cell)
 //   GAIN_C = round(2^GAIN_BITS / K), K = prod_i sqrt(1 + 2^-2i) (= 636751 for 20 bits,
 //   relative gain error 1.9e-7).  Since 1/K > 1/2 the product is formed as
 //   (x << (GAIN_BITS-1)) + x * (GAIN_C - 2^(GAIN_BITS-1)): a 17-bit constant multiply.
@@ -16,10 +19,11 @@
 // 2^(GAIN_BITS-1); one 18-bit slice per product, so that each is one 18 x 18
 // multiplier on ECP5 / one DSP48E with its product registered), beside them
 // (x << (GAIN_BITS-1)) + rounding constant; P = the sum of the three, of which the
-// output keeps bits [SH +: IN_W].  No multiplier output goes through LUTs before a
-// register.
-// Formats: re, im signed IN_W (integers); mag unsigned OUT_W = IN_W (the largest
-// magnitude, sqrt(2) * 2^(IN_W-1), is below 2^IN_W: no overflow is possible).
+// output keeps bits [SH - FRAC +: IN_W + FRAC].  No multiplier output goes through LUTs
+// before a register.
+// Formats: re, im signed IN_W (integers); mag unsigned IN_W + FRAC bits, FRAC of them
+// fractional (the largest magnitude, sqrt(2) * 2^(IN_W-1), is below 2^IN_W: no overflow
+// is possible).
 // Error (measured in sim/tests/test_rx_array.py over random full-scale inputs):
 // |mag - exact| <= 1.1 LSB + 2e-7 |z|, mean bias below 0.15 LSB (ITER = 12, GUARD = 3).
 // Internal width IW = IN_W + GUARD + 2 holds K * sqrt(2) * 2^(IN_W-1+GUARD) < 2^(IW-1).
@@ -34,6 +38,8 @@ module fmt_magnitude #(
     parameter GUARD     = 3,    // extra fractional bits inside the CORDIC
     parameter GAIN_BITS = 20,   // fractional bits of the gain-compensation constant
     parameter GAIN_C    = 636751, // round(2^GAIN_BITS / K(ITER)), > 2^(GAIN_BITS-1); the model checks it
+    parameter FRAC      = 0,    // fractional bits of the output: 0 = rounded half up to an
+                                // integer; > 0 = truncated (0 .. GAIN_BITS + GUARD - 1)
     parameter TAG_W     = 8     // width of the side-band tag carried with each sample
 ) (
     input  wire                  clk,
@@ -44,7 +50,7 @@ module fmt_magnitude #(
     input  wire signed [IN_W-1:0] in_im_i,  // imaginary part
     input  wire [TAG_W-1:0]      in_tag_i,  // side band (row index, flags), delayed with the data
     output reg                   out_valid_o, // magnitude valid (ITER + 3 ce cycles later)
-    output reg  [IN_W-1:0]       out_mag_o, // unsigned magnitude, same LSB as the input
+    output reg  [IN_W+FRAC-1:0]  out_mag_o, // unsigned magnitude, LSB = 2^-FRAC input LSB
     output reg  [TAG_W-1:0]      out_tag_o  // the sample's tag
 );
 
@@ -76,7 +82,15 @@ module fmt_magnitude #(
     // GAIN_C lies in [2^(GAIN_BITS-1), 2^GAIN_BITS): g is GAIN_C without its top bit
     localparam [GAIN_BITS-1:0] GC = GAIN_C;
     wire [GLW-1:0] gain_lo = GC[GLW-1:0];
-    wire [PW-1:0]  round_w = {{(PW-1){1'b0}}, 1'b1} << (SH - 1);
+    // FRAC = 0: the half of the integer LSB; FRAC > 0: none (truncation)
+    wire [PW-1:0]  round_w = (FRAC == 0) ? ({{(PW-1){1'b0}}, 1'b1} << (SH - 1)) : {PW{1'b0}};
+
+    generate
+        if (FRAC < 0 || FRAC >= SH) begin : g_check_frac
+            // FRAC outside 0 .. GAIN_BITS + GUARD - 1: stop elaboration
+            fmt_magnitude_FRAC_out_of_range u_bad_frac ();
+        end
+    endgenerate
 
     always @(posedge clk) begin
         if (rst) begin
@@ -140,8 +154,8 @@ module fmt_magnitude #(
         end
     endgenerate
 
-    // gain stage P; the low SH bits are the rounded-away fraction and the top bits
-    // are zero by range
+    // gain stage P; the low SH - FRAC bits are the rounded-away (FRAC > 0: truncated)
+    // fraction and the top bits are zero by range
     /* verilator lint_off UNUSEDSIGNAL */
     wire [PW-1:0] sum_w = {{(PW-ALW-GLW){1'b0}}, pl_q} + ph_sh + c_q;
     wire          unused_sign = x_q[NS-1][IW-1];
@@ -159,7 +173,7 @@ module fmt_magnitude #(
 
     always @(posedge clk) begin
         if (ce) begin
-            out_mag_o <= sum_w[SH +: IN_W];
+            out_mag_o <= sum_w[SH - FRAC +: IN_W + FRAC];
             out_tag_o <= mt_q;
         end
     end

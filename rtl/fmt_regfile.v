@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0x8F2F.
+// Register map id 0xA9D2.
 `default_nettype none
 
 module fmt_regfile (
@@ -55,8 +55,8 @@ module fmt_regfile (
     output reg  [31:0] latency_dial_o,              // LATENCY_DIAL (rw): Dial-a-latency: extra event delay in processing cycles (delay_i)
     output reg  [31:0] report_period_o,             // REPORT_PERIOD (rw): Minimum processing cycles between reported frames (report_period_i; 0 = every frame; default 250 Hz)
     input  wire [31:0] frame_count_i,               // FRAME_COUNT (ro): Frames processed since reset
-    input  wire [8:0] status_set_i,                 // STATUS: bits to set
-    output reg  [8:0] status_o,                     // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, bit 7 blob overflow (more than 8 blobs in a frame)/overrun, bit 8 a calibration write went into a frame's flattening (more writes during one frame than fmt_flatten's queue holds)
+    input  wire [10:0] status_set_i,                // STATUS: bits to set
+    output reg  [10:0] status_o,                    // STATUS (w1c): Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver FFT overflow (an FFT stage saturated), bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, bit 7 blob overflow (more than 8 blobs in a frame)/overrun, bit 8 a calibration write went into a frame's flattening (more writes during one frame than fmt_flatten's queue holds), bit 9 receiver heat-map cell saturated (clipped at 2^HM_W - 1), bit 10 receiver overrun (a row lost: the shared units' queue full, a row rewritten before it was read, or ce too fast)
     input  wire [15:0] ctrl_errors_i,               // CTRL_ERRORS (ro): Control-port error count, saturating (every ERROR reply and junk burst)
     input  wire [7:0] ctrl_last_err_i,              // CTRL_LAST_ERR (ro): Control-port code of the last error (docs/PROTOCOL
     input  wire [15:0] ev_drop_count_i,             // EV_DROP_COUNT (ro): Event port: frames dropped for lack of room
@@ -213,7 +213,7 @@ module fmt_regfile (
             cal_col_o <= 6'h00;
             latency_dial_o <= 32'h00000000;
             report_period_o <= 32'h0007A120;
-            status_o <= 9'h000;
+            status_o <= 11'h000;
         end else begin
             if (wr_scratch) scratch_o <= reg_wdata_i[31:0];
             if (wr_run) run_o <= reg_wdata_i[0:0];
@@ -236,7 +236,7 @@ module fmt_regfile (
             if (wr_cal_col) cal_col_o <= reg_wdata_i[5:0];
             if (wr_latency_dial) latency_dial_o <= reg_wdata_i[31:0];
             if (wr_report_period) report_period_o <= reg_wdata_i[31:0];
-            status_o <= (status_o & ~(wr_status ? reg_wdata_i[8:0] : 9'h000)) | status_set_i;
+            status_o <= (status_o & ~(wr_status ? reg_wdata_i[10:0] : 11'h000)) | status_set_i;
         end
     end
 
@@ -274,7 +274,7 @@ module fmt_regfile (
                 A_LATENCY_DIAL: reg_rdata_o <= latency_dial_o;
                 A_REPORT_PERIOD: reg_rdata_o <= report_period_o;
                 A_FRAME_COUNT: reg_rdata_o <= frame_count_i;
-                A_STATUS: reg_rdata_o <= {23'h0, status_o};
+                A_STATUS: reg_rdata_o <= {21'h0, status_o};
                 A_CTRL_ERRORS: reg_rdata_o <= {16'h0, ctrl_errors_i};
                 A_CTRL_LAST_ERR: reg_rdata_o <= {24'h0, ctrl_last_err_i};
                 A_EV_DROP_COUNT: reg_rdata_o <= {16'h0, ev_drop_count_i};

@@ -15,17 +15,19 @@
 //   engine  takes a row from the FIFO and reads the pairs' result memories at that row
 //           (one address for all pairs), feeding unit u with cell c = g*MAG_UNITS + u in
 //           step g = 0 .. P-1, P = ceil(COLS / MAG_UNITS): a row takes P steps
-//   accum   one memory of 2^(ROW_W+G_W) x MAG_UNITS*SUM_W bits, address {row, g}
+//   accum   the magnitudes keep MAG_FRAC fractional bits (fmt_magnitude FRAC, truncated:
+//           the cell below is the chain's one rounding, no bias from rounding twice);
+//           one memory of 2^(ROW_W+G_W) x MAG_UNITS*SUM_W bits, address {row, g}
 //           (synchronous read: block RAM), exact sum over the M windows (SUM_W = MW +
-//           MC_W bits: M_MAX windows cannot overflow), then the rounded mean
-//             cell = floor((sum + M) / 2M)          (round half up of sum / 2M; the 2 is
-//                                                    the pair split's factor, HM_SHIFT = 1)
-//           by an exact reciprocal multiply: t = sum + M < 2^T (T = SUM_W + 1),
+//           MAG_FRAC + MC_W bits: M_MAX windows cannot overflow), then the rounded mean
+//             cell = floor((sum + M F) / 2MF), F = 2^MAG_FRAC  (round half up of sum / 2MF;
+//                                  the 2 is the pair split's factor, HM_SHIFT = 1)
+//           by an exact reciprocal multiply: t = sum + M F < 2^T (T = SUM_W + 1),
 //           l = ceil(log2 M), R = ceil(2^(T+l) / M) (T + 1 bits), cell = (t R) >>
-//           (T + l + 1) = floor(floor(t / M) / 2) for every t < 2^T (Granlund-Montgomery:
+//           (T + l + 1 + MAG_FRAC) = floor(floor(t / M) / 2F) for every t < 2^T (Granlund-Montgomery:
 //           R M - 2^(T+l) < M <= 2^l; rx_fixed.recip / recip_divide, tested exhaustively
 //           at small T and by the bound for every M at the build's T); for M = 2^m exactly
-//           (sum + 2^m) >> (m + 1), the arithmetic of fmt_accum.  R comes from
+//           (sum + 2^(m+MAG_FRAC)) >> (m + 1 + MAG_FRAC).  R comes from
 //           fmt_recip.hex (rx_fixed.recip_rom: ceil(2^(40+l) / M) for M = 0..255)
 //           as ceil(entry / 2^(40-T)) (one add per row).  Then saturate to HM_W bits
 //   stream  group g's cells go into the row register at [g*MAG_UNITS*HM_W]; after the
@@ -41,7 +43,7 @@
 // fmt_rx_array_MAG_UNITS_too_few) when ROWS * P > N * C (a window's rows cannot be
 // processed in a window); at run time (ce faster than CLK_PER_SAMPLE says) a row arriving
 // with the queue full or while its previous window's copy is still queued or being fed
-// sets the sticky overrun bit, reported in ovf_o.  Twin: rx_fixed.rx_share_schedule.
+// sets the sticky overrun bit, reported in overrun_o.  Twin: rx_fixed.rx_share_schedule.
 // Stream: hm_valid_o one clk per row, hm_row_o its index, hm_frame_o the frame number (wraps,
 // FRAME_W bits, from 0 after reset), hm_data_o column c at [c*HM_W +: HM_W] (valid with
 // hm_valid_o), hm_eof_o one step after the frame's last row, never with a row.  Frame =
@@ -68,10 +70,10 @@
 // pairs' result memories) has its output register, every product its operand and
 // product registers (the 2T+1-bit t R as four 17 x 17-bit partial products, then one
 // adder per step).
-// Flags (sticky until reset): fft_ovf_o = OR of the FFTs' saturation flags, sat_o = a
-// heat-map cell saturated, ovf_o = either or an overrun: queue full, a row rewritten
-// before it was read, or (FFT_CH > 1) ce faster than one per FFT_CH clk (the magnitude
-// cannot overflow).
+// Flags (sticky until reset, each on its own so a host can tell them apart): fft_ovf_o =
+// OR of the FFTs' saturation flags, sat_o = a heat-map cell saturated, overrun_o = a row
+// lost to timing: queue full, a row rewritten before it was read, or (FFT_CH > 1) ce
+// faster than one per FFT_CH clk (the magnitude cannot overflow).
 // Twin: sim/fmt/rx_array.py rx_heatmaps_fixed (values), rx_row_beats (timing).
 `default_nettype none
 `include "fmt_defaults.vh"
@@ -92,6 +94,8 @@ module fmt_rx_array #(
     parameter CLK_PER_SAMPLE = (POST_CLK != 0) ? 3 : 1,   // smallest clk per ce period the
                                            // shared units must keep up with (POST_CLK = 1)
     parameter MAG_ITER   = 12,             // CORDIC iterations of fmt_magnitude
+    parameter MAG_FRAC   = 2,              // fractional bits the magnitudes keep (truncated)
+                                           // into the sums: the cell is rounded once
     parameter MAG_UNITS  = 0,              // shared magnitude units K; 0 = the default rule
     parameter FFT_CH     = (POST_CLK != 0) ? CLK_PER_SAMPLE : 1  // column pairs per FFT engine
                                            // (time-multiplexed, needs ce at most every
@@ -110,7 +114,7 @@ module fmt_rx_array #(
     output reg                      hm_eof_o,  // end of frame marker
     output wire                     fft_ovf_o, // sticky: an FFT saturated
     output wire                     sat_o,     // sticky: a heat-map cell saturated
-    output wire                     ovf_o      // sticky: either of the above or a queue overrun
+    output wire                     overrun_o  // sticky: a row lost (queue full, rewritten, ce too fast)
 );
 
     localparam PAIRS = COLS / 2;
@@ -133,13 +137,14 @@ module fmt_rx_array #(
     localparam P    = (COLS + K - 1) / K;                    // steps (groups) per row
     localparam G_W  = (P > 1) ? $clog2(P) : 1;               // group index width
     localparam AW   = ROW_W + G_W;                           // accumulator address {row, g}
-    localparam SUM_W = MW + MC_W;                            // exact sum over M_MAX windows
+    localparam MAGW = MW + MAG_FRAC;                         // magnitude word (MAG_FRAC fraction)
+    localparam SUM_W = MAGW + MC_W;                          // exact sum over M_MAX windows
     localparam T    = SUM_W + 1;                             // divider input width (sum + M)
     localparam TR   = 40;                                    // precision of fmt_recip.hex
     localparam RW   = TR + 1;                                // ROM word width
     localparam LW   = 4;                                     // width of l = ceil(log2 M) <= 8
     localparam PW   = 2 * T + 1;                             // product width
-    localparam QW   = PW - T - 1;                            // product >> (T + 1) width
+    localparam QW   = PW - T - 1 - MAG_FRAC;                 // product >> (T + 1 + MAG_FRAC) width
     localparam TAGW = ROW_W + G_W + MC_W + 2;                // {row, g, M, first, last}
     localparam QD   = 1 << ROW_W;                            // queue depth (>= ROWS)
     localparam LAST_ROW = last_row_f(0);
@@ -147,8 +152,9 @@ module fmt_rx_array #(
     localparam [G_W-1:0] G_LAST = PM1[G_W-1:0];
 
     generate
-        if (M_MAX < 1 || M_MAX > 255 || T > TR) begin : g_check_m
-            // M_MAX outside 1 .. 255 (fmt_recip.hex) or the sum too wide for its precision
+        if (M_MAX < 1 || M_MAX > 255 || T > TR || MAG_FRAC < 0) begin : g_check_m
+            // M_MAX outside 1 .. 255 (fmt_recip.hex), the sum too wide for its precision
+            // or a negative MAG_FRAC
             fmt_rx_array_M_MAX_unsupported u_bad_m ();
         end
         if (ROWS * P > N * STEPC) begin : g_check
@@ -397,7 +403,7 @@ module fmt_rx_array #(
             assign mx_tag = {row_q, g_q, etag_q};
         end
     endgenerate
-    wire [K*MW-1:0] mags;
+    wire [K*MAGW-1:0] mags;
     wire            mg_valid;
     wire [TAGW-1:0] mg_tag;
     reg             sel_v_q;
@@ -440,20 +446,20 @@ module fmt_rx_array #(
                 end
             end
             if (u == 0) begin : g_lead
-                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(TAGW)) u_mag (
+                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .FRAC(MAG_FRAC), .TAG_W(TAGW)) u_mag (
                     .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(sel_v_q),
                     .in_re_i(sel_q[MW-1:0]), .in_im_i(sel_q[CW-1:MW]),
                     .in_tag_i(sel_tag_q),
-                    .out_valid_o(mg_valid), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(mg_tag));
+                    .out_valid_o(mg_valid), .out_mag_o(mags[u*MAGW +: MAGW]), .out_tag_o(mg_tag));
             end else begin : g_follow
                 // runs in lockstep with unit 0: its valid and tag are unit 0's
                 /* verilator lint_off UNUSEDSIGNAL */
                 wire unused_v, unused_t;
                 /* verilator lint_on UNUSEDSIGNAL */
-                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .TAG_W(1)) u_mag (
+                fmt_magnitude #(.IN_W(MW), .ITER(MAG_ITER), .FRAC(MAG_FRAC), .TAG_W(1)) u_mag (
                     .clk(clk), .rst(rst), .ce(post_ce), .in_valid_i(sel_v_q),
                     .in_re_i(sel_q[MW-1:0]), .in_im_i(sel_q[CW-1:MW]), .in_tag_i(1'b0),
-                    .out_valid_o(unused_v), .out_mag_o(mags[u*MW +: MW]), .out_tag_o(unused_t));
+                    .out_valid_o(unused_v), .out_mag_o(mags[u*MAGW +: MAGW]), .out_tag_o(unused_t));
             end
         end
     endgenerate
@@ -465,7 +471,7 @@ module fmt_rx_array #(
     // An address is read and written once per window (no read-after-write hazard).
     reg [K*SUM_W-1:0] acc_mem [0:(1<<AW)-1];
     reg [K*SUM_W-1:0] acc_rd_q, acc_rd2_q;
-    reg [K*MW-1:0]    a_mag_q, a2_mag_q;
+    reg [K*MAGW-1:0]  a_mag_q, a2_mag_q;
     reg [TAGW-1:0]    a_tag_q, a2_tag_q;
     reg               a_valid_q, a2_valid_q;
     wire [AW-1:0]     mg_addr = mg_tag[TAGW-1 -: AW];
@@ -510,7 +516,7 @@ module fmt_rx_array #(
     always @* begin
         for (l = 0; l < K; l = l + 1)
             sum_d[l*SUM_W +: SUM_W] = (a_first ? {SUM_W{1'b0}} : acc_rd2_q[l*SUM_W +: SUM_W])
-                                    + {{MC_W{1'b0}}, a2_mag_q[l*MW +: MW]};
+                                    + {{MC_W{1'b0}}, a2_mag_q[l*MAGW +: MAGW]};
     end
 
     always @(posedge clk) begin
@@ -537,7 +543,8 @@ module fmt_rx_array #(
         end
     end
 
-    // stage C1: t = sum + M (the rounding half of 2M), R = ceil(entry / 2^(TR-T)) =
+    // stage C1: t = sum + M 2^MAG_FRAC (the rounding half of 2M 2^MAG_FRAC), R =
+    // ceil(entry / 2^(TR-T)) =
     // ceil(2^(T+l) / M), l = ceil(log2 M)
     wire [MC_W-1:0] b_m     = b_tag_q[MC_W+1:2];
     reg  [LW-1:0]   l_d;
@@ -557,7 +564,8 @@ module fmt_rx_array #(
     always @(posedge clk) begin
         if (post_ce) begin
             for (l = 0; l < K; l = l + 1)
-                c1_t_q[l*T +: T] <= {1'b0, b_sum_q[l*SUM_W +: SUM_W]} + {{(T-MC_W){1'b0}}, b_m};
+                c1_t_q[l*T +: T] <= {1'b0, b_sum_q[l*SUM_W +: SUM_W]}
+                                  + ({{(T-MC_W){1'b0}}, b_m} << MAG_FRAC);
             c1_r_q  <= r_round[TR-T +: T+1];
             c1_l_q  <= l_d;
             c1_rg_q <= b_tag_q[TAGW-1 -: ROW_W+G_W];
@@ -611,14 +619,14 @@ module fmt_rx_array #(
         end
     endgenerate
 
-    // stage C3: cell = (t R) >> (T + 1 + l) = floor((sum + M) / 2M), saturated
+    // stage C3: cell = (t R) >> (T + 1 + MAG_FRAC + l) = floor((sum + M F) / 2MF), saturated
     reg [K*HM_W-1:0] cell_d;
     reg              clip_d;
     reg [QW-1:0]     scaled;
     always @* begin
         clip_d = 1'b0;
         for (l = 0; l < K; l = l + 1) begin
-            scaled = c2_p_q[l*PW + T + 1 +: QW] >> c2_l_q;
+            scaled = c2_p_q[l*PW + T + 1 + MAG_FRAC +: QW] >> c2_l_q;
             if (scaled > {{(QW-HM_W){1'b0}}, {HM_W{1'b1}}}) begin
                 cell_d[l*HM_W +: HM_W] = {HM_W{1'b1}};
                 clip_d = 1'b1;
@@ -714,7 +722,7 @@ module fmt_rx_array #(
 
     assign fft_ovf_o = fft_ovf_any;
     assign sat_o     = sat_q;
-    assign ovf_o     = fft_ovf_o | sat_q | overrun_q;
+    assign overrun_o = overrun_q;
 
 endmodule
 

@@ -57,10 +57,16 @@ MUTATIONS = {
         "the receive sign is the transmit sign rx_delay samples earlier"),
     "rx_mean_round_down": (
         "rtl/fmt_rx_array.v",
-        "c1_t_q[l*T +: T] <= {1'b0, b_sum_q[l*SUM_W +: SUM_W]} + {{(T-MC_W){1'b0}}, b_m};",
-        "c1_t_q[l*T +: T] <= {1'b0, b_sum_q[l*SUM_W +: SUM_W]} + {T{1'b0}};",
+        "+ ({{(T-MC_W){1'b0}}, b_m} << MAG_FRAC);",
+        "+ {T{1'b0}};",
         "fmt_rx_array/test_fmt_rx_array.py::test_fmt_rx_array[icarus-small-3]",
-        "heat-map cell = floor((sum + M) / 2M), round half up of the mean"),
+        "heat-map cell = floor((sum + M F) / 2MF), round half up of the mean"),
+    "magnitude_frac_rounded": (
+        "rtl/fmt_magnitude.v",
+        "<< (SH - 1)) : {PW{1'b0}};",
+        "<< (SH - 1)) : ({{(PW-1){1'b0}}, 1'b1} << (SH - FRAC - 1));",
+        "fmt_magnitude/test_fmt_magnitude.py::test_fmt_magnitude[icarus-21_frac2]",
+        "magnitudes with fractional bits truncated, not rounded (the cell is the one rounding)"),
     "blob_peak_tie_last": (
         "rtl/fmt_blob.v",
         "y_peak = ({y[O_PEAK +: HM_W], ~y[O_PR +: ROW_IDX_W], ~y[O_PC +: COL_IDX_W]} >\n"

@@ -145,12 +145,14 @@ REGISTERS: list[Reg] = [
       f"default {HOST_REPORT_HZ} Hz)."),
     # ---- status -----------------------------------------------------------------------------
     R("FRAME_COUNT", 0x080, 32, "ro", 0, "Frames processed since reset."),
-    R("STATUS", 0x081, 9, "w1c", 0,
-      "Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver accumulator/FFT "
-      "overflow, bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 "
+    R("STATUS", 0x081, 11, "w1c", 0,
+      "Sticky flags, write 1 to clear: bit 0 flattening saturation, bit 1 receiver FFT "
+      "overflow (an FFT stage saturated), bit 2 event port dropped a frame, bit 3 latency counter saturation, bit 4 "
       "control-port error, bit 5 localmax overflow/overrun, bit 6 tracker drop/no slot/overrun, "
       "bit 7 blob overflow (more than 8 blobs in a frame)/overrun, bit 8 a calibration write "
-      "went into a frame's flattening (more writes during one frame than fmt_flatten's queue holds)."),
+      "went into a frame's flattening (more writes during one frame than fmt_flatten's queue holds), "
+      "bit 9 receiver heat-map cell saturated (clipped at 2^HM_W - 1), bit 10 receiver overrun (a row "
+      "lost: the shared units' queue full, a row rewritten before it was read, or ce too fast)."),
     R("CTRL_ERRORS", 0x082, 16, "ro", 0, "Control-port error count, saturating (every ERROR reply and junk burst)."),
     R("CTRL_LAST_ERR", 0x083, 8, "ro", 0, "Control-port code of the last error (docs/PROTOCOL.md)."),
     R("EV_DROP_COUNT", 0x084, 16, "ro", 0, "Event port: frames dropped for lack of room."),
@@ -193,6 +195,18 @@ WINDOWS: list[Window] = [
 ]
 
 BY_NAME = {r.name: r for r in REGISTERS}
+# STATUS bit i's short name (fmtctl prints the names of the set flags; the description
+# above is the documentation of each)
+STATUS_FLAGS = ("flat_sat", "rx_fft_ovf", "ev_drop", "lat_sat", "ctrl_err", "lm_ovf",
+                "trk_drop", "blob_ovf", "cal_late", "rx_sat", "rx_overrun")
+
+
+def status_names(value: int) -> list[str]:
+    """Names of the STATUS bits set in value (unknown bits as bitN)."""
+    out = [n for i, n in enumerate(STATUS_FLAGS) if value >> i & 1]
+    extra = value >> len(STATUS_FLAGS)
+    out += [f"bit{len(STATUS_FLAGS) + i}" for i in range(extra.bit_length()) if extra >> i & 1]
+    return out
 WINDOW_BY_NAME = {w.name: w for w in WINDOWS}
 
 

@@ -24,9 +24,10 @@ How a point is measured (the cheapest faithful path)
   hm_scale * |S + n| (S the exact comb-bin DFT of the noiseless column signal, n complex
   Gaussian with the statistics of a DFT bin of the ADC noise plus its quantisation).  They
   are then quantised like the fixed receive chain (``quantise``): the magnitude word of
-  ``fmt_magnitude`` is |2A| in FFT-output LSBs = 2 x cell, rounded half up, and the
-  M-window accumulation is ``rx_fixed.accum_fixed`` (the twin of ``fmt_rx_array``'s
-  accumulator: sum, round half up of sum / 2M, saturate, for any M = 1 .. 255).  What this omits: the FFT's own rounding and the CORDIC
+  ``fmt_magnitude`` is |2A| in FFT-output LSBs = 2 x cell with MAG_FRAC fractional bits,
+  truncated, and the M-window accumulation is ``rx_fixed.accum_fixed`` (the twin of
+  ``fmt_rx_array``'s accumulator: sum, round half up of sum / 2M, saturate, for any
+  M = 1 .. 255).  What this omits: the FFT's own rounding and the CORDIC
   error (both ~1 count, against >= 100 counts of noise at 40 dB), clipping, PN.  The
   agreement with the full path (ADC -> ``rx_fixed.rx_heatmaps_fixed``) is checked in
   ``sim/tests/test_report.py`` (noise statistics within the stated tolerances).
@@ -57,8 +58,8 @@ window end -> event = receive chain (last ADC sample of the frame's last window 
 heat-map row beat: ``rx_clk`` processing-clock cycles at 3 x fs, the figure measured and
 asserted by tb/fmt_rx_array ``latency_and_slow_ce``; computed here from its formula and
 compared with ``build/rx_latency_default_postclk1_cps3.txt`` when that file exists) + touch processing
-(last row beat -> last event on the event port: ``--touch-clk``, default 120 cycles = the
-bound tb/fmt_touch asserts on scene heat maps (``BUDGET``); the header of rtl/fmt_touch.v
+(last row beat -> last event on the event port: ``--touch-clk``, default 140 cycles = the
+bound tb/fmt_touch asserts on scene heat maps and 16 fingers (``BUDGET``); the header of rtl/fmt_touch.v
 gives the per-stage figures 4 + (6 + n) + 23 + (events + 5) + 3).  Plus (M - 1) N / fs.
 """
 from __future__ import annotations
@@ -86,7 +87,7 @@ from .settings import TouchSettings
 
 ROOT = Path(__file__).resolve().parents[2]
 CLK_PER_SAMPLE = 3                  # processing clock = 3 x fs (docs/ARCHITECTURE.md)
-TOUCH_CLK_DEFAULT = 120             # tb/fmt_touch BUDGET (last row beat -> last event)
+TOUCH_CLK_DEFAULT = 140             # tb/fmt_touch BUDGET (last row beat -> last event)
 BASE_THRESHOLD = 2000               # TouchSettings().threshold at HM_W = 16
 INTERPS = (("vn", False), ("vn", True), ("moore", False), ("moore", True))
 PAPER_RATE_HZ, PAPER_LAT_US = 4000.0, 40.0
@@ -153,11 +154,12 @@ def window_cells(scene: _scene.Scene) -> np.ndarray:
 def quantise(cells: np.ndarray, m: int, hm_w: int, cells_w: int = 16):
     """Per-window float cells (at ``cells_w`` bits) -> (heat maps (frames, rows, cols) int64
     at ``hm_w`` bits, saturated flag), as the fixed receive chain: magnitude word
-    round_half_up(2 x cell) (|2A| in FFT LSBs), then ``rx_fixed.accum_fixed`` for any M
-    (fmt_rx_array's exact divider: round half up of sum / 2M)."""
+    floor(2 x cell x 2^MAG_FRAC) (|2A| in FFT LSBs with MAG_FRAC fractional bits), then
+    ``rx_fixed.accum_fixed`` for any M (fmt_rx_array's exact divider: round half up of
+    sum / 2M, the chain's one rounding)."""
     c = np.asarray(cells, dtype=np.float64) * 2.0 ** (hm_w - cells_w)
-    mags = np.floor(2.0 * c + 0.5).astype(np.int64)
-    return _rx.accum_fixed(mags, m=m, hm_w=hm_w, hm_shift=_rx.HM_SHIFT)
+    mags = np.floor(2.0 * c * 2.0 ** _rx.MAG_FRAC).astype(np.int64)
+    return _rx.accum_fixed(mags, m=m, hm_w=hm_w, hm_shift=_rx.HM_SHIFT + _rx.MAG_FRAC)
 
 
 # ---- latency --------------------------------------------------------------------------------
@@ -494,8 +496,8 @@ def render_md(res, plots, cmd: str) -> str:
          f"{sp['scenes'] * sp['interior_contacts_per_scene']} interior and "
          f"{sp['scenes'] * sp['edge_contacts_per_scene']} edge positions, the same at every point.",
          "* Heat maps: `chain.render_heatmaps` per window (default physics: SNR per window at a "
-         "finger centred on a cell), quantised as the fixed receive chain (magnitude word = round(2 x "
-         "cell), `rx_fixed.accum_fixed` = the accumulator of `fmt_rx_array`); touch processing `touch.process_frames(fixed=True)` "
+         "finger centred on a cell), quantised as the fixed receive chain (magnitude word = floor(2 x "
+         "cell) with 2 fractional bits, `rx_fixed.accum_fixed` = the accumulator of `fmt_rx_array`); touch processing `touch.process_frames(fixed=True)` "
          "= bit-exact twin of `rtl/fmt_touch.v` (`tb/fmt_touch` checks the RTL against it event for event on "
          "random and scene heat maps of the MEDIUM sensor: that is the RTL confirmation of this model; the "
          "sweep's own points are not re-run through the RTL); scoring "

@@ -6,16 +6,24 @@ Chain per column pair (columns 2p, 2p+1; COLS must be even):
   despread  x = adc * (+1/-1 from rx_sign)                   (ADC_BITS + 1 bits)
   FFT       Z = fft_fixed(x_a + j x_b) per window of N samples, Z = X * 2^-SHIFT, OUT_W bits
   split     2A[k] = Z[k] + conj(Z[N-k]),  2B[k] = (Z[k] - conj(Z[N-k])) / j   (exact, OUT_W+1)
-  magnitude CORDIC vectoring, ITER = 12, GUARD = 3, gain compensated, round half up
-  accum     sum over M windows (any M = 1..M_MAX; fmt_accum: M = 2^m), D = M * 2^HM_SHIFT,
-            cell = floor((sum + floor(D/2)) / D) (round half up), saturated to HM_W bits
-            (sticky flag); for M = 2^m exactly (sum + 2^(s-1)) >> s, s = m + HM_SHIFT.
-            fmt_rx_array divides by an exact reciprocal multiply (recip_divide, below).
+  magnitude CORDIC vectoring, ITER = 12, GUARD = 3, gain compensated; fmt_rx_array keeps
+            MAG_FRAC = 2 fractional bits (truncated: floor), the reference fmt_col_pair_rx
+            none (round half up to an integer)
+  accum     sum over M windows (any M = 1..M_MAX; fmt_accum: M = 2^m), D = M * 2^s,
+            s = HM_SHIFT + the magnitude's fractional bits, cell = floor((sum +
+            floor(D/2)) / D) (round half up), saturated to HM_W bits (sticky flag); for
+            M = 2^m exactly (sum + 2^(s'-1)) >> s', s' = m + s.  fmt_rx_array divides by
+            an exact reciprocal multiply (recip_divide, below).
 With HM_SHIFT = 1 a cell is |A[k]| * 2^-SHIFT (FFT output LSBs), averaged over M.
 
-Rounding: everything is exact except (1) the FFT's own rounding (``fft_fixed``), (2) the
-CORDIC (arithmetic right shifts = floor inside the iterations, final round half up),
-(3) the accumulator's round half up.  Integer arithmetic is numpy int64 throughout.
+Rounding (fmt_rx_array): everything is exact except (1) the FFT's own rounding
+(``fft_fixed``), (2) the CORDIC (arithmetic right shifts = floor inside the iterations,
+the gain-compensated result truncated to MAG_FRAC fractional bits) and (3) the cell's
+one round half up of sum / 2M.  The truncation's mean, -2^-(MAG_FRAC+2) cell LSB, and the
+half-up rounding's, +2^-(MAG_FRAC+2) / M, cancel at M = 1.  (The reference pair receiver
+rounds the magnitude to an integer and then the cell: two roundings, a +0.2 LSB mean
+offset against a float receiver; ``test_rx_fixed_vs_float`` measures both.)  Integer
+arithmetic is numpy int64 throughout.
 
 Floating-point receiver (``receive``, the chain's float path): despread, FFT per window, comb bins, magnitude, accumulation.
 
@@ -56,6 +64,7 @@ M_MAX = 255          # fmt_rx_array / fmt_core M_MAX: M = 1 .. 255 (the 8-bit WI
 RECIP_TR = 40        # precision of the reciprocal ROM rtl/fmt_recip.hex (see recip_rom)
 RECIP_HEX = "fmt_recip.hex"
 HM_SHIFT = 1         # fmt_accum HM_SHIFT: undo the factor 2 of the pair split
+MAG_FRAC = 2         # fmt_rx_array MAG_FRAC: fractional bits the magnitudes keep (floor)
 
 
 def cordic_gain(iters: int = MAG_ITER) -> float:
@@ -74,8 +83,13 @@ def magnitude_float(re, im) -> np.ndarray:
 
 
 def magnitude_fixed(re, im, iters: int = MAG_ITER, guard: int = MAG_GUARD,
-                    gain_bits: int = MAG_GAIN_BITS) -> np.ndarray:
-    """Bit-exact twin of fmt_magnitude (any input width: the RTL sizes itself)."""
+                    gain_bits: int = MAG_GAIN_BITS, frac: int = 0) -> np.ndarray:
+    """Bit-exact twin of fmt_magnitude (any input width: the RTL sizes itself).
+
+    frac = 0: |z| rounded half up to an integer; frac > 0 (FRAC): |z| * 2^frac truncated
+    (floor), the fraction left for the one rounding downstream."""
+    if not 0 <= frac < gain_bits + guard:
+        raise ValueError(f"magnitude frac {frac} outside 0 .. {gain_bits + guard - 1}")
     x = np.abs(np.asarray(re, dtype=np.int64)) << guard
     y = np.asarray(im, dtype=np.int64) << guard
     for i in range(iters):
@@ -84,8 +98,8 @@ def magnitude_fixed(re, im, iters: int = MAG_ITER, guard: int = MAG_GUARD,
         dy = x >> i
         x, y = np.where(neg, x - dx, x + dx), np.where(neg, y + dy, y - dy)
     gc = cordic_gain_const(iters, gain_bits)
-    sh = gain_bits + guard
-    return (x * gc + (1 << (sh - 1))) >> sh
+    sh = gain_bits + guard - frac
+    return (x * gc + ((1 << (sh - 1)) if frac == 0 else 0)) >> sh
 
 
 # ---- pair split ----------------------------------------------------------------------
@@ -220,14 +234,15 @@ def recip_divide(t, m: int, t_bits: int):
     return (t * r) >> (t_bits + ceil_log2(m))
 
 
-def rx_sum_width(cfg, m_max: int = M_MAX) -> int:
-    """SUM_W of fmt_rx_array: magnitude width MW + width of M, exact for M_MAX windows."""
-    return (fft_out_w(cfg) + 1) + int(m_max).bit_length()
+def rx_sum_width(cfg, m_max: int = M_MAX, mag_frac: int = MAG_FRAC) -> int:
+    """SUM_W of fmt_rx_array: magnitude width MW + MAG_FRAC + width of M, exact for M_MAX
+    windows."""
+    return (fft_out_w(cfg) + 1) + mag_frac + int(m_max).bit_length()
 
 
-def rx_div_t_bits(cfg, m_max: int = M_MAX) -> int:
-    """T of fmt_rx_array's divider: SUM_W + 1 (the sum plus the rounding half M)."""
-    return rx_sum_width(cfg, m_max) + 1
+def rx_div_t_bits(cfg, m_max: int = M_MAX, mag_frac: int = MAG_FRAC) -> int:
+    """T of fmt_rx_array's divider: SUM_W + 1 (the sum plus the rounding half M 2^MAG_FRAC)."""
+    return rx_sum_width(cfg, m_max, mag_frac) + 1
 
 
 # ---- the whole receive path ----------------------------------------------------------
@@ -269,7 +284,7 @@ def fft_windows_fixed(x_re, x_im, cfg, fft_kw=None):
 
 
 def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHIFT,
-                      fft_kw=None, fft_fn=None, m=None):
+                      fft_kw=None, fft_fn=None, m=None, mag_frac: int = MAG_FRAC):
     """Bit-exact twin of fmt_rx_array.
 
     adc (samples, cols) int (ADC_BITS two's complement values), rx_sign (samples,) 0/1
@@ -277,7 +292,9 @@ def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHI
     sample 0 (the first ce after reset); only complete frames of M windows are returned
     (M = m, any 1 .. M_MAX, or 2^m_log2 when m is None).  Returns (heatmaps (frames, rows, cols) int64, row_order (rows,), RxFlags).
     ``fft_fn(x_re, x_im) -> (Z_re, Z_im, ovf)`` on (windows, N) arrays replaces the
-    default fft_fixed (tests of the blocks without the FFT).
+    default fft_fixed (tests of the blocks without the FFT).  ``mag_frac``: the
+    magnitudes' fractional bits (MAG_FRAC of fmt_rx_array; 0 = the reference
+    fmt_col_pair_rx, which rounds the magnitude to an integer).
     """
     adc = np.asarray(adc, dtype=np.int64)
     n, cols = cfg.n_fft, adc.shape[1]
@@ -296,9 +313,9 @@ def rx_heatmaps_fixed(adc, rx_sign, cfg, m_log2: int = 0, hm_shift: int = HM_SHI
             zr, zi, o = fft_fn(xr, xi)
         ovf = ovf or bool(o)
         a_re, a_im, b_re, b_im = pair_split_fixed(zr, zi, cfg)
-        mags[:, :, 2 * p] = magnitude_fixed(a_re, a_im)
-        mags[:, :, 2 * p + 1] = magnitude_fixed(b_re, b_im)
-    hm, sat = accum_fixed(mags, m_log2, cfg.hm_width, hm_shift, m=m)
+        mags[:, :, 2 * p] = magnitude_fixed(a_re, a_im, frac=mag_frac)
+        mags[:, :, 2 * p + 1] = magnitude_fixed(b_re, b_im, frac=mag_frac)
+    hm, sat = accum_fixed(mags, m_log2, cfg.hm_width, hm_shift + mag_frac, m=m)
     return hm, row_order(cfg), RxFlags(fft_ovf=ovf, sat=sat)
 
 

@@ -3,6 +3,8 @@ consistent, reset values come from the shared parameters/settings, and the regis
 file model behaves as documented."""
 from __future__ import annotations
 
+import re
+
 from fmt import params, regmap
 from fmt.settings import TouchSettings
 from fmt.tracker import TrackParams
@@ -52,6 +54,23 @@ def test_regfile_model():
     assert m.read(a["STATUS"].addr) == 0x1A                      # w1c
     assert m.read(0x7FF) == 0                                    # unmapped
     assert m.read(a["FRAME_COUNT"].addr, {"FRAME_COUNT": 77}) == 77
+
+
+def test_status_flag_names():
+    """One short name per STATUS bit, each bit described in the map, and the core's
+    status_set concatenation (rtl/fmt_core.v, read here) has one term per bit."""
+    st = regmap.BY_NAME["STATUS"]
+    assert len(regmap.STATUS_FLAGS) == st.width == len(set(regmap.STATUS_FLAGS))
+    for i in range(st.width):
+        assert f"bit {i} " in st.desc
+    src = (regmap.ROOT / "rtl" / "fmt_core.v").read_text()
+    m = re.search(r"wire \[(\d+):0\] status_set = \{(.*?)\};", src, re.S)
+    assert m and int(m.group(1)) == st.width - 1
+    terms = [t.strip() for t in m.group(2).split(",")]
+    assert len(terms) == st.width
+    assert terms[-2] == "rx_fft_ovf" and terms[1] == "rx_sat" and terms[0] == "rx_overrun"
+    assert regmap.status_names(0) == []
+    assert regmap.status_names(0b110_0000_0010 | 1 << 12) == ["rx_fft_ovf", "rx_sat", "rx_overrun", "bit12"]
 
 
 def test_regfile_ports_follow_map():

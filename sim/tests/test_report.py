@@ -23,7 +23,7 @@ def _fingers(cfg, n=8):
 
 def test_render_path_noise_matches_adc_path():
     """DEFAULT sensor, 8 fingers, 30 dB per window, PN on, M = 2, 128 frames: the heat
-    maps of report's path (render per window, magnitude word round(2 x cell), accum_fixed)
+    maps of report's path (render per window, magnitude word floor(8 x cell), accum_fixed)
     against ADC -> rx_fixed (the RTL's twin), different noise draws.
 
     Tolerances (n = samples): baseline cells (1145 cells x 128 frames = 147k samples):
@@ -80,17 +80,19 @@ def test_width_scaling_is_exact():
 
 
 def test_quantise_divider_agrees_with_accum():
-    """report.quantise uses fmt_rx_array's divider (accum_fixed with any M): round half up
-    of sum / 2M for M = 2^k and for M = 40 (the mean of the magnitude words / 2)."""
+    """report.quantise uses fmt_rx_array's divider (accum_fixed with any M): the magnitude
+    words floor(2 x cell x 4) (two fractional bits), then round half up of sum / 8M for
+    M = 2^k and for M = 40 (the mean of the magnitude words / 8)."""
     rng = np.random.default_rng(4)
     cells = rng.uniform(0, 9000, size=(80, 3, 5))
-    mags = np.floor(2 * cells + 0.5).astype(np.int64)
+    assert report._rx.MAG_FRAC == 2
+    mags = np.floor(8 * cells).astype(np.int64)
     for m in (1, 2, 4, 8, 16):
         hm, _ = report.quantise(cells, m, 16)
         s = mags.reshape(80 // m, m, 3, 5).sum(axis=1)
-        assert np.array_equal(hm, (s + m) // (2 * m))
+        assert np.array_equal(hm, (s + 4 * m) // (8 * m))
     hm40, sat = report.quantise(cells, 40, 16)
-    exact = mags.reshape(2, 40, 3, 5).sum(axis=1) / 80.0
+    exact = mags.reshape(2, 40, 3, 5).sum(axis=1) / 320.0
     assert not sat and np.array_equal(hm40, np.floor(exact + 0.5).astype(np.int64))
     big, sat = report.quantise(np.full((4, 1, 1), 70000.0), 4, 16)
     assert sat and big.max() == (1 << 16) - 1

@@ -1,5 +1,7 @@
 """cocotb testbench of rtl/ref/fmt_col_pair_rx.v (one column pair: despread x2, FFT, pair
-split, magnitude x2, accumulation) against rx_heatmaps_fixed on two columns.
+split, magnitude x2, accumulation) against rx_heatmaps_fixed on two columns
+(mag_frac = 0: the reference rounds each magnitude to an integer, fmt_rx_array keeps two
+fractional bits).
 
 Bit-exact cells for stirred tones with random PN settings at M = 1, 2, 4 and for
 full-range random ADC words, rows in rx_fixed.row_order with out_last_row_o on the last
@@ -96,7 +98,7 @@ async def exact_pn_m(dut):
         adc = rx_stim.tones(cfg, s, rng, tx=tx)[:, :2]
         await tb.reset()
         outs = await tb.run(adc, rx, lambda i: m_log2, every)
-        exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, m_log2)
+        exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, m_log2, mag_frac=0)
         check(tb, outs, exp, f"M={1 << m_log2} ce/{every}")
         if m_log2 > 0:
             # the zero tail (N + 60 samples) never completes another frame of M >= 2
@@ -121,7 +123,7 @@ async def random_words_and_saturation(dut):
     rx = np.zeros(2 * n, dtype=np.uint8)
     await tb.reset()
     outs = await tb.run(adc, rx, lambda i: 0)
-    exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, 0)
+    exp, _, flags = R.rx_heatmaps_fixed(adc, rx, cfg, 0, mag_frac=0)
     check(tb, outs, exp, "random/full-scale")
     assert flags.sat, "the square wave must saturate its cell in the model"
     assert int(dut.sat_o.value) == 1
@@ -140,8 +142,8 @@ async def m_change_at_frame_start(dut):
     await tb.reset()
     # frame 0 = windows 0, 1 (M = 2); M = 4 requested during window 1 -> windows 2..5
     outs = await tb.run(adc, rx, lambda i: 1 if i < n + n // 2 else 2)
-    e1, _, _ = R.rx_heatmaps_fixed(adc[:2 * n], rx[:2 * n], cfg, 1)
-    e2, _, _ = R.rx_heatmaps_fixed(adc[2 * n:], rx[2 * n:], cfg, 2)
+    e1, _, _ = R.rx_heatmaps_fixed(adc[:2 * n], rx[:2 * n], cfg, 1, mag_frac=0)
+    e2, _, _ = R.rx_heatmaps_fixed(adc[2 * n:], rx[2 * n:], cfg, 2, mag_frac=0)
     check(tb, outs, np.concatenate([e1, e2]), "M 2 -> 4")
 
 

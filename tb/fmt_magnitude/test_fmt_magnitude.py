@@ -4,7 +4,9 @@ Bit-exact magnitudes for random full-scale inputs, the extremes (-2^(W-1) on bot
 axes, zero), the tag and valid path, ce gating (random ce pattern: the pipeline only
 advances on ce) and the latency ITER + 3 ce cycles, and inputs whose gain product lands
 exactly on a half LSB (IN_W = 19; they round up); the model test bounds the error
-against the exact sqrt.
+against the exact sqrt.  FRAC = 2 (IN_W = 21, as fmt_rx_array instantiates it): the output
+keeps two fractional bits, truncated; the random vectors land on every fraction, so a
+rounding there instead of the truncation fails them.
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ class TB(ClockedTB):
         super().__init__(dut)
         self.w = env_int("IN_W", 19)
         self.iters = env_int("ITER", 12)
+        self.frac = env_int("FRAC", 0)
         dut.ce.value = 0
         dut.in_valid_i.value = 0
         dut.in_re_i.value = 0
@@ -65,7 +68,7 @@ class TB(ClockedTB):
 
 async def run_vectors(tb, re_, im_, ce_prob):
     outs, in_at = await tb.stream(re_, im_, ce_prob)
-    exp = R.magnitude_fixed(np.array(re_), np.array(im_), iters=tb.iters)
+    exp = R.magnitude_fixed(np.array(re_), np.array(im_), iters=tb.iters, frac=tb.frac)
     assert len(outs) == len(re_), f"{len(outs)} outputs for {len(re_)} inputs"
     for j, (at, mag, tag) in enumerate(outs):
         assert mag == int(exp[j]), f"sample {j}: ({re_[j]}, {im_[j]}) rtl {mag} model {exp[j]}"
@@ -130,6 +133,8 @@ async def exact_halves(dut):
     + 1/2 rounded down, written out here by hand, and the model's."""
     tb = TB(dut)
     await tb.reset()
+    if tb.frac:
+        return                                   # FRAC > 0: truncation, no half to round
     cases = half_cases(tb.w, tb.iters)
     if not cases:
         return                                   # IN_W = 13: no exact half exists
@@ -175,8 +180,8 @@ async def reset_clears_valid(dut):
     assert seen == 0, "samples in flight at reset must not come out"
 
 
-@pytest.mark.parametrize("in_w", [13, 19])
-def test_fmt_magnitude(sim, in_w):
+@pytest.mark.parametrize("in_w,frac", [(13, 0), (19, 0), (21, 2)], ids=["13", "19", "21_frac2"])
+def test_fmt_magnitude(sim, in_w, frac):
     run_cocotb(
         sim=sim,
         toplevel="fmt_magnitude",
@@ -184,7 +189,8 @@ def test_fmt_magnitude(sim, in_w):
         test_module="test_fmt_magnitude",
         test_dir=Path(__file__).parent,
         parameters={"IN_W": in_w, "ITER": R.MAG_ITER, "GUARD": R.MAG_GUARD,
-                    "GAIN_BITS": R.MAG_GAIN_BITS, "GAIN_C": R.cordic_gain_const(), "TAG_W": 8},
-        extra_env={"IN_W": in_w, "ITER": R.MAG_ITER},
+                    "GAIN_BITS": R.MAG_GAIN_BITS, "GAIN_C": R.cordic_gain_const(), "FRAC": frac,
+                    "TAG_W": 8},
+        extra_env={"IN_W": in_w, "ITER": R.MAG_ITER, "FRAC": frac},
         build_args=["-CFLAGS", "-O0"] if sim == "verilator" else None,   # compile time dominates
     )

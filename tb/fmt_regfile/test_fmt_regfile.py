@@ -54,7 +54,7 @@ HAND_TEXT = """
 0x040 LATENCY_DIAL 32 rw 0x0
 0x041 REPORT_PERIOD 32 rw 0x7A120
 0x080 FRAME_COUNT 32 ro -
-0x081 STATUS 9 w1c 0x0
+0x081 STATUS 11 w1c 0x0
 0x082 CTRL_ERRORS 16 ro -
 0x083 CTRL_LAST_ERR 8 ro -
 0x084 EV_DROP_COUNT 16 ro -
@@ -193,13 +193,13 @@ async def regfile_equals_hand_cases(dut):
             getattr(dut, f"{port}_rdata_i").value = 0
     # STATUS (w1c): set by status_set_i, cleared only where 1 is written
     await tb.writable()
-    dut.status_set_i.value = 0x1A5
+    dut.status_set_i.value = 0x5A5
     await RisingEdge(tb.clk)
     await tb.writable()
     dut.status_set_i.value = 0
-    assert await tb.read(0x081) == 0x1A5
-    await tb.write(0x081, 0x105)
-    assert await tb.read(0x081) == 0xA0
+    assert await tb.read(0x081) == 0x5A5
+    await tb.write(0x081, 0x405)
+    assert await tb.read(0x081) == 0x1A0
     # unmapped addresses read 0 and ignore writes
     mapped = {a for a, *_ in HAND}
     for a in (0x003, 0x00F, 0x015, 0x034, 0x0A2, 0x100, 0xFFFF):

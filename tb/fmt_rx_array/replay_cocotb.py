@@ -37,6 +37,6 @@ async def replay(dut):
     hm = tb.frames_from(beats, eofs, frames)
     np.save(os.environ["REPLAY_OUT"], hm.astype(np.uint32))
     info = {"frames": int(frames), "sat": int(dut.sat_o.value), "fft_ovf": int(dut.fft_ovf_o.value),
-            "ovf": int(dut.ovf_o.value)}
+            "overrun": int(dut.overrun_o.value)}
     Path(os.environ["REPLAY_OUT"] + ".json").write_text(json.dumps(info) + "\n")
     dut._log.info(f"replay: {info}")

@@ -6,8 +6,8 @@ rendered from moving finger contacts (fmt.sensor, disk profile), rows in random 
 a random calibration (offset / gain) loaded through the calibration port.  Every
 frame's events (all fields, in order, ev_last) must equal the model's.  The latency
 from the frame's last row beat to its last event on the output (dial 0, consumer
-ready) is measured per frame and checked against the budget (~120 processing-clock
-cycles); the numbers are logged (pytest -s, or the cocotb log).
+ready) is measured per frame and checked against the budget (140 processing-clock
+cycles, BUDGET below); the numbers are logged (pytest -s, or the cocotb log).
 
 Blobs (blob_en_i = 1, test ``blobs``): palm scenes (a large ellipse and fingers next to
 it, some fingers landing on the palm) and random maps, bit-exact with
@@ -30,10 +30,15 @@ from common.runner import run_cocotb, sources
 from common.tb_util import env_int
 from fmt import flatten, params, sensor
 from fmt.settings import TouchSettings
-from fmt.touch import process_frames
+from fmt.blob import blob_stream_fixed
+from fmt.touch import MAX_BLOBS, process_frames
 from fmt_touch.touch_driver import FRAME_PERIOD_S, TB, build_args, group, scene_maps
 
-BUDGET = 120
+# last row -> last event, blobs off: the 30 x 40 sensor with 16 fingers (the contact
+# limit) measured 128 (2026-11-28, test-long; 100 before the 125 MHz redesigns of the
+# local maxima and the tracker); 140 with the receive chain's 820 clk stays inside the
+# 8 us budget (1,000 clk at 125 MHz) with 40 clk to spare
+BUDGET = 140
 BLOB_BUDGET = 200              # blobs on: + the wait for the blob mask and the replay
 
 
@@ -276,9 +281,15 @@ async def settings_midframe(dut):
     assert len(got) == sum(1 for x in exp if x)
     d = tb.dut
     assert int(d.lm_overrun_o.value) == 0 and int(d.trk_overrun_o.value) == 0
-    assert int(d.ev_overflow_o.value) == 0 and int(d.blob_flag_o.value) == 0
+    assert int(d.ev_overflow_o.value) == 0
+    # the blob flag (sticky): set exactly when a frame with blobs on had more blobs than
+    # the list holds (random maps at full size do), never by an overrun
+    flat, _ = flatten.flatten_fixed(maps, *flatten.identity(cfg), cfg)
+    blob_ovf = [k for k in range(n) if per_frame[k].blobs and blob_stream_fixed(
+        flat[k], per_frame[k].blob_threshold, per_frame[k].blob_min_cells, MAX_BLOBS)[2]]
+    assert int(d.blob_flag_o.value) == int(bool(blob_ovf)), f"blob overflow in frames {blob_ovf}"
     dut._log.info(f"settings changed before {changed} of {n} frames; "
-                  f"{sum(len(e) for e in exp)} events bit-exact")
+                  f"{sum(len(e) for e in exp)} events bit-exact; blob overflow in frames {blob_ovf}")
 
 
 # ---- pytest entry ------------------------------------------------------------------

@@ -110,7 +110,7 @@ module fpga_core #(
 
     // ---------------------------------------------------------------- core
     wire        ce;
-    wire [8:0]  status;
+    wire [10:0] status;
     /* verilator lint_off PINCONNECTEMPTY */  // event fields: the UART streams them
     fmt_core #(
         .ROWS(ROWS), .COLS(COLS), .LOG2_N(LOG2_N), .BIN_LO(BIN_LO), .BIN_STEP(BIN_STEP),
@@ -154,7 +154,7 @@ module fpga_core #(
     end
     assign led_o = {status[2:0], adc_lost, adc_err, dds_done, adc_trained, hb_q[HB_BITS-1]};
     /* verilator lint_off UNUSEDSIGNAL */
-    wire unused_status = &{1'b0, status[8:3]};
+    wire unused_status = &{1'b0, status[10:3]};
     /* verilator lint_on UNUSEDSIGNAL */
 endmodule
 `default_nettype wire

@@ -328,7 +328,8 @@ def cmd_latency(dev: Device, a) -> None:
     print(f"  histogram first event ({half} bins): " + " ".join(map(str, hist[:half])))
     print(f"  histogram last event  ({half} bins): " + " ".join(map(str, hist[half:])))
     print(f"  frames {st['FRAME_COUNT']}, event frames dropped {st['EV_DROP_COUNT']}, "
-          f"skipped {st['EV_SKIP_COUNT']}, status flags 0x{st['STATUS']:02X}")
+          f"skipped {st['EV_SKIP_COUNT']}, status flags 0x{st['STATUS']:03X}"
+          + (f" ({', '.join(regmap.status_names(st['STATUS']))})" if st['STATUS'] else ""))
 
 
 def cmd_calibrate(dev: Device, a) -> None:
