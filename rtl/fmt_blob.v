@@ -26,11 +26,13 @@
 //       and add); X5 sum z*r.  The peak and its first column by a tournament of 1, 2,
 //       2, 1 levels in X2..X5.  Then the event enters a 32-entry FIFO (LUT RAM).  The
 //       extraction runs ahead of the labelling by up to the FIFO depth.
-//   L0, L1: the label under the event's label column: L0 selects it from the previous
-//       row's labels P (one per column, 0 = background), or from the current row's
-//       labels C when the step in L2 may end the previous row first; the step of that
-//       cycle is registered (its victim, survivor, run label) and applied in L1,
-//       together with the step of L1's own cycle (its rename, its run).
+//   L0, LG, L1: the label under the event's label column: L0 selects it, per 8 columns,
+//       from the previous row's labels P (one per column, 0 = background), or from the
+//       current row's labels C when the step in L2 may end the previous row first
+//       (registered per group); the step of that cycle is registered (its victim,
+//       survivor, run label) and applied in LG, which gathers the groups; the step of
+//       LG's cycle is applied in L1, together with the step of L1's own cycle (its
+//       rename, its run).
 //   L2: one step per cycle (x = the label of the current C run, y = L1's label):
 //         RUN, a label y        -> ADD(y): the C run's columns in C get y, x = y
 //         RUN, no label         -> NEW(n): n = a free label (prefetched), x = n
@@ -64,8 +66,9 @@
 //       slot number; the entries sit in LUT RAM.
 // After the frame's hm_eof, once every row is labelled and every label closed, the list
 // is emitted: centroid cx = (sum z*c * 256 + sum z / 2) / sum z (round half up, the
-// same for cy) by one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8) shared
-// by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
+// same for cy): the entry's slot registered (EA), its sums read and the numerator
+// registered (EB), then one pipelined fmt_div (QW + 1 cycles, QW = max index width + 8)
+// shared by the coordinates (the n x quotients, then the n y quotients), one blob per cycle,
 // then blob_eof_o (also for a frame without blobs).
 //
 // Membership (for removing the fingers inside blobs): the labelling stores the labels
@@ -99,16 +102,16 @@
 // Latency (processing-clock cycles, measured by tb/fmt_blob): a row is fetched as soon
 // as rows 0..r are present; the extraction and the labelling take max(1, events)
 // cycles per row each (no bubble between rows: L1 forwards the step of L2), the
-// extraction ahead; from a row's fetch to its first step 12 cycles; after the last
+// extraction ahead; from a row's fetch to its first step 13 cycles; after the last
 // row's last step: 3 cycles to the close engine, one cycle per closed label, then the emission
-// (QW + 3 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
+// (QW + 5 + 2 x blobs cycles) and, in parallel, the membership pass (ROWS + 4).
 // 30 x 40, rows in the FFT's order one per cycle, a palm: last row beat -> blob_eof_o
-// 47..56 cycles, -> mask_ready_o 64..71 cycles.  Worst case per frame: at most
+// 50..59 cycles, -> mask_ready_o 65..72 cycles.  Worst case per frame: at most
 // ceil(COLS/2) events per row (600 at 30 x 40) plus the pipeline; measured from the
-// first row beat to the end: checkerboard (600 RUN events, every label slot live) 691,
-// combs 652, weave (the most merges with the most runs) 652 cycles: within the
+// first row beat to the end: checkerboard (600 RUN events, every label slot live) 693,
+// combs 653, weave (the most merges with the most runs) 654 cycles: within the
 // 768-cycle frame period at 3 x fs (python -m pytest -q -s tb/fmt_blob -k default;
-// unchanged by the L0/L1 and X3/X4 splits of 2026-11-27).  A frame must be finished (blob_eof_o and the
+// 2026-11-28: LG +1 cycle, EA/EB +2 cycles to blob_eof_o).  A frame must be finished (blob_eof_o and the
 // membership pass) before the next frame's hm_eof, else overrun_o (sticky).
 //
 // Settings are taken with the rows: the threshold applies to a row when it arrives,
@@ -179,7 +182,7 @@ module fmt_blob #(
     localparam SY_W   = SZ_W + ROW_IDX_W;            // sum z*r
     localparam IDXMX  = (ROW_IDX_W > COL_IDX_W) ? ROW_IDX_W : COL_IDX_W;
     localparam QW     = IDXMX + 8;                   // centroid quotient bits (Q8.8)
-    localparam DL     = QW + 1;                      // fmt_div latency
+    localparam DL     = QW + 3;                      // emission: slot, numerator, fmt_div (QW + 1)
     localparam NUM_W  = ((SX_W > SY_W) ? SX_W : SY_W) + 9;
     localparam GS     = 8;                           // columns per partial-sum group
     localparam NG     = (COLS + GS - 1) / GS;
@@ -365,7 +368,7 @@ module fmt_blob #(
             f1_row_q <= fr_row;
         end
         if (f1_mv) begin
-            f2_one_q <= ((f1_es_q & ~es_neg) == {COLS{1'b0}});
+            f2_one_q <= le1(f1_es_q);         // (not by the carry of es_neg: 9 levels)
             f2_row_q <= f1_row_q;
         end
     end
@@ -381,8 +384,17 @@ module fmt_blob #(
         input [2:0] a, b;
         ucomb = {a[2] | b[2] | (a[1] & b[0]) | (a[0] & b[1]), a[1] | b[1] | (a[0] & b[0]), a[0] | b[0]};
     endfunction
-    function le2;
+    function le2;                             // x has at most two bits set
         input [COLS-1:0] x;
+        le2 = !ucnt(x, 1'b1);
+    endfunction
+    function le1;                             // x has at most one bit set
+        input [COLS-1:0] x;
+        le1 = !ucnt(x, 1'b0);
+    endfunction
+    function ucnt;                            // sel 1: >= 3 bits set, sel 0: >= 2
+        input [COLS-1:0] x;
+        input            sel;
         integer g, k, w;
         reg [3:0]        q;
         reg [3*LE_P-1:0] v;
@@ -399,7 +411,7 @@ module fmt_blob #(
             for (w = LE_P / 2; w >= 1; w = w / 2)
                 for (k = 0; k < w; k = k + 1)
                     v[3 * k +: 3] = ucomb(v[3 * (2 * k) +: 3], v[3 * (2 * k + 1) +: 3]);
-            le2 = !v[2];
+            ucnt = sel ? v[2] : v[1];
         end
     endfunction
 
@@ -690,8 +702,8 @@ module fmt_blob #(
     reg [FE_W-1:0]  fmem [0:FD-1];
     reg [FP_W-1:0]  fwp_q, frp_q;
     reg [FP_W:0]    fcnt_q;
-    wire            l0_free;
-    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && l0_free;
+    wire            adv;                      // L0..L2 advance (L2 does not wait)
+    wire            fpop = (fcnt_q != {(FP_W+1){1'b0}}) && adv;
     always @(posedge clk) begin
         if (y5_v_q) fmem[fwp_q] <= y5_e_q;
     end
@@ -721,6 +733,11 @@ module fmt_blob #(
     reg                  l0_v_q;
     reg [FE_W-1:0]       l0_e_q;
     reg [COLS-1:0]       l0_oh_q;             // the label column, one-hot
+    reg                  lg_v_q;              // LG: the label gathered from the groups
+    reg [FE_W-1:0]       lg_e_q;
+    reg [COLS-1:0]       lg_oh_q;
+    reg [NG*LBL_W-1:0]   lg_yg_q;             // per GS columns: the label (0 off its group)
+    reg                  lg_hp_q;             // LG's label column under that step's run
     reg                  l1_v_q;
     reg [FE_W-1:0]       l1_e_q;
     reg [COLS-1:0]       l1_oh_q;
@@ -730,6 +747,7 @@ module fmt_blob #(
     /* verilator lint_off UNUSEDSIGNAL */     // L2 does not use the label column
     reg [FE_W-1:0]       l2_e_q;
     wire [EF_W-1:0]      l0_f  = l0_e_q[F_FL +: EF_W];    // L0, L1 use the first flag only
+    wire [EF_W-1:0]      lg_f  = lg_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l1_f  = l1_e_q[F_FL +: EF_W];
     wire [EF_W-1:0]      l2_f  = l2_e_q[F_FL +: EF_W];    // L2: all but the first flag
     wire             new_wait /* verilator public_flat_rd */;   // a NEW waits for a free label
@@ -761,6 +779,11 @@ module fmt_blob #(
     localparam VC  = NG + NAG;
     reg  [NYC*LBL_W-1:0] yc_q, xc_q;          // copies of l2_y_q, x_q
     reg  [NYC-1:0]       dmc_q;               // copies of dm_q
+    reg  [NYC-1:0]       clrc_q;              // clear P, C, alias, live masks (copies)
+    localparam NAD = 12;                      // copies of adv: 2 for L0, 3 each LG, L1, L2,
+                                              // one for the merge decision
+    reg  [NAD-1:0]       advc_q;
+    wire                 releasing;           // the frame is released (S_WAIT -> S_RUN)
     wire             row_done = rd_q;
     wire [LBL_W-1:0] lrun     = l2_hy ? l2_y_q : n0_q;
     assign           new_wait = l2_stall;
@@ -772,64 +795,92 @@ module fmt_blob #(
             rbit[i] = (lrun == i[LBL_W-1:0]);
         end
     end
-    // L1 lookup: the event's label column in P, or in C when L2 ends the previous row
-    // this cycle (C becomes P); this cycle's step forwarded
-    // L0 reads C when its event is the first of its row, or when L1 holds that first
-    // event (L2 may end the previous row this cycle); the step of this cycle is applied,
-    // L1 applies the next one
-    wire             bnd = l0_f[3] || (l1_v_q && l1_f[3]);
-    // (one-hot select, the compares with the victim done per column beside it)
-    reg  [LBL_W-1:0] raw_p, raw_c;
+    // L0 looks up the event's label column in P, or in C when L2 may end the previous row
+    // before the event's own row starts (C becomes P): C when its event is the first of
+    // its row, or when LG or L1 holds that first event.  L0 selects per GS columns only
+    // (the one-hot select beside each group of P and C, registered per group: lg_yg_q);
+    // the step of that cycle is registered (s_*) and applied in LG, which gathers the
+    // groups; the step of LG's cycle is applied in L1, the step of L1's cycle in L2's load.
+    wire             bnd = l0_f[3] || (lg_v_q && lg_f[3]) || (l1_v_q && l1_f[3]);
+    reg  [NG*LBL_W-1:0] y0g;                  // per group: the label under the column, or 0
     reg  [COLS-1:0]  ren_p, ren_c;            // column holds the victim label
-    reg  [COLS-1:0]  l1_m, t_p, t_c;
-    always @(*) begin : c_l1
-        integer i, b;
-        for (b = 0; b < LBL_W; b = b + 1) begin
-            for (i = 0; i < COLS; i = i + 1) begin
-                t_p[i] = l0_oh_q[i] && p_q[i*LBL_W + b];
-                t_c[i] = l0_oh_q[i] && c_q[i*LBL_W + b];
+    reg  [COLS-1:0]  l1_m;
+    reg  [GS-1:0]    t_p, t_c;
+    always @(*) begin : c_l0
+        integer g, i, b;
+        for (g = 0; g < NG; g = g + 1)
+            for (b = 0; b < LBL_W; b = b + 1) begin
+                for (i = 0; i < GS; i = i + 1) begin
+                    t_p[i] = (g * GS + i < COLS) && l0_oh_q[(g * GS + i < COLS) ? g * GS + i : 0]
+                             && p_q[((g * GS + i < COLS) ? g * GS + i : 0) * LBL_W + b];
+                    t_c[i] = (g * GS + i < COLS) && l0_oh_q[(g * GS + i < COLS) ? g * GS + i : 0]
+                             && c_q[((g * GS + i < COLS) ? g * GS + i : 0) * LBL_W + b];
+                end
+                y0g[g * LBL_W + b] = bnd ? |t_c : |t_p;
             end
-            raw_p[b] = |t_p;
-            raw_c[b] = |t_c;
-        end
         for (i = 0; i < COLS; i = i + 1) begin
             ren_p[i] = (p_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
             ren_c[i] = (c_q[i*LBL_W +: LBL_W] == yc_q[(i/GS)*LBL_W +: LBL_W]);
-            l1_m[i] = (i[COL_IDX_W-1:0] >= l0_e_q[F_CMN +: COL_IDX_W])
-                   && (i[COL_IDX_W-1:0] <= l0_e_q[F_CMX +: COL_IDX_W]);
+            l1_m[i] = (i[COL_IDX_W-1:0] >= lg_e_q[F_CMN +: COL_IDX_W])
+                   && (i[COL_IDX_W-1:0] <= lg_e_q[F_CMX +: COL_IDX_W]);
         end
     end
-    // L0 selects only (no forwarding); the step of this cycle is registered (s_*) and
-    // applied in L1, one cycle later, together with the step of that cycle
-    wire [LBL_W-1:0] y0_raw = bnd ? raw_c : raw_p;
     wire             l0_hp  = bnd && |(l0_oh_q & l2_m_q);  // under this cycle's run, if any
     reg              s_mrg_q, s_run_q;        // the step of the cycle before: a merge, a run
     reg  [LBL_W-1:0] s_v_q, s_x_q, s_lrun_q;  // its victim, survivor, run label
     reg              l1_hp_q;                 // L1's label column under that step's run
+    // LG: the groups gathered (one is nonzero at most), the step of the cycle before
+    // applied (yga); LG's label column under this cycle's run (only when LG reads C: its
+    // event is the first of its row or L1 holds that first event)
+    reg  [LBL_W-1:0] lg_y;
+    wire             sg_run = lg_hp_q && s_run_q;
+    wire             sg_mrg = s_mrg_q && (lg_y == s_v_q);
+    wire [LBL_W-1:0] yga = sg_run ? s_lrun_q : (sg_mrg ? s_x_q : lg_y);
+    wire             eqg = sg_run ? (s_lrun_q == l2_y_q)     // (yga == l2_y_q), the three
+                         : (sg_mrg ? (s_x_q == l2_y_q) : (lg_y == l2_y_q));   // compared beside
+    reg  [NG*LBL_W-1:0] yga_g;                // yga in group 0 (LG held)
+    always @(*) begin : c_lg
+        integer g;
+        lg_y = {LBL_W{1'b0}};
+        for (g = 0; g < NG; g = g + 1) lg_y = lg_y | lg_yg_q[g*LBL_W +: LBL_W];
+        yga_g = {(NG*LBL_W){1'b0}};
+        yga_g[LBL_W-1:0] = yga;
+    end
+    wire             lg_hp = (lg_f[3] || (l1_v_q && l1_f[3])) && |(lg_oh_q & l2_m_q);
     // L1's label after the step of the cycle before (ya), and whether it is this
     // cycle's merge victim (eqa: the three candidates compared beside the select)
     wire             sa_run = l1_hp_q && s_run_q;
-    wire             sa_mrg = s_mrg_q && (l1_y_q == s_v_q);
+    // (l1_sv_q = (l1_y_q == s_v_q), registered beside them: s_v_q is l2_y_q of the cycle
+    // before, compared in LG with L1's next label)
+    reg              l1_sv_q;
+    wire             sa_mrg = s_mrg_q && l1_sv_q;
     wire [LBL_W-1:0] ya  = sa_run ? s_lrun_q : (sa_mrg ? s_x_q : l1_y_q);
     wire             eqa = sa_run ? (s_lrun_q == l2_y_q)
                          : (sa_mrg ? (s_x_q == l2_y_q) : (l1_y_q == l2_y_q));
     // L1: this cycle's step (a run of the previous row only for the row's first event)
-    wire             l1_hit = l1_f[3] && do_run && |(l1_oh_q & l2_m_q);
+    // (l1_ov_q: L1's label column under L2's run mask, registered from its next value:
+    // when the stages advance, LG's column and L1's run)
+    reg              l1_ov_q, l1_mg_q;        // l1_mg_q: L1 holds a merge event with a label
+    wire             l1_hit = l1_f[3] && do_run && l1_ov_q;
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
-    wire             l2_ld = l1_v_q && (!l2_v_q || step);
-    wire             l1_ld = l0_v_q && (!l1_v_q || l2_ld);
+    // L0, LG, L1 and L2 advance together (a bubble moves too) unless L2 waits (a NEW
+    // without a free label): adv; the wide loads of the stages' registers take kept
+    // copies of it, registered from its next value (no logic in front of the enables)
+    assign           adv   = !l2_v_q || step;
+    wire             l2_ld = l1_v_q && adv;
     // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
     // (l1_hit: x becomes lrun) or x_q (a merge now: x stays), or else ya
     wire [LBL_W-1:0] x_nx  = do_run ? lrun : x_q;
     wire             ne_nx = !l1_hit && !(do_merge && eqa)
                           && (sa_run ? (s_lrun_q != x_nx) : (sa_mrg ? (s_x_q != x_nx) : (l1_y_q != x_nx)));
-    wire             dm_nx = !rst && l2_ld && !l1_f[0] && l1_f[1] && ne_nx;
+    wire             dm_nx = !rst && advc_q[NAD-1] && l1_mg_q && ne_nx;
     always @(posedge clk) dm_q <= dm_nx;
     // next L2 state: valid, flags, and whether a NEW label is ready (n0v_q's next)
     wire             l2v_nx  = !rst && (l2_ld || (l2_v_q && !step));
     wire [2:0]       l2f_nx  = l2_ld ? l1_f[2:0] : l2_f[2:0];
     wire             n0v_nx  = !rst && !releasing && (n0_fill ? |free_q : n0v_q);
     wire             st_nx   = l2v_nx && !(l2f_nx[0] && !l2f_nx[1] && !n0v_nx);
+    wire             adv_nx  = !l2v_nx || st_nx;
     wire             run_nx  = st_nx && l2f_nx[0];
     wire             rd_nx   = st_nx && l2f_nx[2];
     always @(posedge clk) begin
@@ -847,9 +898,16 @@ module fmt_blob #(
             // the copies of l2_y_q are read only for a merge, which L2 loaded the cycle before)
             (* keep *) always @(posedge clk) yc_q[gy*LBL_W +: LBL_W] <= y1;
             (* keep *) always @(posedge clk) xc_q[gy*LBL_W +: LBL_W] <= x_nx;
+            (* keep *) always @(posedge clk) clrc_q[gy] <= rst || releasing;
+        end
+        for (gy = 0; gy < NAD; gy = gy + 1) begin : g_adv
+            (* keep *) always @(posedge clk) advc_q[gy] <= adv_nx;
         end
     endgenerate
     // synthesis translate_off
+    reg rst_seen;                             // (the copies are loaded from the reset on)
+    initial rst_seen = 1'b0;
+    always @(posedge clk) if (rst) rst_seen <= 1'b1;
     always @(posedge clk) begin
         if (!rst && l2_v_q && (dm_q !== (step && !l2_isrun && l2_hy && (l2_y_q != x_q)))) begin
             $display("fmt_blob: dm_q %b differs from the merge condition", dm_q);
@@ -859,6 +917,16 @@ module fmt_blob #(
             $display("fmt_blob: a copy of l2_y_q or x_q differs in a merge");
             $finish;
         end
+        if (!rst && rst_seen && (l1_mg_q !== (l1_v_q && !l1_f[0] && l1_f[1])
+                                 || l1_sv_q !== (l1_y_q == s_v_q)
+                                 || (l1_v_q && l1_ov_q !== |(l1_oh_q & l2_m_q)))) begin
+            $display("fmt_blob: l1_mg_q, l1_sv_q or l1_ov_q differs");
+            $finish;
+        end
+        if (!rst && rst_seen && advc_q !== {NAD{adv}}) begin
+            $display("fmt_blob: a copy of adv differs");
+            $finish;
+        end
         if (!rst && (st_q !== (l2_v_q && !l2_stall) || run_q !== (l2_v_q && !l2_stall && l2_isrun)
                      || rd_q !== (l2_v_q && !l2_stall && l2_last))) begin
             $display("fmt_blob: st_q %b run_q %b rd_q %b differ from the step", st_q, run_q, rd_q);
@@ -866,7 +934,6 @@ module fmt_blob #(
         end
     end
     // synthesis translate_on
-    assign           l0_free = !l0_v_q || l1_ld;
 
     // next label vectors and live masks of this cycle's step
     reg [COLS*LBL_W-1:0] p_nx, c_nx;
@@ -885,7 +952,6 @@ module fmt_blob #(
     end
     // free labels: the lowest one is prefetched into n0_q
     wire        n0_fill = !n0v_q || do_new;
-    wire        releasing;
     wire [NL:1] f_low   = free_q & (~free_q + 1'b1);
     reg  [LBL_W-1:0] f_enc;
     reg  [NL:1]      f_t;
@@ -1004,7 +1070,10 @@ module fmt_blob #(
     end
     // next values of pk_q, pk_v_q and of the read addresses (label A; label B of a
     // MERGE, else the close engine's label)
-    wire [LBL_W-1:0] pk_nx  = (pk_fill && !rst) ? p_enc : pk_q;
+    // (pk_hold kept: the merge flag enters at the last select, not through pk_fill)
+    (* keep *) wire  pk_hold;
+    assign           pk_hold = rst || (b_merge && pk_v_q);      // = rst || !pk_fill
+    wire [LBL_W-1:0] pk_nx  = pk_hold ? pk_q : p_enc;
     wire             pkv_nx = rst ? 1'b0 : (pk_fill ? |pend_q : pk_v_q);
     wire [LBL_W-1:0] ra_nx  = do_merge ? x_q : lrun;
     wire [LBL_W-1:0] rb_nx  = do_merge ? l2_y_q : pk_nx;
@@ -1013,7 +1082,11 @@ module fmt_blob #(
     // the slices' registers, assembled
     wire [E_W-1:0]   w_x, w_yy, cl_e_q;
     wire [E_W-1:0]   w_res = combine(w_x, w_yy);     // (a NEW writes w_yy: per slice)
-    genvar ga;
+    localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
+    localparam CFI  = 4;                      // cf_mem labels per copy of the blob test
+    localparam NCF  = (NL + CFI - 1) / CFI;
+    reg  [NCF:0]     cl_isb_q;                // the blob test of cl_e_q (copy NCF: the list)
+    genvar ga, gk;
     generate
         for (ga = 0; ga < NAS; ga = ga + 1) begin : g_acc
             localparam LO = (ga == 0) ? O_AREA : (ga == 1) ? O_SX : (ga == 2) ? O_SY
@@ -1045,6 +1118,17 @@ module fmt_blob #(
                 if (we_q) acc_q[wa_q] <= nw_q ? w_yy[LO +: SW] : w_res[LO +: SW];
                 if (pkv_q && !mrg_q) cl_q <= rd_b;          // cl_go
             end
+            if (ga == 0) begin : g_isb
+                // the closed label's blob test (area >= min-cells of the labelled buffer,
+                // mc_p_q), registered with cl_q,
+                // in copies: one for the list, one per CFI labels of cf_mem's write data
+                wire [AREA_W-1:0] rb_area = rd_b[O_AREA - LO +: AREA_W];
+                wire isb_nx = ({{(AM_W-AREA_W){1'b0}}, rb_area}
+                               >= {{(AM_W-MINC_W){1'b0}}, mc_p_q});
+                for (gk = 0; gk <= NCF; gk = gk + 1) begin : g_k
+                    (* keep *) always @(posedge clk) cl_isb_q[gk] <= isb_nx;   // (read after cl_go)
+                end
+            end
             assign w_x[LO +: SW]     = fa_q ? wr_q : ra_d_q;
             assign w_yy[LO +: SW]    = fb_q ? wr_q : y_q;
             assign cl_e_q[LO +: SW]  = cl_q;
@@ -1056,8 +1140,7 @@ module fmt_blob #(
     reg [LBL_W-1:0]     cl_lbl_q;
     wire [AREA_W-1:0] cl_area = cl_e_q[O_AREA +: AREA_W];
     wire [IDX_W-1:0]  cl_key  = {cl_e_q[O_RMIN +: ROW_IDX_W], cl_e_q[O_FC +: COL_IDX_W]};
-    localparam AM_W = (MINC_W > AREA_W) ? MINC_W : AREA_W;
-    wire              cl_isblob = ({{(AM_W-AREA_W){1'b0}}, cl_area} >= {{(AM_W-MINC_W){1'b0}}, mc_p_q});
+    wire              cl_isblob = cl_isb_q[NCF];
     wire              cl_blob = cl_v_q && cl_isblob;
 
     // The list holds the sort keys (area, raster index of the first cell) and a slot
@@ -1117,9 +1200,14 @@ module fmt_blob #(
     reg [AREA_W-1:0]  em_found_q;
     wire              em_issue = (state_q == S_EMIT) && (em_i_q != em_n_q);
     wire              em_tok   = (state_q == S_EMIT) && (em_i_q == em_n_q);
-    // the sums of list entry em_i_q (an index >= MB reads entry 0)
+    // the sums of list entry em_i_q (an index >= MB reads entry 0): the slot registered
+    // (EA), the sums read and the numerator registered (EB), then the divider
     wire [SL_W-1:0]  em_slot = (em_i_q < MB_C) ? l_slot_q[em_i_q[MBI_W-1:0]] : l_slot_q[0];
-    wire [PE_W-1:0]  em_p    = pe_mem[em_slot];
+    reg  [SL_W-1:0]  ea_slot_q;
+    reg              ea_v_q, ea_ph_q, eb_v_q;
+    reg  [NUM_W-1:0] eb_num_q;
+    reg  [SZ_W-1:0]  eb_den_q;
+    wire [PE_W-1:0]  em_p    = pe_mem[ea_slot_q];
     wire [SZ_W-1:0]  em_sz   = em_p[0 +: SZ_W];
     wire [SX_W-1:0]  em_sx   = em_p[SZ_W +: SX_W];
     wire [SY_W-1:0]  em_sy   = em_p[SZ_W + SX_W +: SY_W];
@@ -1137,8 +1225,16 @@ module fmt_blob #(
     /* verilator lint_on UNUSEDSIGNAL */
     wire [QW-1:0] dq;
     fmt_div #(.NUM_W(NUM_W), .DEN_W(SZ_W), .QW(QW)) u_div (
-        .clk(clk), .rst(rst), .valid_i(em_issue), .num_i(em_ph_q ? num_y : num_x),
-        .den_i(em_sz), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+        .clk(clk), .rst(rst), .valid_i(eb_v_q), .num_i(eb_num_q),
+        .den_i(eb_den_q), .valid_o(dq_v), .quot_o(dq), .ovf_o(dq_ovf));
+    always @(posedge clk) begin
+        ea_slot_q <= em_slot;
+        ea_ph_q   <= em_ph_q;
+        ea_v_q    <= em_issue && !rst;
+        eb_num_q  <= ea_ph_q ? num_y : num_x;
+        eb_den_q  <= em_sz;
+        eb_v_q    <= ea_v_q && !rst;
+    end
     // index, phase and end token travel beside the divider
     reg [DL-1:0]       dl_v_q, dl_x_q, dl_t_q;
     reg [CNT_W-1:0]    dl_i_q [0:DL-1];
@@ -1167,10 +1263,8 @@ module fmt_blob #(
     reg                  bw_busy_q;           // the frame's membership pass is not done
     reg                  tok_q;               // the frame's blob_eof went out
     always @(posedge clk) begin
-        if (bw_run_q) begin
-            fr_rd1_q <= fr_mem[bw_r_q];
-            lr_rd1_q <= lr_mem[bw_r_q];
-        end
+        fr_rd1_q <= fr_mem[bw_r_q];           // (read every cycle: used only while
+        lr_rd1_q <= lr_mem[bw_r_q];           //  bw_v_q, no enable net of ~550 loads)
         fr_rd_q <= fr_rd1_q;                  // the block RAMs' output registers
         lr_rd_q <= lr_rd1_q;
     end
@@ -1192,7 +1286,7 @@ module fmt_blob #(
         integer l;
         for (l = 1; l <= NL; l = l + 1)
             if (cl_v_q && cl_lbl_q == l[LBL_W-1:0])
-                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isblob}};
+                cf_mem[cl_row_q][(l-1)*CFB +: CFB] <= {CFB{cl_isb_q[(l-1)/CFI]}};
         cf_rd1_q <= cf_mem[cf_row_nx];        // with fr_rd1_q (row bw_r_q)
         for (l = 1; l <= NL; l = l + 1)
             cf_rd_q[l] <= cf_rd1_q[(l-1)*CFB]; // the output register, with fr_rd_q
@@ -1274,7 +1368,7 @@ module fmt_blob #(
     end
 
     wire pipe_busy = f1_v_q || f2_v_q || e1_v_q || x1_v_q || x2_v_q || x3_v_q || y4_v_q
-                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || l1_v_q || l2_v_q || x4_v_q
+                   || y5_v_q || (fcnt_q != {(FP_W+1){1'b0}}) || l0_v_q || lg_v_q || l1_v_q || l2_v_q || x4_v_q
                    || w_wr || cl_v_q || (|pend_q) || pk_v_q;
     reg  idle_q;                              // the pipeline was idle (one cycle late)
     wire complete  = (arr_p == {ROWS{1'b1}});
@@ -1368,16 +1462,34 @@ module fmt_blob #(
         y4_e_q <= x3_ev;  y4_pk_q <= pk5[PN5*PK_W-1:0];  y4_ylo_q <= ylo;  y4_yhi_q <= yhi;
         y4_sx_q <= sx4;
         y5_e_q <= y4_ev;
-        if (fpop) l0_e_q <= f_rd;
-        if (fpop) l0_oh_q <= lc_oh;
-        if (l1_ld) begin                      // (L1 holds only while L2 waits: no step)
-            l1_e_q  <= l0_e_q;
-            l1_oh_q <= l0_oh_q;
-            l1_m_q  <= l1_m;
-            l1_y_q  <= y0_raw;
-            l1_hp_q <= l0_hp;
-        end else begin                        // (held: no step this cycle; the pending
-            l1_y_q  <= ya;                    //  one applied now)
+        // the stages' wide registers: enables from the copies of adv, in ranges
+        for (i = 0; i < FE_W; i = i + 1) begin
+            if (advc_q[(i * 2) / FE_W])     l0_e_q[i] <= f_rd[i];
+            if (advc_q[2 + (i * 3) / FE_W]) lg_e_q[i] <= l0_e_q[i];
+            if (advc_q[5 + (i * 3) / FE_W]) l1_e_q[i] <= lg_e_q[i];
+            if (advc_q[8 + (i * 3) / FE_W]) l2_e_q[i] <= l1_e_q[i];
+        end
+        for (i = 0; i < COLS; i = i + 1) begin
+            if (advc_q[1])  l0_oh_q[i] <= lc_oh[i];
+            if (advc_q[4])  lg_oh_q[i] <= l0_oh_q[i];
+            if (advc_q[6])  l1_oh_q[i] <= lg_oh_q[i];
+            if (advc_q[7])  l1_m_q[i]  <= l1_m[i];
+            if (advc_q[10]) l2_m_q[i]  <= l1_m_q[i];
+        end
+        if (adv) begin                        // (LG, L1 hold only while L2 waits: no step)
+            l1_ov_q <= |(lg_oh_q & l1_m_q);
+            l1_mg_q <= lg_v_q && !lg_f[0] && lg_f[1];
+            l1_sv_q <= eqg;
+            lg_yg_q <= y0g;
+            lg_hp_q <= l0_hp;
+            l1_y_q  <= yga;
+            l1_hp_q <= lg_hp;
+            l2_y_q  <= y1;
+        end else begin                        // (held: the pending step applied now)
+            lg_yg_q <= yga_g;
+            lg_hp_q <= 1'b0;
+            l1_y_q  <= ya;
+            l1_sv_q <= eqa;                   // (ya == l2_y_q)
             l1_hp_q <= 1'b0;
         end
         s_mrg_q  <= do_merge;
@@ -1385,11 +1497,6 @@ module fmt_blob #(
         s_v_q    <= l2_y_q;
         s_x_q    <= x_q;
         s_lrun_q <= lrun;
-        if (l2_ld) begin
-            l2_e_q <= l1_e_q;
-            l2_y_q <= y1;
-            l2_m_q <= l1_m_q;
-        end
         if (do_run) x_q <= lrun;
         // (reset: the step registers before it are reset one cycle late for this one)
         x4_op_q  <= rst ? OP_NONE : (do_merge ? OP_MERGE : (do_new ? OP_NEW
@@ -1450,6 +1557,8 @@ module fmt_blob #(
             fcnt_q   <= {(FP_W+1){1'b0}};
             res_q    <= {(FP_W+1){1'b0}};
             l0_v_q   <= 1'b0;
+            lg_v_q   <= 1'b0;
+            l1_mg_q  <= 1'b0;
             l1_v_q   <= 1'b0;
             l2_v_q   <= 1'b0;
             n0v_q    <= 1'b0;
@@ -1458,12 +1567,7 @@ module fmt_blob #(
             pk_v_q   <= 1'b0;
             idle_q   <= 1'b0;
             abort_q  <= 1'b0;
-            p_q      <= {(COLS*LBL_W){1'b0}};
-            c_q      <= {(COLS*LBL_W){1'b0}};
-            livep_q  <= {NL{1'b0}};
-            livec_q  <= {NL{1'b0}};
             free_q   <= {NL{1'b1}};
-            alias_q  <= alias_id;
             pend_q   <= {NL{1'b0}};
             x1_v_q   <= 1'b0;
             x2_v_q   <= 1'b0;
@@ -1532,10 +1636,11 @@ module fmt_blob #(
             if (fpop)   frp_q <= frp_q + 1'b1;
             fcnt_q <= fcnt_q + {{FP_W{1'b0}}, y5_v_q} - {{FP_W{1'b0}}, fpop};
             res_q  <= res_q + {{FP_W{1'b0}}, ev_go} - {{FP_W{1'b0}}, fpop};
-            if (fpop) l0_v_q <= 1'b1;
-            else if (l1_ld) l0_v_q <= 1'b0;
-            if (l1_ld) l1_v_q <= 1'b1;
-            else if (l2_ld) l1_v_q <= 1'b0;
+            if (adv) begin
+                l0_v_q <= fpop;
+                lg_v_q <= l0_v_q;
+                l1_v_q <= lg_v_q;
+            end
             if (l2_ld) l2_v_q <= 1'b1;
             else if (step) l2_v_q <= 1'b0;
 
@@ -1655,15 +1760,25 @@ module fmt_blob #(
                 arr_q[pb_q]  <= {ROWS{1'b0}};
                 eofs_q[pb_q] <= 1'b0;
                 pb_q         <= ~pb_q;
-                // an aborted frame leaves labels behind: start clean
-                p_q     <= {(COLS*LBL_W){1'b0}};
-                c_q     <= {(COLS*LBL_W){1'b0}};
-                livep_q <= {NL{1'b0}};
-                livec_q <= {NL{1'b0}};
+                // an aborted frame leaves labels behind: start clean (P, C, the live
+                // masks and alias by clrc_q, one cycle later)
                 free_q  <= {NL{1'b1}};
                 n0v_q   <= 1'b0;
-                alias_q <= alias_id;
             end
+        end
+        // the label vectors cleared one cycle after a reset or a release (no event is
+        // in L0..L2 then, nor in the cycle after), by registered copies per GS columns,
+        // per alias group and for the live masks
+        for (i = 0; i < COLS; i = i + 1)
+            if (clrc_q[i/GS]) begin
+                p_q[i*LBL_W +: LBL_W] <= {LBL_W{1'b0}};
+                c_q[i*LBL_W +: LBL_W] <= {LBL_W{1'b0}};
+            end
+        for (i = 1; i <= NL; i = i + 1)
+            if (clrc_q[NG + (i-1)/ALG]) alias_q[(i-1)*LBL_W +: LBL_W] <= alias_id[(i-1)*LBL_W +: LBL_W];
+        if (clrc_q[VC]) begin
+            livep_q <= {NL{1'b0}};
+            livec_q <= {NL{1'b0}};
         end
     end
 
