@@ -187,10 +187,10 @@ async def random_ops(dut):
                          [(1, 4, 1, 1, 0, 1, 0), (3, 4, 0, 1, 0, 1, 0), (8, 4, 1, 1, 0, 1, 0),
                           (5, 0, 0, 1, 0, 1, 0), (4, 3, 1, 0, 0, 1, 0), (1, 4, 1, 1, 1, 1, 0),
                           (8, 4, 1, 1, 1, 1, 0), (5, 3, 0, 1, 1, 1, 0), (8, 4, 1, 1, 1, 4, 0),
-                          (5, 3, 0, 1, 1, 2, 0), (8, 4, 1, 1, 1, 4, 1), (1, 4, 1, 1, 1, 1, 1)],
+                          (5, 3, 0, 1, 1, 2, 0), (8, 4, 1, 1, 1, 4, 1)],
                          ids=["k1_idx", "k3", "k8_idx", "k5_nopay", "k4_idx_nopop",
                               "k1_idx_early", "k8_idx_early", "k5_early", "k8_idx_early_cp4",
-                              "k5_early_cp2", "k8_idx_early_cp4_ahead", "k1_idx_early_ahead"])
+                              "k5_early_cp2", "k8_idx_early_cp4_ahead"])
 def test_fmt_sorted_list(sim, k, pay_w, pay_rst_idx, has_pop, early, cp, ahead):
     p = {"K": k, "KEY_W": 4, "TIE_W": 3, "PAY_W": pay_w, "PAY_RST_IDX": pay_rst_idx,
          "HAS_POP": has_pop, "EARLY": early, "NXT_CP": cp, "AHEAD_IN": ahead}
