@@ -865,7 +865,7 @@ module fmt_blob #(
     wire [LBL_W-1:0] y1 = l1_hit ? lrun : ((do_merge && eqa) ? x_q : ya);
     // L0, LG, L1 and L2 advance together (a bubble moves too) unless L2 waits (a NEW
     // without a free label): adv; the wide loads of the stages' registers take kept
-    // copies of it, registered from its next value (no logic in front of the enables)
+    // copies of it, registered from its next value (no gates in front of the enables)
     assign           adv   = !l2_v_q || step;
     wire             l2_ld = l1_v_q && adv;
     // the event L2 loads is a merge with y1 != x (x after this cycle's step): y1 is lrun
