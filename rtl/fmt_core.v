@@ -165,7 +165,8 @@ module fmt_core #(
     wire        tone_tw_we, tone_amp_we, tone_tw_re, tone_amp_re;
     wire [31:0] tone_tw_wdata;
     wire [8:0]  tone_amp_wdata;
-    wire [15:0] r_threshold, r_max_jump, r_hold_jump, r_blob_thr;
+    wire [15:0] r_threshold, r_max_jump, r_hold_jump, r_blob_thr, r_on_thr;
+    wire [2:0]  r_confirm;
     wire [2:0]  r_mode;
     wire [11:0] r_hold_off, r_blob_min;
     wire [3:0]  r_vel_shift;
@@ -337,6 +338,7 @@ module fmt_core #(
         .threshold_i(r_threshold[HM_W-1:0]), .moore_i(r_mode[0]), .limit_i(limit),
         .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .hold_jump_i(r_hold_jump),
         .hold_off_i(r_hold_off), .vel_shift_i(r_vel_shift), .max_speed_i(r_max_speed),
+        .on_thr_i(r_on_thr[HM_W-1:0]), .confirm_i(r_confirm),
         .delay_i(r_lat_dial), .report_period_i(r_report_period),
         .blob_en_i(r_mode[2]), .blob_threshold_i(r_blob_thr[HM_W-1:0]),
         .blob_min_cells_i({4'd0, r_blob_min}),
@@ -503,7 +505,8 @@ module fmt_core #(
         .track_max_jump_o(r_max_jump), .track_hold_jump_o(r_hold_jump),
         .track_hold_off_o(r_hold_off), .track_vel_shift_o(r_vel_shift),
         .track_max_speed_o(r_max_speed), .blob_threshold_o(r_blob_thr),
-        .blob_min_cells_o(r_blob_min), .cal_row_o(r_cal_row), .cal_col_o(r_cal_col),
+        .blob_min_cells_o(r_blob_min), .touch_on_threshold_o(r_on_thr),
+        .track_confirm_o(r_confirm), .cal_row_o(r_cal_row), .cal_col_o(r_cal_col),
         .cal_offset_we_o(cal_off_we), .cal_offset_wdata_o(cal_off_wdata), .cal_offset_re_o(cal_off_re),
         .cal_offset_rdata_i(rb_off_q),
         .cal_gain_we_o(cal_gain_we), .cal_gain_wdata_o(cal_gain_wdata), .cal_gain_re_o(cal_gain_re),

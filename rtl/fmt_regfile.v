@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0xA9D2.
+// Register map id 0xB9E7.
 `default_nettype none
 
 module fmt_regfile (
@@ -42,6 +42,8 @@ module fmt_regfile (
     output reg  [20:0] track_max_speed_o,           // TRACK_MAX_SPEED (rw): Velocity clamp per axis, 2^-(8+VF) cells per frame (default 3000
     output reg  [15:0] blob_threshold_o,            // BLOB_THRESHOLD (rw): Cells above this belong to a connected region (blob detection)
     output reg  [11:0] blob_min_cells_o,            // BLOB_MIN_CELLS (rw): A region of at least this many cells is reported as a blob
+    output reg  [15:0] touch_on_threshold_o,        // TOUCH_ON_THRESHOLD (rw): Activation threshold: a touch starts a new contact only at least this strong (counts); TOUCH_THRESHOLD is the deactivation threshold of a continuing contact (on_thr_i)
+    output reg  [2:0] track_confirm_o,              // TRACK_CONFIRM (rw): Frames a new contact must be seen (matched in consecutive frames) before its new event; 1 = at once, 0 is taken as 1; a contact missing before that is dropped without events (confirm_i)
     output reg  [4:0] cal_row_o,                    // CAL_ROW (rw): Row of the calibration windows (cal_row_i)
     output reg  [5:0] cal_col_o,                    // CAL_COL (rw): Column of the calibration windows (cal_col_i)
     output wire cal_offset_we_o,                    // CAL_OFFSET (window): write strobe
@@ -108,6 +110,8 @@ module fmt_regfile (
     localparam [15:0] A_TRACK_MAX_SPEED = 16'h0027;
     localparam [15:0] A_BLOB_THRESHOLD = 16'h0028;
     localparam [15:0] A_BLOB_MIN_CELLS = 16'h0029;
+    localparam [15:0] A_TOUCH_ON_THRESHOLD = 16'h002A;
+    localparam [15:0] A_TRACK_CONFIRM = 16'h002B;
     localparam [15:0] A_CAL_ROW = 16'h0030;
     localparam [15:0] A_CAL_COL = 16'h0031;
     localparam [15:0] A_CAL_OFFSET = 16'h0032;
@@ -161,6 +165,8 @@ module fmt_regfile (
     wire wr_track_max_speed = reg_we_i && (reg_addr_i == A_TRACK_MAX_SPEED);
     wire wr_blob_threshold = reg_we_i && (reg_addr_i == A_BLOB_THRESHOLD);
     wire wr_blob_min_cells = reg_we_i && (reg_addr_i == A_BLOB_MIN_CELLS);
+    wire wr_touch_on_threshold = reg_we_i && (reg_addr_i == A_TOUCH_ON_THRESHOLD);
+    wire wr_track_confirm = reg_we_i && (reg_addr_i == A_TRACK_CONFIRM);
     wire wr_cal_row = reg_we_i && (reg_addr_i == A_CAL_ROW);
     wire wr_cal_col = reg_we_i && (reg_addr_i == A_CAL_COL);
     wire wr_cal_offset = reg_we_i && (reg_addr_i == A_CAL_OFFSET);
@@ -209,6 +215,8 @@ module fmt_regfile (
             track_max_speed_o <= 21'h000F19;
             blob_threshold_o <= 16'h03E8;
             blob_min_cells_o <= 12'h00C;
+            touch_on_threshold_o <= 16'h09C4;
+            track_confirm_o <= 3'h2;
             cal_row_o <= 5'h00;
             cal_col_o <= 6'h00;
             latency_dial_o <= 32'h00000000;
@@ -232,6 +240,8 @@ module fmt_regfile (
             if (wr_track_max_speed) track_max_speed_o <= reg_wdata_i[20:0];
             if (wr_blob_threshold) blob_threshold_o <= reg_wdata_i[15:0];
             if (wr_blob_min_cells) blob_min_cells_o <= reg_wdata_i[11:0];
+            if (wr_touch_on_threshold) touch_on_threshold_o <= reg_wdata_i[15:0];
+            if (wr_track_confirm) track_confirm_o <= reg_wdata_i[2:0];
             if (wr_cal_row) cal_row_o <= reg_wdata_i[4:0];
             if (wr_cal_col) cal_col_o <= reg_wdata_i[5:0];
             if (wr_latency_dial) latency_dial_o <= reg_wdata_i[31:0];
@@ -267,6 +277,8 @@ module fmt_regfile (
                 A_TRACK_MAX_SPEED: reg_rdata_o <= {11'h0, track_max_speed_o};
                 A_BLOB_THRESHOLD: reg_rdata_o <= {16'h0, blob_threshold_o};
                 A_BLOB_MIN_CELLS: reg_rdata_o <= {20'h0, blob_min_cells_o};
+                A_TOUCH_ON_THRESHOLD: reg_rdata_o <= {16'h0, touch_on_threshold_o};
+                A_TRACK_CONFIRM: reg_rdata_o <= {29'h0, track_confirm_o};
                 A_CAL_ROW: reg_rdata_o <= {27'h0, cal_row_o};
                 A_CAL_COL: reg_rdata_o <= {26'h0, cal_col_o};
                 A_CAL_OFFSET: reg_rdata_o <= {16'h0, cal_offset_rdata_i};

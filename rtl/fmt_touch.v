@@ -84,6 +84,8 @@ module fmt_touch #(
     input  wire [HOLD_W-1:0]     hold_off_i,         // frames missing before lift
     input  wire [3:0]            vel_shift_i,        // velocity filter gain 2^-S
     input  wire [V_W-2:0]        max_speed_i,        // velocity clamp
+    input  wire [HM_W-1:0]       on_thr_i,           // activation threshold of a new contact
+    input  wire [2:0]            confirm_i,          // frames a new contact is seen before its event
     input  wire [TIME_W-1:0]     delay_i,            // dial-a-latency (cycles)
     input  wire [TIME_W-1:0]     report_period_i,    // min cycles between reported frames
     input  wire                  blob_en_i,          // 1: blob detection, finger removal, blob events
@@ -151,10 +153,10 @@ module fmt_touch #(
     //     candidate, blob-list and blob-mask streams; the fine touches' blob_en is the
     //     candidates' delayed by fmt_interp's latency, the events' is registered at the
     //     tracker frame's first beat (no table read in front of the tracker);
-    //   tracker: its five settings in a register, loaded after the frame's cand_eof
+    //   tracker: its seven settings in a register, loaded after the frame's cand_eof
     //     once the tracker is idle (before the frame's first touch reaches it).
     localparam FLAT_LAT = 5;                           // fmt_flatten's fixed latency
-    localparam TRK_W    = 16 + 16 + HOLD_W + 4 + (V_W - 1);   // tracker settings
+    localparam TRK_W    = HM_W + 3 + 16 + 16 + HOLD_W + 4 + (V_W - 1);   // tracker settings
     localparam IN_W     = HM_W + 1 + LIM_W + HM_W + 16;       // intake settings
     reg                    in_q;                       // a frame is arriving (row .. eof)
     wire                   first_row = hm_valid_i && !in_q;
@@ -172,7 +174,8 @@ module fmt_touch #(
     always @(posedge clk) begin
         if (first_row) begin
             sti_mem[fi] <= {threshold_i, moore_i, limit_i, blob_threshold_i, blob_min_cells_i};
-            stt_mem[fi] <= {max_jump_i, hold_jump_i, hold_off_i, vel_shift_i, max_speed_i};
+            stt_mem[fi] <= {on_thr_i, confirm_i, max_jump_i, hold_jump_i, hold_off_i, vel_shift_i,
+                            max_speed_i};
         end
     end
 
@@ -475,8 +478,10 @@ module fmt_touch #(
             if ((g_valid || g_eof) && !tin_q) bk_q <= ben_v[g_frame[1:0]];
         end
     end
-    wire [15:0]            max_jump_f  = trk_set_q[TRK_W-1 -: 16];
-    wire [15:0]            hold_jump_f = trk_set_q[TRK_W-17 -: 16];
+    wire [HM_W-1:0]        on_thr_f    = trk_set_q[TRK_W-1 -: HM_W];
+    wire [2:0]             confirm_f   = trk_set_q[TRK_W-HM_W-1 -: 3];
+    wire [15:0]            max_jump_f  = trk_set_q[TRK_W-HM_W-4 -: 16];
+    wire [15:0]            hold_jump_f = trk_set_q[TRK_W-HM_W-20 -: 16];
     wire [HOLD_W-1:0]      hold_off_f  = trk_set_q[4+V_W-1 +: HOLD_W];
     wire [3:0]             vel_shift_f = trk_set_q[V_W-1 +: 4];
     wire [V_W-2:0]         max_speed_f = trk_set_q[V_W-2:0];
@@ -485,7 +490,8 @@ module fmt_touch #(
                   .VF(VF), .V_W(V_W), .HOLD_W(HOLD_W)) u_tracker (
         .clk(clk), .rst(rst),
         .max_jump_i(max_jump_f), .hold_jump_i(hold_jump_f), .hold_off_i(hold_off_f),
-        .vel_shift_i(vel_shift_f), .max_speed_i(max_speed_f),
+        .vel_shift_i(vel_shift_f), .max_speed_i(max_speed_f), .on_thr_i(on_thr_f),
+        .confirm_i(confirm_f),
         .tp_valid_i(g_valid), .tp_frame_i(g_frame), .tp_x_i(g_x), .tp_y_i(g_y),
         .tp_strength_i(g_strength), .tp_axis_major_i(g_major), .tp_axis_minor_i(g_minor),
         .tp_angle_i(g_angle), .tp_flags_i(g_flags), .tp_eof_i(g_eof),

@@ -34,33 +34,42 @@
 //            assignment meanwhile).  Empty queue, nothing in flight: MATCH ends.
 //            The loop is only the head's compare-and-select: no search in the loop.
 //   EV       from the cycle after MATCH ends: one lift per cycle (lowest slot first,
-//            active, unmatched, miss + 1 >= hold_off_i), then one new per cycle
-//            (unmatched touches in arrival order; the first free slot after the
-//            round-robin pointer; generation + 1; no free slot: dropped, sticky
-//            noslot_flag_o).  Every mask keeps its lowest set bit (the next pick)
-//            and "not empty" in registers, computed the cycle before.
+//            active, unmatched, tentative or miss + 1 >= hold_off_i), then one new
+//            per cycle (unmatched touches at least on_thr_i strong, in arrival order;
+//            the first free slot after the round-robin pointer; generation + 1; no
+//            free slot: dropped, sticky noslot_flag_o).  Every mask keeps its lowest
+//            set bit (the next pick) and "not empty" in registers, computed the cycle
+//            before.
+//   Confirmation (confirm_i >= 2): a new slot is tentative (seen 1 frame); its moves
+//            count frames seen and the one that makes confirm_i is reported as 'new';
+//            until then its operations emit nothing, and it is lifted without an
+//            event the first frame it is not matched (no hold-off).
 //   UPD      then one slot per cycle in hold-off (active, neither matched nor new):
 //            miss + 1, p += v; busy_o falls when the update pipeline has drained.
 // Every move / lift / new / update is an operation: issued into a register, released
-// (stage E1: LUT-RAM reads, the event out, miss counter) when the next operation is
-// issued or the frame's events end (ev_last_o), then fmt_tracker_vel E2..E4
+// (stage E1: LUT-RAM reads, the event, miss counter, tentative count) when the next
+// operation is issued or the frame's events end, then fmt_tracker_vel E2..E4
 // (velocity filter, e = (x << VF) - p; v = clamp(v + (e >>> vel_shift_i),
 // +-max_speed_i); p = (x << VF) + v; p, v written) and E5 (the prediction rounded into
-// its registers).  No multiplier, no block RAM.
+// its registers).  E1's event (if reported) waits in a hold register: it goes out when
+// the frame's next reported event comes, or marked ev_last_o in the cycle after the
+// events end (so a frame whose last operations report nothing still ends with
+// ev_last_o on its last event).  No multiplier, no block RAM.
 //
 // Latency (tp_eof in cycle c, the frame's last touch in cycle a <= c; SB = 4 at 16
 // slots): first MATCH decision in cycle d0 = max(c + 1, a + SB + 3); without stale
 // pops MATCH ends m cycles later (m moves); l lifts and n news take one cycle each;
-// the last event is on the output in cycle d0 + m + l + n + 1 + e (e = 1 if l + n > 0:
+// the last event is on the output in cycle d0 + m + l + n + 2 + e (e = 1 if l + n > 0:
 // lifts and news start the cycle after MATCH ends, so that their masks and picks come
-// from registers only), i.e. m + l + n + 7 + e cycles after tp_eof when the last touch
-// came the cycle before (was m + 2k + l + n + d + 4 with k stale picks and d touches
-// without a slot, which now cost nothing).
+// from registers only; l and n count every lift and new operation, also the silent
+// ones of tentative contacts), i.e. m + l + n + 8 + e cycles after tp_eof when the last
+// touch came the cycle before (was m + 2k + l + n + d + 4 with k stale picks and d
+// touches without a slot, which now cost nothing; + 1 since the event hold).
 // Stale pops: 1 cycle each, and the round waits for the last recomputed key (SB + 1
 // cycles).  Worst case (16 touches ranking 16 slots alike: 120 stale pops): MATCH 211,
-// last event 218 cycles after tp_eof (was 260), busy 4 cycles more; with the 16 touch
-// cycles, 238 of a frame's 768.  busy_o falls 4 cycles after the last event with no
-// contact in hold-off, h + 5 with h.  A frame with no events emits nothing.  Touches of
+// last event 219 cycles after tp_eof (was 260), busy 3 cycles more; with the 16 touch
+// cycles, 238 of a frame's 768.  busy_o falls 3 cycles after the last event with no
+// contact in hold-off, h + 4 with h.  A frame with no events emits nothing.  Touches of
 // the next frame must not arrive before the tracker is idle again (overrun_flag_o;
 // they are dropped).  tp_frame_i is sampled with every touch and with tp_eof.
 //
@@ -88,6 +97,8 @@ module fmt_tracker #(
     input  wire [HOLD_W-1:0]     hold_off_i,       // frames missing before lift (0 acts as 1)
     input  wire [3:0]            vel_shift_i,      // velocity filter gain 2^-S, S <= VF
     input  wire [V_W-2:0]        max_speed_i,      // |v| clamp per axis, 2^-(8+VF) cells/frame
+    input  wire [HM_W-1:0]       on_thr_i,         // activation: a new contact needs this strength
+    input  wire [2:0]            confirm_i,        // frames seen before a new contact's event (0 = 1)
     // touch stream in (fmt_interp)
     input  wire                  tp_valid_i,       // one touch this cycle
     input  wire [FRAME_W-1:0]    tp_frame_i,       // frame number (with tp_valid and tp_eof)
@@ -210,6 +221,16 @@ module fmt_tracker #(
     reg [MT-1:0]        tused_q;                  // touch matched
     reg [MT-1:0]        sused_q;                  // slot matched or newly allocated
     reg [MT-1:0]        act_q;                    // slot active
+    reg [MT-1:0]        tstr_q;                   // touch at least on_thr_i strong (may start a contact)
+    reg [MT-1:0]        tent_q;                   // slot tentative (not reported yet)
+    reg [MT*3-1:0]      seen_q;                   // frames seen while tentative
+    reg                 cf1_q;                    // confirm_i <= 1: news reported at once
+    // the event hold: an event goes out when the frame's next reported event comes, or
+    // flagged last in the cycle after the events end (fl_q)
+    reg                 hev_v_q, fl_q;
+    reg [ID_W-1:0]      hev_id_q;
+    reg [1:0]           hev_typ_q;
+    reg [TD_W-1:0]      hev_d_q;
     reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
     reg [MT-1:0]        mz_q;                     // miss == 0 (gate select)
     reg [MT-1:0]        lexp_q;                   // miss + 1 >= hold-off (lift if unmatched)
@@ -226,6 +247,7 @@ module fmt_tracker #(
     reg                 l_any_q, u_any_q, f_any_q, p_any_q;       // masks not empty
     // arrival: A1 distances, A2 gate test and row write
     reg                 a1_v_q;
+    reg                 a1_str_q;                 // the touch is at least on_thr_i strong
     reg [SB-1:0]        a1_t_q;
     reg [MT*KW-1:0]     dq_q;                     // {D >= 2^16, D mod 2^16} per slot
     // row minimum: request (stage 0), tree stages 1..SB-1 (stage k < SB - 1 holds
@@ -243,6 +265,11 @@ module fmt_tracker #(
     // operation register (stage E1 when released) and the update pipeline E2..E5
     reg                 op_v_q;
     reg [1:0]           op_typ_q;
+    reg                 op_vis_q;                     // its event is reported
+    reg                 op_tnt_q;                     // a tentative slot's move
+    reg                 op_cnf_q;                     // ... that confirms it
+    reg [2:0]           op_seen_q;                    // ... its frames seen then
+    reg [1:0]           op_etyp_q;                    // event type (a confirming move: new)
     reg [SB-1:0]        op_t_q, op_s_q;               // touch, slot
     reg [MT-1:0]        op_so_q;                      // slot (one-hot)
     reg                 e2_v_q, e3_v_q, e4_v_q;
@@ -462,6 +489,9 @@ module fmt_tracker #(
     wire [MT-1:0] sused_n = sused_q | asg_s;
     wire [MT-1:0] tused_n = tused_q | asg_t;
     wire [MT-1:0] tval_n  = tval_q | (arrive ? (one << wa_t) : {MT{1'b0}});
+    // the activation compare is registered with the touch (A1): the news are decided
+    // after MATCH, long after
+    wire [MT-1:0] tstr_n  = tstr_q | ((a1_v_q && a1_str_q) ? (one << a1_t_q) : {MT{1'b0}});
 
     // lifts and news issue from the cycle after MATCH ends (EV), so the masks and their
     // picks update from registers only; a frame with none ends in the m_done cycle
@@ -484,8 +514,8 @@ module fmt_tracker #(
         if (state_q[0] || state_q[1]) begin
             // shadows of the pending lifts and news, exact when MATCH ends (no
             // assignment in that cycle, so they hold into EV)
-            lm_d  = act_q & ~sused_n & lexp_q;
-            um_d  = tval_n & ~tused_n;
+            lm_d  = act_q & ~sused_n & (lexp_q | tent_q);
+            um_d  = tval_n & tstr_n & ~tused_n;
             fm_d  = ~act_q;
             hm_d  = ~act_q & therm_q;
             src_d = (|hm_d) ? hm_d : fm_d;
@@ -509,6 +539,36 @@ module fmt_tracker #(
         else if (iss_upd)
             upm_d = upm_q & ~p_pick_q;
     end
+
+    // confirmation, decided when an operation is issued (the slot's tentative state then:
+    // a lift and a new of the same slot may follow each other, never two operations of
+    // one slot otherwise): a tentative slot's move counts one more frame seen and is
+    // reported as 'new' when that makes confirm_i, else not at all; a tentative slot's
+    // lift is not reported; a new is reported only with confirmation off (cf1_q)
+    reg           h_tent;                 // the head's slot: tentative, frames seen
+    reg  [2:0]    h_seen;
+    always @* begin : c_hsel
+        integer s_i;
+        h_tent = 1'b0;
+        h_seen = 3'd0;
+        for (s_i = 0; s_i < MT; s_i = s_i + 1)
+            if (h_s == s_i[SB-1:0]) begin
+                h_tent = tent_q[s_i];
+                h_seen = seen_q[s_i*3 +: 3];
+            end
+    end
+    wire [2:0]    h_seen1 = (h_seen == 3'd7) ? 3'd7 : h_seen + 1'b1;
+    wire          h_conf  = h_seen1 >= confirm_i;
+    wire          l_tent  = |(tent_q & l_pick_q);
+
+    // the issued operation: the four issue conditions exclude each other (MATCH, EV with
+    // a lift pending or not, UPD), so each field is an AND-OR of its four sources
+    wire [1:0]    iss_typ = {iss_lift | iss_upd, q_asg | iss_upd};   // T_MOVE 1, T_LIFT 2, T_UPD 3
+    wire [SB-1:0] iss_s   = ({SB{q_asg}} & h_s) | ({SB{iss_lift}} & enc(l_pick_q)) |
+                            ({SB{iss_new}} & enc(f_pick_q)) | ({SB{iss_upd}} & enc(p_pick_q));
+    wire [MT-1:0] iss_so  = asg_s | ({MT{iss_lift}} & l_pick_q) | ({MT{iss_new}} & f_pick_q) |
+                            ({MT{iss_upd}} & p_pick_q);
+    wire [SB-1:0] iss_t   = ({SB{q_asg}} & h_t) | ({SB{iss_new}} & enc(u_pick_q));
 
     // the held operation goes on when the next one is issued or the frame's events end
     // (in EV and UPD every cycle; in MATCH with an assignment or at the end)
@@ -534,7 +594,7 @@ module fmt_tracker #(
             e1_miss = e1_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{op_so_q[s_i]}});
         end
     end
-    wire             e1_ev = op_go & (op_typ_q != T_UPD);
+    wire             e1_ev = op_go & op_vis_q;
     always @(posedge clk) begin
         if (op_go && (op_typ_q == T_MOVE || op_typ_q == T_NEW))
             lmem[op_s] <= {t_x, t_y};
@@ -571,6 +631,15 @@ module fmt_tracker #(
             tused_q        <= {MT{1'b0}};
             sused_q        <= {MT{1'b0}};
             act_q          <= {MT{1'b0}};
+            tstr_q         <= {MT{1'b0}};
+            tent_q         <= {MT{1'b0}};
+            seen_q         <= {(MT*3){1'b0}};
+            cf1_q          <= 1'b1;
+            hev_v_q        <= 1'b0;
+            fl_q           <= 1'b0;
+            hev_id_q       <= {ID_W{1'b0}};
+            hev_typ_q      <= 2'd0;
+            hev_d_q        <= {TD_W{1'b0}};
             miss_q         <= {(MT*HOLD_W){1'b0}};
             mz_q           <= {MT{1'b1}};
             lexp_q         <= {MT{1'b0}};
@@ -594,6 +663,7 @@ module fmt_tracker #(
             p_any_q        <= 1'b0;
             inflight_q     <= 1'b0;
             a1_v_q         <= 1'b0;
+            a1_str_q       <= 1'b0;
             a1_t_q         <= {SB{1'b0}};
             dq_q           <= {(MT*KW){1'b0}};
             rv_q           <= {(SB+1){1'b0}};
@@ -608,6 +678,11 @@ module fmt_tracker #(
             key_q          <= {1'b1, {(NW-1){1'b0}}};
             op_v_q         <= 1'b0;
             op_typ_q       <= T_NEW;
+            op_vis_q       <= 1'b0;
+            op_tnt_q       <= 1'b0;
+            op_cnf_q       <= 1'b0;
+            op_seen_q      <= 3'd0;
+            op_etyp_q      <= T_NEW;
             op_t_q         <= {SB{1'b0}};
             op_s_q         <= {SB{1'b0}};
             op_so_q        <= {MT{1'b0}};
@@ -655,7 +730,10 @@ module fmt_tracker #(
                 overrun_flag_o <= 1'b1;
             end
             tval_q <= tval_n;
+            tstr_q <= tstr_n;
+            cf1_q  <= (confirm_i <= 3'd1);
             a1_v_q <= arrive;
+            a1_str_q <= (tp_strength_i >= on_thr_i);
             a1_t_q <= wa_t;
             dq_q   <= dsat;
 
@@ -711,8 +789,11 @@ module fmt_tracker #(
                 sused_q <= sused_q | f_pick_q;
                 therm_q <= ~(f_pick_q | (f_pick_q - 1'b1));
                 for (s_i = 0; s_i < MT; s_i = s_i + 1)
-                    if (f_pick_q[s_i])
+                    if (f_pick_q[s_i]) begin
                         gen_q[s_i*GEN_W +: GEN_W] <= gen_q[s_i*GEN_W +: GEN_W] + 1'b1;
+                        tent_q[s_i]               <= ~cf1_q;
+                        seen_q[s_i*3 +: 3]        <= 3'd1;
+                    end
             end
             if (m_done) state_q <= S_EV;
             if (ev_done) begin
@@ -722,6 +803,7 @@ module fmt_tracker #(
             if (state_q[3] && !p_any_q && drained) begin
                 tcnt_q  <= {TCW{1'b0}};
                 tval_q  <= {MT{1'b0}};
+                tstr_q  <= {MT{1'b0}};
                 tused_q <= {MT{1'b0}};
                 sused_q <= {MT{1'b0}};
                 state_q <= S_IDLE;
@@ -729,26 +811,16 @@ module fmt_tracker #(
 
             // ---- operation register ------------------------------------------------------
             if (iss) begin
-                op_v_q <= 1'b1;
-                if (q_asg) begin
-                    op_typ_q <= T_MOVE;
-                    op_t_q   <= h_t;
-                    op_s_q   <= h_s;
-                    op_so_q  <= asg_s;
-                end else if (iss_lift) begin
-                    op_typ_q <= T_LIFT;
-                    op_s_q   <= enc(l_pick_q);
-                    op_so_q  <= l_pick_q;
-                end else if (iss_new) begin
-                    op_typ_q <= T_NEW;
-                    op_t_q   <= enc(u_pick_q);
-                    op_s_q   <= enc(f_pick_q);
-                    op_so_q  <= f_pick_q;
-                end else begin
-                    op_typ_q <= T_UPD;
-                    op_s_q   <= enc(p_pick_q);
-                    op_so_q  <= p_pick_q;
-                end
+                op_v_q    <= 1'b1;
+                op_tnt_q  <= q_asg & h_tent;
+                op_cnf_q  <= h_conf;
+                op_seen_q <= h_seen1;
+                op_typ_q  <= iss_typ;
+                op_vis_q  <= (q_asg & (~h_tent | h_conf)) | (iss_lift & ~l_tent) | (iss_new & cf1_q);
+                op_etyp_q <= (q_asg & h_tent) ? T_NEW : iss_typ;
+                op_s_q    <= iss_s;
+                op_so_q   <= iss_so;
+                if (q_asg | iss_new) op_t_q <= iss_t;
             end else if (op_go) begin
                 op_v_q <= 1'b0;
             end
@@ -758,15 +830,33 @@ module fmt_tracker #(
                 if (op_go && op_typ_q != T_LIFT && op_so_q[s_i])
                     miss_q[s_i*HOLD_W +: HOLD_W] <= (op_typ_q == T_UPD) ? e1_miss + 1'b1
                                                                           : {HOLD_W{1'b0}};
-            ev_valid_o <= e1_ev;
+            // a tentative slot's move: seen + 1, confirmed (E1 and a new's issue never
+            // name the same slot: a new takes a free slot, a move an active one; and a
+            // slot's move is released before the slot can be matched again, next frame)
+            for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                if (op_go && op_tnt_q && op_so_q[s_i]) begin
+                    seen_q[s_i*3 +: 3] <= op_seen_q;
+                    if (op_cnf_q) tent_q[s_i] <= 1'b0;
+                end
+            // the event hold: E1's event waits for the next one (then the held one goes
+            // out) or for the cycle after the events end (then it goes out marked last)
+            fl_q <= ev_done;
             if (e1_ev) begin
+                hev_v_q   <= 1'b1;
+                hev_id_q  <= {e1_gen, op_s};
+                hev_typ_q <= op_etyp_q;
+                hev_d_q   <= (op_typ_q == T_LIFT) ? {lrec, {(TD_W-32){1'b0}}} : trec;
+            end else if (fl_q) begin
+                hev_v_q   <= 1'b0;
+            end
+            ev_valid_o <= hev_v_q & (e1_ev | fl_q);
+            if (hev_v_q & (e1_ev | fl_q)) begin
                 ev_frame_o <= frame_q;
-                ev_id_o    <= {e1_gen, op_s};
-                ev_type_o  <= op_typ_q;
+                ev_id_o    <= hev_id_q;
+                ev_type_o  <= hev_typ_q;
                 {ev_x_o, ev_y_o, ev_strength_o, ev_axis_major_o, ev_axis_minor_o,
-                 ev_angle_o, ev_flags_o} <= (op_typ_q == T_LIFT) ?
-                                            {lrec, {(TD_W-32){1'b0}}} : trec;
-                ev_last_o  <= ev_done;
+                 ev_angle_o, ev_flags_o} <= hev_d_q;
+                ev_last_o  <= fl_q;
             end
 
             // ---- E2..E5 ------------------------------------------------------------------

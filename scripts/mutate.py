@@ -100,6 +100,12 @@ MUTATIONS = {
         "dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~(mz_q[s_i] ? max_jump_i : hold_jump_i)} + 1'b1;",
         "fmt_tracker/test_fmt_tracker.py::test_fmt_tracker[icarus-small-5]",
         "a touch at distance D <= gate (equal included) is a match candidate"),
+    "tracker_confirm_late": (
+        "rtl/fmt_tracker.v",
+        "wire          h_conf  = h_seen1 >= confirm_i;",
+        "wire          h_conf  = h_seen1 > confirm_i;",
+        "fmt_tracker/test_fmt_tracker.py::test_fmt_tracker[icarus-small-5]",
+        "a new contact is reported in the frame it is seen for the confirm_frames-th time"),
 }
 
 

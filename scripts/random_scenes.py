@@ -139,7 +139,8 @@ def random_settings(rng, cfg) -> TouchSettings:
         max_jump_mm=_f(rng, 0.5, 30), hold_off_us=_f(rng, 0, 400),
         velocity_window_us=_f(rng, 0, 4000), max_speed_mm_s=_f(rng, 0, 6000),
         blobs=bool(rng.random() < 0.4), blob_threshold=int(rng.integers(1, 4000)),
-        blob_min_cells=int(rng.integers(1, 16)))
+        blob_min_cells=int(rng.integers(1, 16)),
+        on_threshold=int(rng.integers(0, 8000)), confirm_frames=int(rng.integers(1, 4)))
 
 
 def random_scene(seed: int, index: int, sensor: str):

@@ -337,6 +337,7 @@ def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
         ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_HOLD_JUMP", tp.hold_jump_q),
         ("TRACK_HOLD_OFF", tp.hold_off_frames), ("TRACK_VEL_SHIFT", tp.vel_shift),
         ("TRACK_MAX_SPEED", tp.max_speed_v),
+        ("TOUCH_ON_THRESHOLD", tp.on_threshold), ("TRACK_CONFIRM", tp.confirm_frames),
         ("BLOB_THRESHOLD", settings.blob_threshold), ("BLOB_MIN_CELLS", settings.blob_min_cells),
         ("LATENCY_DIAL", 0), ("REPORT_PERIOD", 0),
     ]
@@ -402,7 +403,8 @@ def _stats(v) -> dict:
 
 
 def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict, frames: int,
-            wall_s: float, out_dir: Path | None, plot: bool, cal, max_cycle: int | None = None) -> dict:
+            wall_s: float, out_dir: Path | None, plot: bool, cal, max_cycle: int | None = None,
+            confirm_frames: int = 1) -> dict:
     from fmt import run_sim as _run_sim
     cfg = scene.cfg
     clk_hz = cfg.fs_hz * cps
@@ -460,7 +462,7 @@ def analyse(scene: _scene.Scene, ref: Reference, d: Path, cps: int, status: dict
     # accuracy from the RTL events
     frame_events = [per.get(f & 0xFFFF, []) for f in range(min(frames, n_rtl))]
     det = _run_sim.detections(frame_events, cfg)
-    acc = _run_sim.evaluate(scene.replace(frames=len(det)), det)
+    acc = _run_sim.evaluate(scene.replace(frames=len(det)), det, confirm_frames)
     rate = None
     if len(eof) > 1:
         rate = (len(eof) - 1) / ((eof[-1][0] - eof[0][0]) / clk_hz)
@@ -736,6 +738,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
     cflags: the harness's job folder / build (tests use their own, at -O0)."""
     if serve is not None and not (engine == "cpp" and sim == "verilator"):
         raise ValueError("--serve needs the C++ harness (engine cpp, Verilator)")
+    settings = settings or scene.touch_settings()
     if pre is not None and not (engine == "cpp" and sim == "verilator"):
         raise ValueError("a busy core before the reset (pre) needs the C++ harness (engine cpp, Verilator)")
     frames = frames or scene.frames
@@ -746,7 +749,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
         d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet,
                                                       tag=tag, cflags=cflags, serve=serve, pre=pre)
         rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal,
-                      max_cycle=res.get("serve_start_cycle"))
+                      max_cycle=res.get("serve_start_cycle"), confirm_frames=settings.confirm_frames)
         if "serve" in res:
             rep["serve"] = dict(res["serve"], start_cycle=res["serve_start_cycle"])
         rep.update({"engine": "cpp", "build_s": build_s, "sim_clk_per_s": res["clk_per_s"],
@@ -772,7 +775,8 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
                testcase="run_scene", parameters=sim_parameters(scene.cfg, cps, d),
                extra_env=env, build_args=build_args(sim), tag="run_sim_rtl")
     res = json.loads((d / "result.json").read_text())
-    rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal)
+    rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal,
+                  confirm_frames=settings.confirm_frames)
     rep["model_s"] = t1 - t0
     rep["coupling_updates"] = n_upd
     rep["upd_late"] = res.get("upd_late")

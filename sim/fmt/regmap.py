@@ -132,6 +132,13 @@ REGISTERS: list[Reg] = [
       "Cells above this belong to a connected region (blob detection)."),
     R("BLOB_MIN_CELLS", 0x029, 12, "rw", SETTINGS.blob_min_cells,
       "A region of at least this many cells is reported as a blob."),
+    R("TOUCH_ON_THRESHOLD", 0x02A, CFG.hm_width, "rw", SETTINGS.on_threshold,
+      "Activation threshold: a touch starts a new contact only at least this strong (counts); "
+      "TOUCH_THRESHOLD is the deactivation threshold of a continuing contact (on_thr_i)."),
+    R("TRACK_CONFIRM", 0x02B, 3, "rw", SETTINGS.confirm_frames,
+      "Frames a new contact must be seen (matched in consecutive frames) before its new event; "
+      "1 = at once, 0 is taken as 1; a contact missing before that is dropped without events "
+      "(confirm_i)."),
     R("CAL_ROW", 0x030, _ROW_W, "rw", 0, "Row of the calibration windows (cal_row_i)."),
     R("CAL_COL", 0x031, _COL_W, "rw", 0, "Column of the calibration windows (cal_col_i)."),
     R("CAL_OFFSET", 0x032, CFG.hm_width, "window", 0,

@@ -219,7 +219,8 @@ def pooled_jitter(values, frames: int):
 # ---- the sweep ----------------------------------------------------------------------------------
 def settings_for(neigh: str, bias: bool, hm_w: int) -> TouchSettings:
     return TouchSettings(neighbourhood=neigh, bias_correction=bias,
-                         threshold=int(round(BASE_THRESHOLD * 2.0 ** (hm_w - 16))))
+                         threshold=int(round(BASE_THRESHOLD * 2.0 ** (hm_w - 16))),
+                         on_threshold=int(round(TouchSettings.on_threshold * 2.0 ** (hm_w - 16))))
 
 
 def calibrations(cfg, widths) -> dict:
@@ -261,7 +262,8 @@ def run_sweep(spec: SweepSpec, touch_clk: int = TOUCH_CLK_DEFAULT, progress=True
                 sat_any[key] = sat_any.get(key, False) or sat
                 evs = _touch.process_frames(hm, cw, settings_for(neigh, bias, w), fixed=True,
                                             flatten_cal=cal, frame_period_s=sc.frame_period_s)
-                ev = _run_sim.evaluate(sc, _run_sim.detections(evs, cw))
+                ev = _run_sim.evaluate(sc, _run_sim.detections(evs, cw),
+                                       settings_for(neigh, bias, w).confirm_frames)
                 acc.setdefault(key, []).append(ev)
             done += cost(m)
             if progress:

@@ -17,8 +17,10 @@ the true count's mean); ``position_error_mm`` against the scene's truth at each 
 centre time (detections matched to true contacts, nearest first, within
 ``MATCH_MM``): ``rms`` and ``max`` over contacts more than 3.5 mm from every edge,
 ``rms_edge`` / ``max_edge`` over contacts centred 1.5 - 3.5 mm from an edge, the counts;
-frames whose windows hold a contact's onset or lift (partial coupling) are left out of
-the errors, and a detection of such a contact there counts neither as false nor missed;
+frames whose windows hold a contact's onset or lift (partial coupling), and the first
+``confirm_frames - 1`` whole frames of a touch (the tracker's confirmation, whose cost
+the tap latency shows), are left out of the errors, and a detection of such a contact
+there counts neither as false nor missed;
 ``missed`` (true contacts touching the whole frame without a detection) / ``false``
 (detections matching no contact); ``jitter_mm`` (RMS distance about the mean position
 of each stationary, always-touching contact; the worst one and per contact);
@@ -129,13 +131,29 @@ def _rms(v):
     return float(math.sqrt(np.mean(np.square(v)))) if len(v) else None
 
 
-def evaluate(scene: _scene.Scene, det: list) -> dict:
-    """Accuracy, jitter, misses and tap latency of per-frame detections against the truth."""
+def confirming(act_frac, confirm_frames: int) -> np.ndarray:
+    """Frames of a contact that count as its onset: partial coupling (0 < fraction < 1),
+    and the first ``confirm_frames - 1`` whole frames after each onset, in which the
+    tracker's confirmation may still hold the new contact back (its stated latency)."""
+    a = np.asarray(act_frac, dtype=float)
+    out = (a > 0) & (a < 1)
+    run = 0
+    for f in range(len(a)):
+        run = run + 1 if a[f] >= 1 else 0
+        if 0 < run <= confirm_frames - 1:
+            out[f] = True
+    return out
+
+
+def evaluate(scene: _scene.Scene, det: list, confirm_frames: int = 1) -> dict:
+    """Accuracy, jitter, misses and tap latency of per-frame detections against the truth.
+    ``confirm_frames``: the tracker's confirmation (TouchSettings.confirm_frames): the
+    first confirm_frames - 1 whole frames of each touch count like its onset frame."""
     cfg = scene.cfg
     fs, spf = cfg.fs_hz, scene.samples_per_frame
     frames = len(det)
     edges = np.arange(frames + 1, dtype=np.int64) * spf
-    partial = [np.asarray([(0 < f < 1) for f in c.active_fraction(edges, fs)]) for c in scene.contacts]
+    partial = [confirming(c.active_fraction(edges, fs), confirm_frames) for c in scene.contacts]
     act = [np.asarray(c.active_fraction(edges, fs)) for c in scene.contacts]
     err_in, err_edge, missed, false = [], [], 0, 0
     pos = {i: [] for i in range(len(scene.contacts))}
@@ -282,7 +300,7 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
         "noise_sigma_lsb": float(res.noise_sigma),
         "events": int(sum(len(e) for e in evs)),
     }
-    rep.update(evaluate(scene, det))
+    rep.update(evaluate(scene, det, settings.confirm_frames))
     rep["touches"]["truth_mean"] = rep.pop("truth_touches_mean")
     if out_dir is not None:
         d = Path(out_dir) / scene.name

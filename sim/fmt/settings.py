@@ -16,6 +16,9 @@ class TouchSettings:
     threshold: int = 2000          # coarse-touch threshold on the flattened heat map (counts)
     neighbourhood: str = "moore"   # "moore" (3x3, Eq. 5-6) or "vn" (Von Neumann, Eq. 3-4)
     max_touches: int | None = None # contact limit; None = the sensor config's max_touches
+    on_threshold: int = 2500       # activation: a new contact needs a touch this strong (counts);
+                                   # ``threshold`` is the deactivation threshold of a continuing one
+    confirm_frames: int = 2        # a new contact is reported once seen in this many frames (1..7)
     bias_correction: bool = True   # sub-cell bias correction of the paraboloid fits
     # frame matching (physical units)
     max_jump_mm: float = 15.0      # a contact farther than this from its prediction is new
@@ -38,6 +41,7 @@ class TouchSettings:
         I.check_fields(d, {
             "threshold": I.is_int(0, 65535), "neighbourhood": I.is_str(("moore", "vn")),
             "max_touches": I.is_int(1, 255, none_ok=True), "bias_correction": I.is_bool,
+            "on_threshold": I.is_int(0, 65535), "confirm_frames": I.is_int(1, 7),
             "max_jump_mm": I.is_num(0, lo_open=True), "hold_off_us": I.is_num(0),
             "velocity_window_us": I.is_num(0), "max_speed_mm_s": I.is_num(0),
             "blobs": I.is_bool, "blob_threshold": I.is_int(0, 65535),

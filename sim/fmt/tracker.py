@@ -20,12 +20,22 @@ of the frame are dropped and counted):
    come back where it left, so a tap 10 mm away is a different contact (drumroll).
 3. greedy global nearest pairs: repeat { take the candidate pair of smallest D among
    unassigned touches and slots; ties go to the smallest ``t * max_touches + s`` },
-   each assignment emits a ``move`` event (in this order).
-4. lifts: every active, unmatched slot with ``miss + 1 >= hold_off_frames`` is freed
-   and emits a ``lift`` event (slot order) carrying its last measured x, y.
-5. news: every unassigned touch, in arrival order, takes a free slot (round-robin:
-   the first free slot at or after ``next_slot``, which then moves past it) and emits
-   ``new``; with no free slot the touch is dropped and counted.
+   each assignment emits a ``move`` event (in this order); for a *tentative* slot
+   (below) it counts one more frame seen and emits ``new`` (with the touch) when that
+   makes ``confirm_frames``, else nothing.
+4. lifts: every active, unmatched slot that is tentative or has ``miss + 1 >=
+   hold_off_frames`` is freed; a confirmed one emits a ``lift`` event (slot order)
+   carrying its last measured x, y, a tentative one none.
+5. news: every unassigned touch with ``strength >= on_threshold`` (the activation
+   threshold; the localmax threshold below it is the deactivation threshold of
+   continuing contacts), in arrival order, takes a free slot (round-robin: the first
+   free slot at or after ``next_slot``, which then moves past it) and emits ``new``;
+   with ``confirm_frames`` >= 2 the slot is tentative instead (seen 1 frame, no event,
+   no hold-off: freed silently the first frame it is not matched), so a touch that
+   lasts one frame (the spectral leakage of a finger landing or lifting inside a
+   window gives such touches beside it) never becomes a contact, at the cost of
+   ``confirm_frames - 1`` frames of touch-down latency.  With no free slot the touch
+   is dropped and counted.
 6. update.  Matched slot: ``e = (meas << VF) - p`` (the prediction error at full
    precision); ``v = clamp(v + (e >> S), +-max_speed_v)`` per axis (arithmetic shift =
    floor; an alpha-beta filter with g = 1, h = 2^-S, i.e. an exponential average of the
@@ -53,6 +63,7 @@ from .params import SensorConfig
 from .settings import TouchSettings
 
 EV_NEW, EV_MOVE, EV_LIFT, EV_BLOB = 0, 1, 2, 3
+CONFIRM_MAX = 7                         # confirm_frames limit (3-bit register)
 NO_CAND = np.iinfo(np.int64).max        # distance of a pair that is not a candidate
 EV_TYPES = ("new", "move", "lift", "blob")
 EV_CODE = {n: i for i, n in enumerate(EV_TYPES)}
@@ -114,6 +125,8 @@ class TrackParams:
     vel_shift: int = 8             # S: velocity filter gain 2^-S (<= vel_frac)
     max_speed_v: int = 3865        # velocity clamp per axis, units 2^-(8+VF) cells/frame
     vel_frac: int = 12             # VF: extra fractional bits of p and v (RTL parameter)
+    on_threshold: int = 0          # activation threshold: strength a touch needs to start a contact
+    confirm_frames: int = 1        # frames a new contact is seen before its 'new' (1 = at once; <= 7)
     max_touches: int = 16          # slots (RTL parameter MAX_TOUCHES)
     id_w: int = 8                  # ID width (RTL parameter)
     v_w: int = 22                  # velocity register width (signed, RTL parameter)
@@ -142,7 +155,8 @@ class TrackParams:
         mt = cfg.max_touches           # slots = the RTL parameter; the run-time limit is
                                        # applied to the candidates (fmt.localmax)
         args = dict(max_jump_q=min(c["max_jump_q"], 0xFFFF), hold_jump_q=c["max_jump_q"] // 4,
-                    hold_off_frames=hold, vel_shift=shift, max_speed_v=vmax, max_touches=mt)
+                    hold_off_frames=hold, on_threshold=s.on_threshold,
+                    confirm_frames=s.confirm_frames, vel_shift=shift, max_speed_v=vmax, max_touches=mt)
         args.update(kw)
         return cls(**args)
 
@@ -158,6 +172,8 @@ class _Slot:
     miss: int = 0
     lx: int = 0
     ly: int = 0
+    tent: bool = False            # tentative: not reported yet
+    seen: int = 0                 # frames seen while tentative
 
 
 @dataclass
@@ -165,6 +181,8 @@ class TrackerStats:
     dropped_touches: int = 0      # touches beyond max_touches in one frame
     no_slot: int = 0              # new touches with every slot taken
     frames: int = 0
+    lift_ops: int = 0             # slots freed in the last frame (also tentative ones: no event)
+    new_ops: int = 0              # slots allocated in the last frame (also tentative ones)
 
 
 class Tracker:
@@ -189,6 +207,7 @@ class Tracker:
             self.stats.dropped_touches += len(touches) - n
             touches = touches[:n]
         self.stats.frames += 1
+        self.stats.lift_ops = self.stats.new_ops = 0
         nt = len(touches)
         sl = self.slots
         events: list[TouchEvent] = []
@@ -209,15 +228,26 @@ class Tracker:
                 t_used[t] = True
                 matched_touch[s] = t
                 tt = touches[t]
-                events.append(TouchEvent(frame, self.slot_id(s), "move", tt.x_q, tt.y_q,
+                st = sl[s]
+                typ = "move"
+                if st.tent:
+                    st.seen = min(st.seen + 1, CONFIRM_MAX)
+                    if st.seen < p.confirm_frames:
+                        continue
+                    st.tent = False
+                    typ = "new"
+                events.append(TouchEvent(frame, self.slot_id(s), typ, tt.x_q, tt.y_q,
                                          tt.strength, tt.axis_major_q, tt.axis_minor_q,
                                          tt.angle, tt.flags))
         # 4. lifts
         for s in range(n):
             st = sl[s]
-            if st.active and matched_touch[s] < 0 and st.miss + 1 >= p.hold_off_frames:
+            if st.active and matched_touch[s] < 0 and (st.tent or st.miss + 1 >= p.hold_off_frames):
                 st.active = False
-                events.append(TouchEvent(frame, self.slot_id(s), "lift", st.lx, st.ly))
+                self.stats.lift_ops += 1
+                if not st.tent:
+                    events.append(TouchEvent(frame, self.slot_id(s), "lift", st.lx, st.ly))
+                st.tent = False
         # 6a. update matched slots (before news: a new slot is fresh state)
         vmax = p.max_speed_v
         sh = p.vel_shift
@@ -238,7 +268,7 @@ class Tracker:
                 st.py += st.vy
         # 5. news
         for t in range(nt):
-            if t_used[t]:
+            if t_used[t] or touches[t].strength < p.on_threshold:
                 continue
             s = self._alloc()
             if s < 0:
@@ -246,12 +276,16 @@ class Tracker:
                 continue
             tt = touches[t]
             st = sl[s]
+            self.stats.new_ops += 1
             st.active = True
             st.gen = (st.gen + 1) & ((1 << (p.id_w - p.slot_bits)) - 1)
             st.vx = st.vy = 0
             st.px, st.py = tt.x_q << vf, tt.y_q << vf
             st.miss = 0
             st.lx, st.ly = tt.x_q, tt.y_q
+            if p.confirm_frames > 1:
+                st.tent, st.seen = True, 1
+                continue
             events.append(TouchEvent(frame, self.slot_id(s), "new", tt.x_q, tt.y_q,
                                      tt.strength, tt.axis_major_q, tt.axis_minor_q,
                                      tt.angle, tt.flags))

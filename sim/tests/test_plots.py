@@ -8,6 +8,7 @@ import pytest
 
 from fmt import params, plots
 from fmt import scene as _scene
+from fmt.settings import TouchSettings
 from fmt.touch import process_frames
 
 
@@ -83,7 +84,9 @@ def test_animated_gif(tmp_path):
     for f in range(8):
         hm[f] += 9000 * np.exp(-((xx - (8 + f)) ** 2 + (yy - 12.3) ** 2) / (2 * 0.7 ** 2))
     hm = np.rint(hm).astype(np.int64)
-    evs = process_frames(hm, cfg, fixed=True, frame_period_s=cfg.window_s)
+    # new contacts reported at once (no confirmation frame): frame 0 has the finger
+    evs = process_frames(hm, cfg, TouchSettings(confirm_frames=1), fixed=True,
+                         frame_period_s=cfg.window_s)
     path = plots.animation_gif(hm, evs, cfg, tmp_path / "run.gif", fps=10)
     frames = iio.imread(path)
     assert frames.shape[0] == 8

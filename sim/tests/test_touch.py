@@ -30,7 +30,8 @@ def test_one_finger_moving(fixed):
     hm = render(cfg, [[(x, y, 8.0, 1.0)] for x, y in path] + [[]] * 40)
     out = process_frames(hm, cfg, TouchSettings(), fixed=fixed)
     types = [[e.type for e in f] for f in out]
-    assert types[0] == ["new"] and all(t == ["move"] for t in types[1:n])
+    # default confirmation: the contact is reported ('new') in its second frame
+    assert types[0] == [] and types[1] == ["new"] and all(t == ["move"] for t in types[2:n])
     ids = {e.id for f in out for e in f}
     assert len(ids) == 1
     assert sum(t == ["lift"] for t in types) == 1
@@ -67,8 +68,10 @@ def test_two_fingers_and_small_config():
     cfg = params.MEDIUM
     hm = render(cfg, [[(10, 10, 8.0, 1.0), (35, 25, 8.0, 1.0)]] * 5)
     out = process_frames(hm, cfg, TouchSettings(), fixed=True)
-    assert sorted(e.type for e in out[0]) == ["new", "new"]
-    assert all(sorted(e.type for e in f) == ["move", "move"] for f in out[1:])
+    assert out[0] == [] and sorted(e.type for e in out[1]) == ["new", "new"]
+    assert all(sorted(e.type for e in f) == ["move", "move"] for f in out[2:])
+    one = process_frames(hm, cfg, TouchSettings(confirm_frames=1), fixed=True)
+    assert sorted(e.type for e in one[0]) == ["new", "new"]
     assert all(e.frame == k for k, f in enumerate(out) for e in f)
 
 
@@ -78,7 +81,8 @@ def test_blob_stage_model_only():
     hm = render(cfg, [palm] * 2)
     out = process_frames(hm, cfg, TouchSettings(), fixed=True, blobs=True)
     assert [e.type for e in out[0]].count("blob") == 1
-    fingers = [e for e in out[0] if e.type != "blob"]
+    assert [e.type for e in out[0]] == ["blob"]          # the finger: reported from frame 1
+    fingers = [e for e in out[1] if e.type != "blob"]
     assert len(fingers) == 1 and abs(fingers[0].x_q / 256 * 5 - 30) < 1
 
 

@@ -321,3 +321,38 @@ def test_lazy_greedy_worst_case():
     # spread fingers, each nearest its own slot: no stale pick
     dm = np.array([[abs(s - t) * 500 + 3 for s in range(n)] for t in range(n)], dtype=np.int64)
     assert lazy_greedy(dm)[1] == 0
+
+
+def test_confirmation_and_activation():
+    """A touch seen in fewer than confirm_frames frames never becomes a contact (no new,
+    no lift); one seen confirm_frames frames is reported 'new' in the last of them; a
+    touch below on_threshold starts no contact, a contact continues below it."""
+    p = TrackParams(on_threshold=2500, confirm_frames=3, hold_off_frames=3)
+    a, ghost = tq(40, 40, 9000), tq(40, 49, 2600)
+    frames = [[a, ghost], [a], [a], [a], [tq(40, 40, 2100)], [], [], [],
+              [tq(90, 40, 2400)] * 1, [tq(90, 40, 2400)], [tq(90, 40, 2400)],   # weak: never
+              [tq(60, 60, 8000)], [tq(60, 60, 8000)], [], []]                     # 2 frames: never
+    out = run(frames, p)
+    types = [[e.type for e in f] for f in out]
+    assert types[:5] == [[], [], ["new"], ["move"], ["move"]], types
+    assert sum(t.count("lift") for t in types) == 1 and sum(t.count("new") for t in types) == 1
+    # confirm_frames = 1, on_threshold = 0: the old behaviour, the ghost is a contact
+    out1 = run(frames, TrackParams(hold_off_frames=3))
+    assert sum(e.type == "new" for f in out1 for e in f) == 4
+
+
+def test_tap_ghosts_sample():
+    """Alternating taps 8 / 15 / 30 mm apart through the signal chain (scripts/tap_ghosts.py,
+    a sample of its sweep): no ghost with the default confirmation; with it off and no
+    activation threshold the transition frames give ghosts (the check can fail)."""
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "scripts" / "tap_ghosts.py"
+    spec = importlib.util.spec_from_file_location("tap_ghosts", path)
+    tg = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tg)
+    kw = dict(timings=((20, 20), (20, 0)), angles=(0.0,), quiet=True)
+    on = tg.run([8, 15, 30], [1], None, **kw)
+    assert on["ghosts"] == 0 and on["swaps"] == 0 and on["lost"] == 0, on
+    off = tg.run([8, 15, 30], [1], TouchSettings(confirm_frames=1, on_threshold=0), **kw)
+    assert off["ghosts"] > 0, off

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fmt.settings import TouchSettings
 from fmt import params
 from fmt.host import events as E
 from fmt.host import recording as R
@@ -131,9 +132,11 @@ def test_view_recording_cli(scene, tmp_path):
     r = fmtctl("view", "--recording", str(f), "--png-dir", str(out), "--vmax", str(VMAX))
     assert r.returncode == 0, r.stderr
     pngs = sorted(out.glob("frame_*.png"))
-    assert len(pngs) == len(E.group(recs)) == len(hm)
+    # one picture per reported frame: the first confirm_frames - 1 frames report nothing
+    # (the new contacts are confirmed first)
+    assert len(pngs) == len(E.group(recs)) == len(hm) - (TouchSettings().confirm_frames - 1)
     from PIL import Image
-    img = np.asarray(Image.open(pngs[20]))
+    img = np.asarray(Image.open(pngs[sorted({r["frame"] for r in recs}).index(20)]))
     ren = V.Renderer(E.Sensor(CFG.rows, CFG.cols), vmax=VMAX)   # the same geometry
     for e in recs:
         if e["frame"] == 20 and e["type"] in ("new", "move"):

@@ -61,6 +61,8 @@ class TB(ClockedTB):
         d.hold_off_i.value = tp.hold_off_frames
         d.vel_shift_i.value = tp.vel_shift
         d.max_speed_i.value = tp.max_speed_v
+        d.on_thr_i.value = tp.on_threshold
+        d.confirm_i.value = tp.confirm_frames
         d.blob_threshold_i.value = st.blob_threshold
         d.blob_min_cells_i.value = st.blob_min_cells
 

@@ -60,6 +60,8 @@ class TB(ClockedTB):
         d.hold_off_i.value = p.hold_off_frames
         d.vel_shift_i.value = p.vel_shift
         d.max_speed_i.value = p.max_speed_v
+        d.on_thr_i.value = p.on_threshold
+        d.confirm_i.value = p.confirm_frames
 
     async def _count(self):
         while True:
@@ -194,19 +196,19 @@ def match_cycles(dm, sb: int) -> tuple[int, int]:
         c += 1
 
 
-def tail_latency(events, dm, eof: int, last_touch, sb: int) -> tuple[int, int]:
+def tail_latency(ops, dm, eof: int, last_touch, sb: int) -> tuple[int, int]:
     """RTL timing: tp_eof sampled by edge ``eof`` -> the frame's last event on the output
     after edge eof + lat - 1 (a plain register would be lat = 1).  The last touch (edge
     ``last_touch``) has its key in the queue sb + 3 cycles later (A1 distances, A2 row
     write, sb tree stages, insert), MATCH starts the cycle after tp_eof: first decision
     d0 = max(1, last_touch + sb + 3 - eof) cycles after it; then match_cycles; then, if
     the frame has lifts or news, one cycle (they issue from the cycle after MATCH ends)
-    and one cycle per lift and new; and the cycle that marks the last event.
-    Returns (lat, stale pops)."""
+    and one cycle per lift and new (``ops`` = lift + new operations, also the tentative
+    contacts' silent ones); the cycle that ends the events, and the event hold's cycle
+    that marks the last event.  Returns (lat, stale pops)."""
     mc, pops = match_cycles(dm, sb) if dm is not None else (0, 0)
     d0 = max(1, last_touch + sb + 3 - eof) if last_touch is not None else 1
-    ln = sum(1 for e in events if e.type in ("lift", "new"))
-    return d0 + mc + ln + (1 if ln else 0) + 1, pops
+    return d0 + mc + ops + (1 if ops else 0) + 2, pops
 
 
 async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=None,
@@ -230,14 +232,15 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
             # cycle c + lat (a plain register would be lat = 1)
             lat = got[-1][0] - eof + 1
-            exp_lat, pops = tail_latency(exp, dm, eof, tb.last_touch, tree_stages(tb.mt))
+            ops = model.stats.lift_ops + model.stats.new_ops
+            exp_lat, pops = tail_latency(ops, dm, eof, tb.last_touch, tree_stages(tb.mt))
             assert lat == exp_lat, \
                 f"tail latency {lat} (model {exp_lat}) for {len(got)} events, {pops} stale pops"
             # the update of the h contacts in hold-off (active, missed this frame), one
-            # issued per cycle, then the E2..E4 pipeline drains: busy_o low 4 cycles after
-            # the last event (h = 0), h + 5 (h > 0)
+            # issued per cycle, then the E2..E4 pipeline drains: busy_o low 3 cycles after
+            # the last event (h = 0), h + 4 (h > 0)
             h = sum(1 for st in model.slots if st.active and st.miss > 0)
-            assert tb.idle_cycle - got[-1][0] == (h + 5 if h else 4), "busy after the last event"
+            assert tb.idle_cycle - got[-1][0] == (h + 4 if h else 3), "busy after the last event"
             tail.append((len(got), stale, pops, lat, tb.idle_cycle - eof))
         tb.stale_total += stale
     return model, tail
@@ -265,6 +268,8 @@ async def random_streams(dut):
                         hold_off_frames=rng.choice([1, 2, 4, 7]),
                         vel_shift=rng.choice([0, 1, 3, 8, 12]),
                         max_speed_v=rng.choice([1000, 1 << 16, (1 << 21) - 1]),
+                        on_threshold=rng.choice([0, 0, 9000, 30000]),
+                        confirm_frames=rng.choice([1, 1, 2, 3, 7]),
                         max_touches=mt)
         tb.set_params(p)
         await tb.reset()
@@ -353,6 +358,43 @@ async def scripted_scenarios(dut):
     await run_frames(tb, p, frames)
     types = [x[1][2] for x in tb.events[n0:]]
     assert types.count(0) == 1 and types.count(2) == 1      # one new, one lift
+
+
+@cocotb.test()
+async def confirm_and_activation(dut):
+    """Confirmation and the activation threshold: touches that last fewer than
+    confirm_frames frames (the transition ghosts beside a landing or lifting finger
+    last one) never become contacts and leave no lift; a finger seen confirm_frames
+    frames is reported ('new') in the last of them; a touch below on_threshold starts no
+    contact, but a contact goes on below it.  Bit-exact with the model, tail latency
+    included."""
+    tb = TB(dut)
+    mt = tb.mt
+    for conf in (2, 3):
+        p = TrackParams(max_jump_q=q(15), hold_jump_q=q(4), hold_off_frames=4, vel_shift=2,
+                        on_threshold=2500, confirm_frames=conf, max_touches=mt)
+        tb.set_params(p)
+        await tb.reset()
+        A, B = (q(40), q(40)), (q(60), q(40))
+        frames = [[Touch(*A, 7000), Touch(A[0], A[1] + q(9), 2600)]]       # A lands, a ghost
+        frames += [[Touch(*A, 10000)] for _ in range(5)]
+        frames += [[Touch(*A, 6000), Touch(A[0], A[1] - q(9), 2600)]]      # A lifts, a ghost
+        frames += [[] for _ in range(6)]
+        frames += [[Touch(*B, 2000)] for _ in range(4)]                     # too weak to start
+        frames += [[Touch(*B, 9000)] for _ in range(4)]
+        frames += [[Touch(*B, 2100)] for _ in range(4)]                     # fading: goes on
+        frames += [[] for _ in range(6)]
+        frames += [[Touch(q(80), q(80), 8000)] for _ in range(conf - 1)]    # a short blip
+        frames += [[] for _ in range(3)]
+        n0 = len(tb.events)
+        await run_frames(tb, p, frames)
+        got = [x[1] for x in tb.events[n0:]]
+        news = [g for g in got if g[2] == 0]
+        lifts = [g for g in got if g[2] == 2]
+        assert [(g[0], g[3]) for g in news] == [(conf - 1, A[0]), (17 + conf - 1, B[0])], got
+        assert len(lifts) == 2 and all(g[4] == A[1] or g[4] == B[1] for g in lifts), got
+        moves_b = [g for g in got if g[2] == 1 and g[3] == B[0]]
+        assert len(moves_b) == 4 - conf + 4, got          # B's moves, also the weak ones
 
 
 @cocotb.test()

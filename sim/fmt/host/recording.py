@@ -64,7 +64,10 @@ def settings_from_registers(regs: dict, cfg) -> tuple[dict, bool]:
                        blobs=bool(mode & 4),
                        max_touches=int(regs["CONTACT_LIMIT"]) if "CONTACT_LIMIT" in regs else None,
                        blob_threshold=int(regs.get("BLOB_THRESHOLD", TouchSettings.blob_threshold)),
-                       blob_min_cells=int(regs.get("BLOB_MIN_CELLS", TouchSettings.blob_min_cells)))
+                       blob_min_cells=int(regs.get("BLOB_MIN_CELLS", TouchSettings.blob_min_cells)),
+                       on_threshold=int(regs.get("TOUCH_ON_THRESHOLD", TouchSettings.on_threshold)),
+                       confirm_frames=min(7, max(1, int(regs.get("TRACK_CONFIRM",
+                                                                 TouchSettings.confirm_frames)))))
     exact = False
     if cfg is not None:
         m = max(1, int(regs.get("WINDOWS_M", 1)))
