@@ -549,10 +549,31 @@ def drumroll_scene() -> Scene:
         ])
 
 
+def taps8_scene() -> Scene:
+    """Fast alternating taps 8 mm apart, B landing in the frame A lifts (and back), every
+    landing and lift inside a window: the transition frames that gave ghost contacts
+    before the touch-down confirmation (issue #11 item 4)."""
+    cfg = _params.DEFAULT
+    f = lambda k: _frames_s(cfg, k)
+    return Scene(
+        name="taps8", sensor="default", frames=200, seed=8,
+        description="alternating taps 8 mm apart, 20 frames each, B lands as A lifts",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
+        contacts=[
+            Contact(name="A", path=[[0.0, 80.0, 70.0]],
+                    active={"repeat": {"first_s": f(10), "period_s": f(40), "on_s": f(20), "count": 4,
+                                       "step_samples": 31}}),
+            Contact(name="B", path=[[0.0, 88.0, 70.0]],
+                    active={"repeat": {"first_s": f(30), "period_s": f(40), "on_s": f(20), "count": 4,
+                                       "step_samples": 57}}),
+        ])
+
+
 SHIPPED = {
     "default.json": default_scene, "small.json": small_scene, "small.yaml": small_scene,
     "hard_clip.json": hard_clip_scene, "interferer.json": interferer_scene,
     "pinch.json": pinch_scene, "thumb.yaml": thumb_scene, "drumroll.json": drumroll_scene,
+    "taps8.json": taps8_scene,
 }
 
 
