@@ -531,42 +531,34 @@ def thumb_scene() -> Scene:
         ])
 
 
-def drumroll_scene() -> Scene:
-    """Fast alternating taps A B A B 20 mm apart (must not merge into one moving contact)."""
+def _alternating_taps(name: str, seed: int, frames: int, spacing_mm: float, b_first: int,
+                      period: int, count: int, description: str) -> Scene:
+    """Fingers A at (80, 70) mm and B spacing_mm to its right tap in turn: each 20 frames
+    down every ``period`` frames, A from frame 10, B from frame ``b_first``; each tap's
+    landing moves 31 (A) / 57 (B) samples further into its window."""
     cfg = _params.DEFAULT
     f = lambda k: _frames_s(cfg, k)
+    tap = lambda first, step: {"repeat": {"first_s": f(first), "period_s": f(period), "on_s": f(20),
+                                          "count": count, "step_samples": step}}
     return Scene(
-        name="drumroll", sensor="default", frames=240, seed=7,
-        description="alternating taps 20 mm apart: 20 frames down, 20 frames between taps",
+        name=name, sensor="default", frames=frames, seed=seed, description=description,
         effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
-        contacts=[
-            Contact(name="A", path=[[0.0, 80.0, 70.0]],
-                    active={"repeat": {"first_s": f(10), "period_s": f(80), "on_s": f(20), "count": 3,
-                                       "step_samples": 31}}),
-            Contact(name="B", path=[[0.0, 100.0, 70.0]],
-                    active={"repeat": {"first_s": f(50), "period_s": f(80), "on_s": f(20), "count": 3,
-                                       "step_samples": 57}}),
-        ])
+        contacts=[Contact(name="A", path=[[0.0, 80.0, 70.0]], active=tap(10, 31)),
+                  Contact(name="B", path=[[0.0, 80.0 + spacing_mm, 70.0]], active=tap(b_first, 57))])
+
+
+def drumroll_scene() -> Scene:
+    """Fast alternating taps A B A B 20 mm apart (must not merge into one moving contact)."""
+    return _alternating_taps("drumroll", 7, 240, 20.0, 50, 80, 3,
+                             "alternating taps 20 mm apart: 20 frames down, 20 frames between taps")
 
 
 def taps8_scene() -> Scene:
     """Fast alternating taps 8 mm apart, B landing in the frame A lifts (and back), every
     landing and lift inside a window: the transition frames that gave ghost contacts
     before the touch-down confirmation (issue #11 item 4)."""
-    cfg = _params.DEFAULT
-    f = lambda k: _frames_s(cfg, k)
-    return Scene(
-        name="taps8", sensor="default", frames=200, seed=8,
-        description="alternating taps 8 mm apart, 20 frames each, B lands as A lifts",
-        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1}},
-        contacts=[
-            Contact(name="A", path=[[0.0, 80.0, 70.0]],
-                    active={"repeat": {"first_s": f(10), "period_s": f(40), "on_s": f(20), "count": 4,
-                                       "step_samples": 31}}),
-            Contact(name="B", path=[[0.0, 88.0, 70.0]],
-                    active={"repeat": {"first_s": f(30), "period_s": f(40), "on_s": f(20), "count": 4,
-                                       "step_samples": 57}}),
-        ])
+    return _alternating_taps("taps8", 8, 200, 8.0, 30, 40, 4,
+                             "alternating taps 8 mm apart, 20 frames each, B lands as A lifts")
 
 
 SHIPPED = {
