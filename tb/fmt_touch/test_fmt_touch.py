@@ -222,7 +222,9 @@ def random_settings(cfg, rng) -> TouchSettings:
         max_speed_mm_s=float(rng.uniform(200.0, 5000.0)),
         blobs=bool(rng.random() < 0.5),
         blob_threshold=int(rng.integers(1500, 5000)),
-        blob_min_cells=int(rng.integers(1, 16)))
+        blob_min_cells=int(rng.integers(1, 16)),
+        on_threshold=int(rng.integers(0, 6000)),
+        confirm_frames=int(rng.integers(1, 4)))
 
 
 @cocotb.test()
