@@ -9,8 +9,12 @@ evaluation: ghosts (reported contacts matched to no finger, with their frames), 
 swaps, lost IDs and missed finger-frames, at 30 dB per window, M = 1.
 
     python scripts/tap_ghosts.py [--spacings 8 10 ...] [--seeds 1 2] [--settings FILE]
+    python scripts/tap_ghosts.py --finger-peaks
 
 Prints one line per scene and a total; exits 1 if any scene has a ghost or a swap.
+--finger-peaks prints instead the peak strength range (the tracker's touch strength) of
+a 6 mm and an 8 mm finger sliding 400 frames across a cell diagonal (every sub-cell
+position) at 30 dB: the weakest finger an activation threshold must still let in.
 """
 from __future__ import annotations
 
@@ -66,12 +70,39 @@ def run(spacings, seeds, settings=None, timings=TIMINGS, angles=ANGLES, quiet=Fa
     return tot
 
 
+def finger_peaks(diameter_mm: float, snr_db: float = 30.0, frames: int = 400) -> list:
+    """Per frame, the strongest fine touch's strength of one finger sliding diagonally
+    across a cell (80, 70) -> (85, 75) mm, through the signal chain and the fixed-point
+    touch pipeline (calibrated like fmt.run_sim)."""
+    import numpy as np
+    from fmt import chain, touch
+    cfg = params.DEFAULT
+    sc = Scene(name=f"peak{diameter_mm:g}", sensor="default", frames=frames, seed=3,
+               effects={"noise": {"snr_db": snr_db}, "pn": {"enable": True, "chip_len": 1}},
+               contacts=[Contact(name="A", diameter_mm=diameter_mm,
+                                 path=[[0.0, 80.0, 70.0], [frames * cfg.window_s, 85.0, 75.0]])])
+    res = chain.heatmaps_float(sc)
+    pp = touch.TouchPipeline(cfg, _settings.TouchSettings(), fixed=True,
+                             flatten_cal=run_sim.calibration(sc), frame_period_s=sc.frame_period_s)
+    flat = pp.flatten(np.rint(res.heatmaps).astype(np.int64))
+    return [max([t.strength for t in pp.touches(flat[k], k)[0]], default=0)
+            for k in range(flat.shape[0])]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spacings", type=float, nargs="+", default=[8, 10, 12, 15, 20, 25, 30])
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--settings", default=None, help="TouchSettings JSON (default: the defaults)")
+    ap.add_argument("--finger-peaks", action="store_true",
+                    help="print the peak strength range of a 6 mm and an 8 mm finger instead")
     a = ap.parse_args(argv)
+    if a.finger_peaks:
+        for d in (6.0, 8.0):
+            v = sorted(finger_peaks(d))
+            print(f"{d:g} mm finger, 30 dB: peak strength min {v[0]}, 1st percentile "
+                  f"{v[len(v) // 100]}, median {v[len(v) // 2]}, max {v[-1]}")
+        return 0
     try:
         st = _settings.load(a.settings) if a.settings else None
     except Exception as e:  # one line, non-zero exit
