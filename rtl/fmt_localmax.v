@@ -1,11 +1,18 @@
 // fmt_localmax -- coarse touches: strict 3x3 local maxima above a threshold, with the
-// raster-order tie rule, streamed out strongest first (twin: sim/fmt/localmax.py).
+// raster-order tie rule, streamed out continuing first, then strongest first (twin:
+// sim/fmt/localmax.py, LocalMaxima).
 //
 // Rule: cell p is a maximum iff z[p] >= threshold_i and, for every neighbour q on the
 // sensor (Moore 8 or Von Neumann 4, moore_i): z[p] > z[q] when q precedes p in raster
 // order (row above, or left), z[p] >= z[q] when q follows it (right, or row below).
 // Missing neighbours (edges, corners) do not disqualify.  Two equal neighbouring cells
 // give exactly one maximum (the first in raster order).
+// Contact limit with hysteresis on the ranking (issue #11 item 3): a maximum within one
+// cell (|dr| <= 1, |dc| <= 1) of a candidate the previous frame emitted is continuing
+// and ranks ahead of every new one; then z descending, then raster index ascending.  The
+// first limit_i in that order are emitted in that order, so N + 1 fingers under a limit
+// of N give the same N every frame.  No candidate is continuing after a reset or an
+// incomplete frame.
 //
 // Heat-map stream in (docs/ARCHITECTURE.md): rows in ANY order, one per cycle at most.
 // Storage: the rows are written into an inferred RAM of 2 x 2^ROW_IDX_W words of
@@ -44,8 +51,11 @@
 //        each quarter of a group (its select decoded per quarter from the one-hot
 //        lowest maximum), then the quarter;
 //        then a rotation per row and the rows outside the sensor, registered)
-//   SW6  insert (z, raster index, slot) into a sorted list of MAX_TOUCHES entries (z
-//        descending, ties by raster index ascending; fmt_sorted_list, comparing a cycle
+//   SW6  insert ({continuing, z}, raster index, slot) into a sorted list of MAX_TOUCHES
+//        entries (key descending, ties by raster index ascending; the continuing flag
+//        from a row test when the window shifts and a column test in the capture's first
+//        step, against the previous frame's candidates, recorded as they were emitted,
+//        K x (row, column); fmt_sorted_list, comparing a cycle
 //        early with the centre cell from registers of its own, rotated in the capture's
 //        second step, in four copies for the list's comparators); the 3x3 goes to a
 //        (MAX_TOUCHES+1)-slot store (block RAM) at the list's free slot.
@@ -132,6 +142,7 @@ module fmt_localmax #(
     localparam RW     = COLS * HM_W;
     localparam IDX_W  = ROW_IDX_W + COL_IDX_W;    // raster key {row, col}
     localparam Z9_W   = 9 * HM_W;
+    localparam KEY_W  = HM_W + 1;             // the list's key {continuing, z}
     localparam AW     = ROW_IDX_W + 1;            // frame-store address {buffer, row}
     localparam SLOT_W = $clog2(K + 1);            // 3x3 store slot (K + 1 slots)
     localparam integer LAST_ROW_I = ROWS - 1;
@@ -646,6 +657,19 @@ module fmt_localmax #(
             (* keep *) always @(posedge clk) pc_q[gpc*HM_W +: HM_W] <= pc_d;
         end
     endgenerate
+    // continuing-maximum flag of the maximum in pidx_q (the block "continuing maxima"
+    // below), in NLC copies beside pc_q's, and of the captured one
+    reg  [NLC-1:0]      nearp_q;
+    reg                 cap_near_q;
+    wire                near_d;
+    wire [NLC*KEY_W-1:0] nxt_key;              // the list's early keys {near, centre}
+    genvar gnk;
+    generate
+        for (gnk = 0; gnk < NLC; gnk = gnk + 1) begin : g_nk
+            (* keep *) always @(posedge clk) nearp_q[gnk] <= near_d;
+            assign nxt_key[gnk*KEY_W +: KEY_W] = {nearp_q[gnk], pc_q[gnk*HM_W +: HM_W]};
+        end
+    endgenerate
     wire [HM_W-1:0] qa0 = pz_q[0*HM_W +: HM_W], qa1 = pz_q[1*HM_W +: HM_W], qa2 = pz_q[2*HM_W +: HM_W];
     wire [HM_W-1:0] qb0 = pz_q[3*HM_W +: HM_W], qb1 = pz_q[4*HM_W +: HM_W], qb2 = pz_q[5*HM_W +: HM_W];
     wire [HM_W-1:0] qc0 = pz_q[6*HM_W +: HM_W], qc1 = pz_q[7*HM_W +: HM_W], qc2 = pz_q[8*HM_W +: HM_W];
@@ -670,18 +694,18 @@ module fmt_localmax #(
     wire              em_issue = (state_q == S_EMIT) && (left_q != {LIM_W{1'b0}});
     /* verilator lint_off UNUSEDSIGNAL */      // entry 0's index and slot only are read
     wire [K-1:0]        l_v;
-    wire [K*HM_W-1:0]   l_z;
+    wire [K*KEY_W-1:0]  l_z;
     wire [K*IDX_W-1:0]  l_idx;                 // raster index {row, col} of entry i
     wire [K*SLOT_W-1:0] l_slot;                // 3x3 store slot of entry i
     /* verilator lint_on UNUSEDSIGNAL */
     wire [SLOT_W-1:0]   l_free;                // the slot out of the list (next insert's)
     // the list compares a cycle early: cap_z_q's centre and cap_idx_q take z9's centre
     // (= each copy of pc_q) and pidx_q in every cycle
-    fmt_sorted_list #(.K(K), .KEY_W(HM_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
+    fmt_sorted_list #(.K(K), .KEY_W(KEY_W), .TIE_W(IDX_W), .PAY_W(SLOT_W), .PAY_RST_IDX(1),
                       .HAS_POP(1), .EARLY(1), .NXT_CP(NLC)) u_list (
         .clk(clk), .rst(rst), .clear_i(releasing),
-        .ins_i(cap_v_q), .ins_key_i(cap_z_q[4*HM_W +: HM_W]), .ins_tie_i(cap_idx_q),
-        .nxt_key_i(pc_q), .nxt_tie_i(pidx_q), .ins_ahead_i(1'b0),
+        .ins_i(cap_v_q), .ins_key_i({cap_near_q, cap_z_q[4*HM_W +: HM_W]}), .ins_tie_i(cap_idx_q),
+        .nxt_key_i(nxt_key), .nxt_tie_i(pidx_q), .ins_ahead_i(1'b0),
         .ins_pay_i(l_free),
         .pop_i(em_issue), .valid_o(l_v), .key_o(l_z), .tie_o(l_idx), .pay_o(l_slot),
         .drop_pay_o(l_free));
@@ -710,6 +734,46 @@ module fmt_localmax #(
         if (em_row_q == {ROW_IDX_W{1'b0}})     miss9 = miss9 | 9'b000_000_111;
         if (em_row_q == LAST_ROW)              miss9 = miss9 | 9'b111_000_000;
     end
+
+    // ---- continuing maxima (issue #11 item 3: hysteresis on the ranking) ---------------------
+    // The candidates the previous frame emitted, recorded as they are emitted (entry 0 the
+    // latest; cleared at the finish, so none after a reset or an incomplete frame; the
+    // next frame's sweep starts after the emission).  A maximum within one cell of one of
+    // them (|row - r| <= 1 and |col - c| <= 1) is continuing: key {1, z}, ahead of every
+    // new maximum.  The row test is made when the window shifts (w1_q's row, mrow_q's next
+    // value, against every entry: rowhit_q), the column test in capture step 1 on
+    // p1idx_q's column with rowhit_q's copy p1rh_q, registered in nearp_q beside pidx_q.
+    reg [K-1:0]           pe_v_q;              // entry k valid
+    reg [K*ROW_IDX_W-1:0] pe_r_q;              // its row
+    reg [K*COL_IDX_W-1:0] pe_c_q;              // its column
+    reg [K-1:0]           rowhit_q;            // entry k valid and within one row of mrow_q
+    reg [K-1:0]           p1rh_q;              // rowhit_q of p1idx_q's row
+    // the shift on an emission (the oldest entry's bits fall off the top)
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [K:0]            pe_v_sh = {pe_v_q, 1'b1};
+    wire [K*ROW_IDX_W+ROW_IDX_W-1:0] pe_r_sh = {pe_r_q, l_row0};
+    wire [K*COL_IDX_W+COL_IDX_W-1:0] pe_c_sh = {pe_c_q, l_col0};
+    /* verilator lint_on UNUSEDSIGNAL */
+    // a and b within one of each other (one bit wider: no wrap at the index's end)
+    localparam NW = ((ROW_IDX_W > COL_IDX_W) ? ROW_IDX_W : COL_IDX_W) + 1;
+    function near1;
+        input [NW-1:0] a, b;
+        near1 = (a == b) || (a == b + 1'b1) || (a + 1'b1 == b);
+    endfunction
+    reg [K-1:0] rowhit_d;
+    reg         near_c;
+    always @(*) begin : c_near
+        integer k;
+        near_c = 1'b0;
+        for (k = 0; k < K; k = k + 1) begin
+            rowhit_d[k] = pe_v_q[k]
+                && near1({{(NW - ROW_IDX_W){1'b0}}, r2_q},
+                         {{(NW - ROW_IDX_W){1'b0}}, pe_r_q[k*ROW_IDX_W +: ROW_IDX_W]});
+            near_c = near_c | (p1rh_q[k] && near1({{(NW - COL_IDX_W){1'b0}}, p1idx_q[0 +: COL_IDX_W]},
+                                                  {{(NW - COL_IDX_W){1'b0}}, pe_c_q[k*COL_IDX_W +: COL_IDX_W]}));
+        end
+    end
+    assign near_d = near_c;
 
     // the limit and the counts of the finish, registered: limit_p a cycle old, found_q
     // one (it does not change in the cycle before finish: fin_pre_q waits for no capture)
@@ -763,6 +827,7 @@ module fmt_localmax #(
             if (v2_q) begin                    // the window shifts
                 t3_q   <= t2_q;
                 mrow_q <= r2_q;
+                rowhit_q <= rowhit_d;
                 mtop_q <= (r2_q == {ROW_IDX_W{1'b0}});
                 mbot_q <= x2_q;
             end
@@ -775,6 +840,7 @@ module fmt_localmax #(
         p1top_q   <= mtop_q;
         p1bot_q   <= mbot_q;
         p1idx_q   <= {mrow_q, lo_col};
+        p1rh_q    <= rowhit_q;
         pz_q      <= s2;
         pm_q      <= p1m_q;
         ptop_q    <= p1top_q;
@@ -782,6 +848,7 @@ module fmt_localmax #(
         pidx_q    <= p1idx_q;
         cap_z_q   <= z9;
         cap_idx_q <= pidx_q;
+        cap_near_q <= nearp_q[0];
         cand_z_o       <= z9_rd_q;
         cand_missing_o <= miss9;
         cand_row_o     <= em_row_q;
@@ -819,6 +886,7 @@ module fmt_localmax #(
             em_eof_q <= 1'b0;
             em_row_q <= {ROW_IDX_W{1'b0}};
             em_col_q <= {COL_IDX_W{1'b0}};
+            pe_v_q   <= {K{1'b0}};
             cand_valid_o      <= 1'b0;
             cand_eof_o        <= 1'b0;
             cand_count_o      <= {LIM_W{1'b0}};
@@ -892,6 +960,7 @@ module fmt_localmax #(
                       && !iv_q && !p1v_q && !pv_q && !cap_v_q;
             if (finish) begin
                 state_q    <= S_EMIT;
+                pe_v_q     <= {K{1'b0}};        // this frame's candidates replace the last's
                 em_frame_q <= pb_q ? frm1_q : frm0_q;
                 left_q     <= complete ? n_emit_q : {LIM_W{1'b0}};
                 cand_count_o      <= complete ? n_emit_q : {LIM_W{1'b0}};
@@ -913,6 +982,9 @@ module fmt_localmax #(
                 em_row_q <= l_row0;
                 em_col_q <= l_col0;
                 left_q   <= left_q - 1'b1;      // the list pops entry 0
+                pe_v_q   <= pe_v_sh[K-1:0];     // recorded for the next frame's ranking
+                pe_r_q   <= pe_r_sh[K*ROW_IDX_W-1:0];
+                pe_c_q   <= pe_c_sh[K*COL_IDX_W-1:0];
             end
             if (releasing) begin
                 state_q      <= S_RUN;      // the list is cleared

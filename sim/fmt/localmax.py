@@ -25,10 +25,19 @@ models are the same function):
   give one touch per arm; ``sim/tests/test_localmax.py`` checks these statements
   exhaustively over all plateau shapes in a 3x3 box.
 
-* Contact limit: when more maxima than ``max_touches`` exist, the strongest are kept:
-  order = z descending, ties by raster index (row * COLS + col) ascending; the others
-  are dropped, ``overflow`` is set and ``n_found - max_touches`` is the drop count.
-  The candidates come out in that order (strongest first).
+* Contact limit, with hysteresis on the ranking (issue #11 item 3): a maximum is
+  *continuing* when it lies within one cell (|row - r| <= 1 and |col - c| <= 1, for
+  either neighbourhood) of a candidate the previous frame emitted (none after a reset
+  or an incomplete frame).  When more maxima than ``max_touches`` exist, the first in
+  this order are kept: continuing before new, then z descending, then raster index
+  (row * COLS + col) ascending; the others are dropped, ``overflow`` is set and
+  ``n_found - max_touches`` is the drop count.  The candidates come out in that order.
+  So N + 1 fingers under a limit of N give the same N every frame (the strongest N of
+  the frame they landed in), and a finger landing among a full set waits for a free
+  place instead of taking it from a weaker continuing one.  A finger moves far less
+  than a cell per frame (3 m/s is 18 um a frame at 162.76 kHz, the cells are mm), so
+  its maximum stays within one cell of the last frame's.  :class:`LocalMaxima` keeps
+  the previous frame's candidates; :func:`local_maxima_fixed` takes them as ``prev``.
 
 Each candidate carries its 3x3 neighbourhood ``z3[dy+1][dx+1]`` (a neighbour outside
 the sensor reads 0) and ``missing`` (9-bit mask, bit k = (dy+1)*3 + (dx+1) set when that
@@ -102,18 +111,30 @@ def neighbourhood3x3(hm, r: int, c: int) -> tuple[np.ndarray, int]:
     return z3, missing
 
 
-def local_maxima_fixed(hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16):
+def near_mask(shape, prev) -> np.ndarray:
+    """Cells within one cell (Chebyshev) of any (row, col) in ``prev``."""
+    rows, cols = shape
+    m = np.zeros((rows, cols), dtype=bool)
+    for r, c in prev:
+        m[max(0, r - 1):r + 2, max(0, c - 1):c + 2] = True
+    return m
+
+
+def local_maxima_fixed(hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16,
+                       prev=()):
     """Coarse touches of one heat map: ``(candidates, n_found, overflow)``.
 
-    ``candidates``: at most ``max_touches`` :class:`Candidate`, strongest first (ties by
-    raster order); ``n_found``: number of maxima before the limit; ``overflow``:
-    ``n_found > max_touches``.
+    ``candidates``: at most ``max_touches`` :class:`Candidate`, continuing ones first
+    (within one cell of a (row, col) in ``prev``, the previous frame's candidates), then
+    strongest first, ties by raster order; ``n_found``: number of maxima before the
+    limit; ``overflow``: ``n_found > max_touches``.
     """
     z = np.asarray(hm, dtype=np.int64)
     m = maxima_mask(z, threshold, neighbourhood)
     rr, cc = np.nonzero(m)                      # raster order
     vals = z[rr, cc]
-    order = np.lexsort((rr * z.shape[1] + cc, -vals))
+    near = near_mask(z.shape, prev)[rr, cc].astype(np.int64)
+    order = np.lexsort((rr * z.shape[1] + cc, -vals, -near))
     n_found = int(len(order))
     keep = order[:max(0, int(max_touches))]
     cands = []
@@ -121,3 +142,20 @@ def local_maxima_fixed(hm, threshold: int, neighbourhood: str = "moore", max_tou
         z3, missing = neighbourhood3x3(z, int(rr[i]), int(cc[i]))
         cands.append(Candidate(int(rr[i]), int(cc[i]), z3, missing))
     return cands, n_found, n_found > max_touches
+
+
+class LocalMaxima:
+    """The stateful twin of ``rtl/fmt_localmax.v``: :func:`local_maxima_fixed` frame after
+    frame, each ranked against the candidates the frame before emitted."""
+
+    def __init__(self):
+        self.prev: list[tuple[int, int]] = []
+
+    def reset(self) -> None:
+        """After a reset (or a frame that came out incomplete): no continuing maxima."""
+        self.prev = []
+
+    def frame(self, hm, threshold: int, neighbourhood: str = "moore", max_touches: int = 16):
+        out = local_maxima_fixed(hm, threshold, neighbourhood, max_touches, self.prev)
+        self.prev = [(c.row, c.col) for c in out[0]]
+        return out

@@ -63,6 +63,7 @@ class TouchPipeline:
         self.tp = track_params or TrackParams.from_settings(cfg, settings or TouchSettings(),
                                                             frame_period_s)
         self.tracker = Tracker(self.tp)
+        self.localmax = _localmax.LocalMaxima()      # the ranking's previous frame
         self._use(settings or TouchSettings(), blobs)
 
     def _use(self, settings: TouchSettings, blobs: bool | None = None) -> None:
@@ -85,8 +86,7 @@ class TouchPipeline:
         """Fine touches (tracker input) and blobs of one flattened heat map."""
         s = self.s
         zi = np.rint(hm_flat).astype(np.int64) if not self.fixed else hm_flat
-        cands, _, _ = _localmax.local_maxima_fixed(zi, s.threshold, s.neighbourhood,
-                                                   self.max_touches)
+        cands, _, _ = self.localmax.frame(zi, s.threshold, s.neighbourhood, self.max_touches)
         blobs = []
         if self.blobs:
             from . import blob as _blobs

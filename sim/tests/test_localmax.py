@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from fmt import params
-from fmt.localmax import maxima_mask, local_maxima_fixed, offsets
+from fmt.localmax import LocalMaxima, local_maxima_fixed, maxima_mask, near_mask, offsets
 
 
 def brute_force(z, thr, nb):
@@ -139,3 +139,26 @@ def test_packed_z():
     w = c.packed_z(16)
     assert [(w >> (16 * k)) & 0xFFFF for k in range(9)] == [5, 6, 0, 8, 9, 0, 0, 0, 0]
     assert c.missing == 0b111100100
+
+
+def test_continuing_maxima_rank_first():
+    """Hysteresis on the ranking: a maximum within one cell of a candidate of the frame
+    before ranks ahead of every new one, whatever its strength; two cells away it is new."""
+    z = np.zeros((9, 12), dtype=np.int64)
+    pos = [(1, 1), (1, 5), (1, 9), (5, 1), (5, 5)]
+    for p, v in zip(pos, (900, 800, 700, 600, 500)):
+        z[p] = v
+    lm = LocalMaxima()
+    cands, n, ov = lm.frame(z, 100, "moore", 4)
+    assert n == 5 and ov and [(c.row, c.col) for c in cands] == pos[:4]
+    z2 = np.zeros_like(z)                      # every maximum one cell down-right; the
+    for p, v in zip(pos, (900, 800, 700, 300, 5000)):   # dropped one now the strongest
+        z2[p[0] + 1, p[1] + 1] = v
+    cands, _, _ = lm.frame(z2, 100, "moore", 4)
+    assert [(c.row, c.col) for c in cands] == [(2, 2), (2, 6), (2, 10), (6, 2)]
+    assert [c.z for c in cands] == [900, 800, 700, 300]     # continuing, then by strength
+    far = [(c.row, c.col) for c in local_maxima_fixed(z2, 100, "moore", 4, prev=[(0, 0)])[0]]
+    assert far[0] == (6, 6)                    # (0, 0) is two cells from (2, 2): all new
+    lm.reset()
+    assert lm.frame(z2, 100, "moore", 4)[0][0].z == 5000
+    assert near_mask((3, 3), [(0, 0)]).sum() == 4 and near_mask((3, 3), [(1, 1)]).all()

@@ -356,3 +356,25 @@ def test_tap_ghosts_sample():
     assert on["ghosts"] == 0 and on["swaps"] == 0 and on["lost"] == 0, on
     off = tg.run([8, 20], [1], TouchSettings(confirm_frames=1, on_threshold=0), **kw)
     assert off["ghosts"] > 0, off
+
+
+def test_crowding_sample():
+    """N + 1 fingers under a limit of N (scripts/crowding.py, a sample): the same N
+    contacts in every frame, no new ID, no lift; without the ranking's hysteresis the
+    count drops below N in some frames (the check can fail)."""
+    import importlib.util
+    from pathlib import Path
+    from fmt import localmax
+    path = Path(__file__).resolve().parents[2] / "scripts" / "crowding.py"
+    spec = importlib.util.spec_from_file_location("crowding", path)
+    cr = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(cr)
+    on = cr.run([1], [16], 200, quiet=True)
+    assert on["frames_not_n"] == 0 and on["new_ids"] == 0 and on["lifts"] == 0, on
+    saved = localmax.near_mask
+    localmax.near_mask = lambda shape, prev: np.zeros(shape, dtype=bool)
+    try:
+        off = cr.run([1], [16], 200, quiet=True)
+    finally:
+        localmax.near_mask = saved
+    assert off["frames_not_n"] > 0, off

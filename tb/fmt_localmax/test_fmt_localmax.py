@@ -2,10 +2,12 @@
 
 Every frame's candidate stream (row, col, 3x3 neighbourhood, missing mask, order), its
 end-of-frame record (count, found, overflow) and frame number must equal the model's
-``local_maxima_fixed(hm, threshold, neighbourhood, limit)``.  Covered: random heat maps with
+``local_maxima_fixed(hm, threshold, neighbourhood, limit, prev)``, ``prev`` the candidates
+of the frame before (none after a reset: continuing maxima rank first).  Covered: random heat maps with
 many ties, random row orders, beats on consecutive cycles and with gaps, back-to-back
 frames, plateaus (2 cells, 2x2, 3x1), single-cell spikes, saturated cells, edges and
-corners, 17 maxima with a limit of 16, a cell exactly at the threshold, both
+corners, 17 maxima with a limit of 16, continuing maxima kept over stronger new ones
+(also moved by one cell, and not when moved by two), a cell exactly at the threshold, both
 neighbourhoods, a reset in the middle of a frame, undefined row, data and frame inputs
 (X under Icarus, garbage under Verilator) between beats.  The latency from the last row beat
 (and from hm_eof) to the last candidate is measured and bounded: 15 + n + m + e for n
@@ -62,6 +64,7 @@ class TB(ClockedTB):
         self.rows, self.cols = self.cfg.rows, self.cfg.cols
         self.k = env_int("MAX_TOUCHES", self.cfg.max_touches)
         self.frames = []           # records from the candidate stream
+        self.prev = []             # (row, col) of the last frame's candidates (the ranking's)
         self.set(threshold=1, moore=True, limit=self.k)
         for s in ("hm_valid_i", "hm_eof_i"):
             getattr(dut, s).value = 0
@@ -85,6 +88,7 @@ class TB(ClockedTB):
 
     async def reset(self, cycles: int = 4):
         await super().reset(cycles)
+        self.prev = []
         if self.mon is None:                 # outputs are defined from the first reset on
             # cocotb-bus BusMonitor of the candidate stream (tb/common/streams.py)
             self.mon = StreamMonitor(self.dut, "cand", self.clk, self.CAND_FIELDS, eof="eof",
@@ -135,7 +139,8 @@ class TB(ClockedTB):
         raise AssertionError(f"only {len(self.frames)} of {n_frames} frames came out")
 
     def expect(self, rec, hm, frame):
-        cands, n_found, overflow = local_maxima_fixed(hm, self.thr, self.nb, self.limit)
+        cands, n_found, overflow = local_maxima_fixed(hm, self.thr, self.nb, self.limit, self.prev)
+        self.prev = [(c.row, c.col) for c in cands]
         want = [(c.row, c.col, c.packed_z(self.w), c.missing) for c in cands]
         got = [x[:4] for x in rec["cands"]]
         assert got == want, f"frame {frame}: got {got[:4]}.. want {want[:4]}.. (thr {self.thr} {self.nb})"
@@ -255,6 +260,46 @@ async def contact_limit(dut):
     rec = tb.frames[-1]
     assert rec["found"] == n - 1 and rec["overflow"] == int(n - 1 > tb.k)
     assert int(dut.drop_count_o.value) == n - limit + max(0, n - 1 - tb.k)
+
+
+@cocotb.test()
+async def continuing_first(dut):
+    """Hysteresis on the ranking: limit + 1 separated maxima; the weakest of the kept
+    ones then becomes the weakest of all and the dropped one the strongest: the kept
+    set stays (also when every maximum moves by one cell, in any direction); moved by
+    two cells nothing is continuing and the strongest win again."""
+    tb = TB(dut)
+    await tb.reset()
+    rng = random.Random(13)
+    R, C = tb.rows, tb.cols
+    pos = [(r, c) for r in range(1, R - 1, 3) for c in range(1, C - 1, 3)]   # no edge reached
+    n = min(len(pos), tb.k + 1)
+    assert n >= 2, "the configuration holds at least 2 separated maxima"
+    limit = n - 1
+    tb.set(100, True, limit)
+
+    def frame(vals, dr=0, dc=0):
+        z = np.zeros((R, C), dtype=np.int64)
+        for (r, c), v in zip(pos[:n], vals):
+            z[r + dr, c + dc] = v
+        return z
+
+    def kept():
+        return {(x[0], x[1]) for x in tb.frames[-1]["cands"]}
+
+    vals = [3000 + 10 * i for i in range(n)]                # pos[0] the weakest: dropped
+    await tb.run_frames(rng, [frame(vals)], 1)
+    first = kept()
+    assert first == set(pos[1:n])
+    swapped = list(vals)
+    swapped[0], swapped[1] = 9000, 2000                     # the dropped one now the strongest
+    for k, (dr, dc) in enumerate(((0, 0), (1, 0), (0, -1), (-1, 0), (0, 1))):   # <= 1 a frame
+        await tb.run_frames(rng, [frame(swapped, dr, dc)], 2 + k)
+        assert kept() == {(r + dr, c + dc) for r, c in first}, \
+            f"moved by ({dr}, {dc}): the kept set changed"
+    await tb.run_frames(rng, [frame(swapped, 1, -1)], 9)   # two columns from the last frame's
+    got = kept()
+    assert (pos[0][0] + 1, pos[0][1] - 1) in got and (pos[1][0] + 1, pos[1][1] - 1) not in got
 
 
 @cocotb.test()

@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""Crowding above the contact limit (issue #11 item 3), through the fixed-point model.
+
+Two cases per seed, each with N the contact limit (`--limits`, default 16 and 6):
+
+* ``together``: N + 1 fingers land in the same frame;
+* ``one_lands``: N fingers, then one more (the largest and strongest of all) lands 150
+  frames later among them.
+
+The fingers sit on a jittered 20 mm grid (random places, 7-10 mm, strength 0.85-1.0,
+some drifting at up to 0.2 m/s), 30 dB per window, M = 1.  Counted after the contacts
+have settled (the landing frame + 10): frames in which the number of reported contacts
+(new or move events) is not N, new IDs, and lifts.  With continuing contacts ranked
+first, every count is 0: the same N contacts in every frame.
+
+    python scripts/crowding.py [--seeds 1 2 3] [--limits 16 6] [--frames 400]
+
+Prints one line per scene and a total; exits 1 if any count is not 0.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "sim"))
+
+from fmt import chain, params, run_sim, touch  # noqa: E402
+from fmt import settings as _settings  # noqa: E402
+from fmt.scene import Contact, Scene  # noqa: E402
+
+LAND = 10               # frame of the first landing
+LATE = 150              # frames after it that the extra finger lands (one_lands)
+
+
+def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0) -> Scene:
+    cfg = params.DEFAULT
+    rng = np.random.default_rng(1000 * seed + n)
+    w, h = cfg.cols * cfg.pitch_mm, cfg.rows * cfg.pitch_mm
+    grid = [(x, y) for y in np.arange(15.0, h - 10.0, 20.0) for x in np.arange(15.0, w - 10.0, 20.0)]
+    if len(grid) < n + 1:
+        raise ValueError(f"crowding: {n + 1} fingers do not fit the {w:g} x {h:g} mm sensor")
+    pick = rng.choice(len(grid), size=n + 1, replace=False)
+    t_end = frames * cfg.window_s
+    contacts = []
+    for k, g in enumerate(pick):
+        x0, y0 = grid[g][0] + rng.uniform(-3, 3), grid[g][1] + rng.uniform(-3, 3)
+        late = case == "one_lands" and k == n
+        vx, vy = (rng.uniform(-0.2, 0.2, 2) * 1e3) if k % 3 == 0 else (0.0, 0.0)   # mm/s
+        t0 = (LAND + (LATE if late else 0)) * cfg.window_s + rng.uniform(0, cfg.window_s)
+        contacts.append(Contact(
+            name=f"F{k}", diameter_mm=10.0 if late else float(rng.uniform(7.0, 9.0)),
+            strength=1.0 if late else float(rng.uniform(0.85, 1.0)),
+            path=[[0.0, x0, y0], [t_end, x0 + vx * t_end, y0 + vy * t_end]],
+            active=[[t0, t_end + 1.0]]))
+    return Scene(name=f"crowd_{case}_{n}_{seed}", sensor="default", frames=frames, seed=seed,
+                 effects={"noise": {"snr_db": snr_db}, "pn": {"enable": True, "chip_len": 1}},
+                 contacts=contacts)
+
+
+def count(frame_events: list, n: int, settle: int) -> dict:
+    """Frames (index >= settle) whose reported contacts are not n; new IDs and lifts there."""
+    bad = new = lifts = 0
+    for ev in frame_events[settle:]:
+        live = {e.id for e in ev if e.type in ("new", "move")}
+        bad += len(live) != n
+        new += sum(e.type == "new" for e in ev)
+        lifts += sum(e.type == "lift" for e in ev)
+    return {"frames_not_n": bad, "new_ids": new, "lifts": lifts}
+
+
+def events(sc: Scene, st) -> list:
+    """Per frame, the fixed-point pipeline's events (calibrated as fmt.run_sim does)."""
+    res = chain.heatmaps_float(sc)
+    return touch.process_frames(np.rint(res.heatmaps).astype(np.int64), sc.cfg, st, fixed=True,
+                                flatten_cal=run_sim.calibration(sc),
+                                frame_period_s=sc.frame_period_s)
+
+
+def run(seeds, limits, frames: int, quiet: bool = False) -> dict:
+    tot = {"scenes": 0, "frames_not_n": 0, "new_ids": 0, "lifts": 0}
+    for n in limits:
+        st = _settings.TouchSettings(max_touches=n)
+        for case in ("together", "one_lands"):
+            for seed in seeds:
+                sc = crowd_scene(case, n, seed, frames)
+                settle = LAND + 10
+                c = count(events(sc, st), n, settle)
+                tot["scenes"] += 1
+                for k in c:
+                    tot[k] += c[k]
+                if not quiet:
+                    print(f"limit {n:2d}  {case:9s}  seed {seed}:  frames without {n} contacts "
+                          f"{c['frames_not_n']} of {frames - settle}, new IDs {c['new_ids']}, "
+                          f"lifts {c['lifts']}", flush=True)
+    return tot
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--limits", type=int, nargs="+", default=[16, 6])
+    ap.add_argument("--frames", type=int, default=400)
+    a = ap.parse_args(argv)
+    if any(not 1 <= n <= 16 for n in a.limits) or a.frames <= LAND + LATE + 20:
+        print(f"crowding: limits must be 1..16 and frames > {LAND + LATE + 20}", file=sys.stderr)
+        return 2
+    tot = run(a.seeds, a.limits, a.frames)
+    print(f"total: {tot['scenes']} scenes, frames without N contacts {tot['frames_not_n']}, "
+          f"new IDs {tot['new_ids']}, lifts {tot['lifts']}")
+    return 1 if tot["frames_not_n"] or tot["new_ids"] or tot["lifts"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
