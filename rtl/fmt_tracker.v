@@ -36,10 +36,14 @@
 //   EV       from the cycle after MATCH ends: one lift per cycle (lowest slot first,
 //            active, unmatched, tentative or miss + 1 >= hold_off_i), then one new
 //            per cycle (unmatched touches at least on_thr_i strong, in arrival order;
-//            the first free slot after the round-robin pointer; generation + 1; no
-//            free slot: dropped, sticky noslot_flag_o).  Every mask keeps its lowest
-//            set bit (the next pick) and "not empty" in registers, computed the cycle
-//            before.
+//            the first free slot after the round-robin pointer; generation + 1).  No
+//            free slot: first a lift of the contact in hold-off seen longest ago (its
+//            last move or new issued earliest: an age order of the slots, older_q[j][i]
+//            = slot j's last move or new came before slot i's, set when a move or new
+//            is issued), then the new takes that slot; none in hold-off either: dropped,
+//            sticky noslot_flag_o.  Every mask keeps its lowest set bit (the hold-off
+//            mask its oldest slot: the next pick) and "not empty" in registers,
+//            computed the cycle before.
 //   Confirmation (confirm_i >= 2): a new slot is tentative (seen 1 frame); its moves
 //            count frames seen and the one that makes confirm_i is reported as 'new';
 //            until then its operations emit nothing, and it is lifted without an
@@ -188,6 +192,22 @@ module fmt_tracker #(
                 if (oh[i]) enc = enc | i[SB-1:0];
         end
     endfunction
+    // the oldest slot of a mask by the age order (one-hot, 0 if none): in the mask, and
+    // no slot of the mask seen before it
+    function [MT-1:0] oldest;
+        input [MT-1:0]    m;
+        input [MT*MT-1:0] o;
+        integer i, j;
+        reg     b;
+        begin
+            for (i = 0; i < MT; i = i + 1) begin
+                b = 1'b0;
+                for (j = 0; j < MT; j = j + 1)
+                    if (j != i) b = b | (m[j] & o[j*MT + i]);   // (the diagonal is unused)
+                oldest[i] = m[i] & ~b;
+            end
+        end
+    endfunction
     // lowest set bit (one-hot, 0 if none)
     function [MT-1:0] lowest;
         input [MT-1:0] m;
@@ -243,8 +263,11 @@ module fmt_tracker #(
     reg [MT-1:0]        fm_q;                     // free slots
     reg [MT-1:0]        src_q;                    // free slots after the pointer, else fm_q
     reg [MT-1:0]        upm_q;                    // hold-off updates to issue
+    reg [MT-1:0]        ho_q;                     // contacts in hold-off (EV: may be evicted)
+    reg [MT*MT-1:0]     older_q;                  // [j*MT + i]: slot j seen before slot i
     reg [MT-1:0]        l_pick_q, u_pick_q, f_pick_q, p_pick_q;   // lowest bits (one-hot)
-    reg                 l_any_q, u_any_q, f_any_q, p_any_q;       // masks not empty
+    reg [MT-1:0]        o_pick_q;                 // the oldest contact in hold-off (one-hot)
+    reg                 l_any_q, u_any_q, f_any_q, p_any_q, o_any_q; // masks not empty
     // arrival: A1 distances, A2 gate test and row write
     reg                 a1_v_q;
     reg                 a1_str_q;                 // the touch is at least on_thr_i strong
@@ -497,13 +520,15 @@ module fmt_tracker #(
     // picks update from registers only; a frame with none ends in the m_done cycle
     wire          iss_lift = state_q[2] & l_any_q;
     wire          iss_new  = state_q[2] & ~l_any_q & u_any_q & f_any_q;
-    wire          ev_done  = (m_done | state_q[2]) & ~l_any_q & ~(u_any_q & f_any_q);
+    // no free slot for the next new: the oldest contact in hold-off is lifted for it
+    wire          iss_evl  = state_q[2] & ~l_any_q & u_any_q & ~f_any_q & o_any_q;
+    wire          ev_done  = (m_done | state_q[2]) & ~l_any_q & ~(u_any_q & (f_any_q | o_any_q));
     wire          iss_upd  = state_q[3] & p_any_q;
-    wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
+    wire          iss      = q_asg | iss_lift | iss_new | iss_upd | iss_evl;
     wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
 
     // next masks and their picks
-    reg  [MT-1:0] lm_d, um_d, fm_d, src_d, upm_d, hm_d;
+    reg  [MT-1:0] lm_d, um_d, fm_d, src_d, upm_d, hm_d, ho_d;
     always @* begin
         lm_d  = lm_q;
         um_d  = um_q;
@@ -511,10 +536,12 @@ module fmt_tracker #(
         src_d = src_q;
         upm_d = upm_q;
         hm_d  = src_q;
+        ho_d  = ho_q;
         if (state_q[0] || state_q[1]) begin
             // shadows of the pending lifts and news, exact when MATCH ends (no
             // assignment in that cycle, so they hold into EV)
             lm_d  = act_q & ~sused_n & (lexp_q | tent_q);
+            ho_d  = act_q & ~sused_n & ~(lexp_q | tent_q);
             um_d  = tval_n & tstr_n & ~tused_n;
             fm_d  = ~act_q;
             hm_d  = ~act_q & therm_q;
@@ -525,6 +552,12 @@ module fmt_tracker #(
             fm_d  = fm_q | l_pick_q;
             hm_d  = fm_d & therm_q;
             src_d = (|hm_d) ? hm_d : fm_d;
+        end else if (iss_evl) begin
+            // the evicted slot is the only free one: the next new takes it
+            ho_d  = ho_q & ~o_pick_q;
+            fm_d  = o_pick_q;
+            hm_d  = o_pick_q & therm_q;
+            src_d = o_pick_q;
         end else if (iss_new) begin
             // src: free slots after the last pick (from the pointer), else all free slots
             um_d  = um_q & ~u_pick_q;
@@ -563,11 +596,14 @@ module fmt_tracker #(
 
     // the issued operation: the four issue conditions exclude each other (MATCH, EV with
     // a lift pending or not, UPD), so each field is an AND-OR of its four sources
-    wire [1:0]    iss_typ = {iss_lift | iss_upd, q_asg | iss_upd};   // T_MOVE 1, T_LIFT 2, T_UPD 3
+    wire [1:0]    iss_typ = {iss_lift | iss_evl | iss_upd, q_asg | iss_upd};   // T_MOVE 1, T_LIFT 2, T_UPD 3
     wire [SB-1:0] iss_s   = ({SB{q_asg}} & h_s) | ({SB{iss_lift}} & enc(l_pick_q)) |
-                            ({SB{iss_new}} & enc(f_pick_q)) | ({SB{iss_upd}} & enc(p_pick_q));
+                            ({SB{iss_new}} & enc(f_pick_q)) | ({SB{iss_upd}} & enc(p_pick_q)) |
+                            ({SB{iss_evl}} & enc(o_pick_q));
     wire [MT-1:0] iss_so  = asg_s | ({MT{iss_lift}} & l_pick_q) | ({MT{iss_new}} & f_pick_q) |
-                            ({MT{iss_upd}} & p_pick_q);
+                            ({MT{iss_upd}} & p_pick_q) | ({MT{iss_evl}} & o_pick_q);
+    // the slot a move or a new is issued for: it becomes the youngest in the age order
+    wire [MT-1:0] seen_so = asg_s | ({MT{iss_new}} & f_pick_q);
     wire [SB-1:0] iss_t   = ({SB{q_asg}} & h_t) | ({SB{iss_new}} & enc(u_pick_q));
 
     // the held operation goes on when the next one is issued or the frame's events end
@@ -622,7 +658,7 @@ module fmt_tracker #(
     wire [PR_W-1:0] w_pry = pred_of(pw_y_q);
 
     always @(posedge clk) begin : s_main
-        integer s_i;
+        integer s_i, s_j;
         if (rst) begin
             state_q        <= S_IDLE;
             frame_q        <= {FRAME_W{1'b0}};
@@ -654,6 +690,9 @@ module fmt_tracker #(
             src_q          <= {MT{1'b0}};
             upm_q          <= {MT{1'b0}};
             l_pick_q       <= {MT{1'b0}};
+            o_pick_q       <= {MT{1'b0}};
+            ho_q           <= {MT{1'b0}};
+            o_any_q        <= 1'b0;
             u_pick_q       <= {MT{1'b0}};
             f_pick_q       <= {MT{1'b0}};
             p_pick_q       <= {MT{1'b0}};
@@ -772,6 +811,9 @@ module fmt_tracker #(
             fm_q     <= fm_d;
             src_q    <= src_d;
             upm_q    <= upm_d;
+            ho_q     <= ho_d;
+            o_pick_q <= oldest(ho_d, older_q);
+            o_any_q  <= |ho_d;
             l_pick_q <= lowest(lm_d);
             u_pick_q <= lowest(um_d);
             f_pick_q <= lowest(src_d);
@@ -784,6 +826,14 @@ module fmt_tracker #(
             // ---- lifts, then news (first free slot from the round-robin pointer) --------
             if (iss_lift)
                 act_q <= act_q & ~l_pick_q;
+            if (iss_evl)
+                act_q <= act_q & ~o_pick_q;
+            // the age order (no reset: every pair of slots in hold-off has been set by
+            // their moves or news since the reset)
+            for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                for (s_j = 0; s_j < MT; s_j = s_j + 1)
+                    if (seen_so[s_i])      older_q[s_j*MT + s_i] <= 1'b1;   // all before s_i
+                    else if (seen_so[s_j]) older_q[s_j*MT + s_i] <= 1'b0;   // s_j the youngest
             if (iss_new) begin
                 act_q   <= act_q | f_pick_q;
                 sused_q <= sused_q | f_pick_q;
@@ -816,7 +866,8 @@ module fmt_tracker #(
                 op_cnf_q  <= h_conf;
                 op_seen_q <= h_seen1;
                 op_typ_q  <= iss_typ;
-                op_vis_q  <= (q_asg & (~h_tent | h_conf)) | (iss_lift & ~l_tent) | (iss_new & cf1_q);
+                op_vis_q  <= (q_asg & (~h_tent | h_conf)) | (iss_lift & ~l_tent) | (iss_new & cf1_q) |
+                             iss_evl;                   // a contact in hold-off is confirmed
                 op_etyp_q <= (q_asg & h_tent) ? T_NEW : iss_typ;
                 op_s_q    <= iss_s;
                 op_so_q   <= iss_so;

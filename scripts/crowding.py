@@ -1,17 +1,22 @@
 #!/usr/bin/env python3
 """Crowding above the contact limit (issue #11 item 3), through the fixed-point model.
 
-Two cases per seed, each with N the contact limit (`--limits`, default 16 and 6):
+Three cases per seed, each with N the contact limit (`--limits`, default 16 and 6):
 
 * ``together``: N + 1 fingers land in the same frame;
 * ``one_lands``: N fingers, then one more (the largest and strongest of all) lands 150
-  frames later among them.
+  frames later among them;
+* ``relands``: N fingers lift after 150 frames and N others land elsewhere 5 frames
+  later, while the first N are still in hold-off (33 frames): the new ones take the
+  slots of the contacts in hold-off.
 
 The fingers sit on a jittered 20 mm grid (random places, 7-10 mm, strength 0.85-1.0,
 some drifting at up to 0.2 m/s), 30 dB per window, M = 1.  Counted after the contacts
 have settled (the landing frame + 10): frames in which the number of reported contacts
-(new or move events) is not N, new IDs, and lifts.  With continuing contacts ranked
-first, every count is 0: the same N contacts in every frame.
+(new or move events) is not N, new IDs, and lifts (``relands``: from 5 frames after
+the second landing on, counting the N new IDs and N lifts there as expected).  With
+continuing contacts ranked first and hold-off slots given up to new touches, every
+count is 0: the same N contacts in every frame.
 
     python scripts/crowding.py [--seeds 1 2 3] [--limits 16 6] [--frames 400]
 
@@ -33,7 +38,9 @@ from fmt import settings as _settings  # noqa: E402
 from fmt.scene import Contact, Scene  # noqa: E402
 
 LAND = 10               # frame of the first landing
-LATE = 150              # frames after it that the extra finger lands (one_lands)
+LATE = 150              # frames after it that the extra finger lands (one_lands), or
+                        # that the N fingers lift (relands; the others land 5 later)
+RELAND = 5
 
 
 def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0) -> Scene:
@@ -43,7 +50,7 @@ def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0)
     grid = [(x, y) for y in np.arange(15.0, h - 10.0, 20.0) for x in np.arange(15.0, w - 10.0, 20.0)]
     if len(grid) < n + 1:
         raise ValueError(f"crowding: {n + 1} fingers do not fit the {w:g} x {h:g} mm sensor")
-    pick = rng.choice(len(grid), size=n + 1, replace=False)
+    pick = rng.choice(len(grid), size=2 * n if case == "relands" else n + 1, replace=False)
     t_end = frames * cfg.window_s
     contacts = []
     for k, g in enumerate(pick):
@@ -51,24 +58,31 @@ def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0)
         late = case == "one_lands" and k == n
         vx, vy = (rng.uniform(-0.2, 0.2, 2) * 1e3) if k % 3 == 0 else (0.0, 0.0)   # mm/s
         t0 = (LAND + (LATE if late else 0)) * cfg.window_s + rng.uniform(0, cfg.window_s)
+        t1 = t_end + 1.0
+        if case == "relands":
+            lift = (LAND + LATE) * cfg.window_s + rng.uniform(0, cfg.window_s)
+            t0, t1 = ((t0, lift) if k < n else
+                      ((LAND + LATE + RELAND) * cfg.window_s + rng.uniform(0, cfg.window_s), t1))
         contacts.append(Contact(
             name=f"F{k}", diameter_mm=10.0 if late else float(rng.uniform(7.0, 9.0)),
             strength=1.0 if late else float(rng.uniform(0.85, 1.0)),
             path=[[0.0, x0, y0], [t_end, x0 + vx * t_end, y0 + vy * t_end]],
-            active=[[t0, t_end + 1.0]]))
+            active=[[t0, t1]]))
     return Scene(name=f"crowd_{case}_{n}_{seed}", sensor="default", frames=frames, seed=seed,
                  effects={"noise": {"snr_db": snr_db}, "pn": {"enable": True, "chip_len": 1}},
                  contacts=contacts)
 
 
-def count(frame_events: list, n: int, settle: int) -> dict:
-    """Frames (index >= settle) whose reported contacts are not n; new IDs and lifts there."""
+def count(frame_events: list, n: int, settle: int, first: int | None = None) -> dict:
+    """Frames (index >= settle) whose reported contacts are not n; new IDs and lifts from
+    frame ``first`` (default settle) on."""
+    first = settle if first is None else first
     bad = new = lifts = 0
-    for ev in frame_events[settle:]:
+    for k, ev in enumerate(frame_events):
         live = {e.id for e in ev if e.type in ("new", "move")}
-        bad += len(live) != n
-        new += sum(e.type == "new" for e in ev)
-        lifts += sum(e.type == "lift" for e in ev)
+        bad += k >= settle and len(live) != n
+        new += k >= first and sum(e.type == "new" for e in ev)
+        lifts += k >= first and sum(e.type == "lift" for e in ev)
     return {"frames_not_n": bad, "new_ids": new, "lifts": lifts}
 
 
@@ -84,11 +98,18 @@ def run(seeds, limits, frames: int, quiet: bool = False) -> dict:
     tot = {"scenes": 0, "frames_not_n": 0, "new_ids": 0, "lifts": 0}
     for n in limits:
         st = _settings.TouchSettings(max_touches=n)
-        for case in ("together", "one_lands"):
+        for case in ("together", "one_lands", "relands"):
             for seed in seeds:
                 sc = crowd_scene(case, n, seed, frames)
-                settle = LAND + 10
-                c = count(events(sc, st), n, settle)
+                evs = events(sc, st)
+                if case == "relands":
+                    settle = LAND + LATE + RELAND + 5
+                    c = count(evs, n, settle, LAND + LATE)
+                    c["new_ids"] -= n           # the second set's N, and the first set's lifts
+                    c["lifts"] -= n
+                else:
+                    settle = LAND + 10
+                    c = count(evs, n, settle)
                 tot["scenes"] += 1
                 for k in c:
                     tot[k] += c[k]

@@ -35,7 +35,11 @@ of the frame are dropped and counted):
    lasts one frame (the spectral leakage of a finger landing or lifting inside a
    window gives such touches beside it) never becomes a contact, at the cost of
    ``confirm_frames - 1`` frames of touch-down latency.  With no free slot the touch
-   is dropped and counted.
+   takes the slot of the contact in hold-off that was seen longest ago (the earliest
+   last move or new, in event order; the slot's ``lift`` event comes first, then the
+   slot is allocated as above): a hold-off keeps an ID for a finger that comes back,
+   it must not keep a new finger out.  With no contact in hold-off either the touch is
+   dropped and counted.
 6. update.  Matched slot: ``e = (meas << VF) - p`` (the prediction error at full
    precision); ``v = clamp(v + (e >> S), +-max_speed_v)`` per axis (arithmetic shift =
    floor; an alpha-beta filter with g = 1, h = 2^-S, i.e. an exponential average of the
@@ -174,6 +178,7 @@ class _Slot:
     ly: int = 0
     tent: bool = False            # tentative: not reported yet
     seen: int = 0                 # frames seen while tentative
+    last_op: int = 0              # sequence number of its last move or new (the age order)
 
 
 @dataclass
@@ -183,6 +188,7 @@ class TrackerStats:
     frames: int = 0
     lift_ops: int = 0             # slots freed in the last frame (also tentative ones: no event)
     new_ops: int = 0              # slots allocated in the last frame (also tentative ones)
+    evictions: int = 0            # contacts in hold-off lifted early for a new touch
 
 
 class Tracker:
@@ -192,6 +198,7 @@ class Tracker:
         self.p = p
         self.slots = [_Slot() for _ in range(p.max_touches)]
         self.next_slot = 0
+        self.op_seq = 0               # counts moves and news (silent ones too)
         self.stats = TrackerStats()
 
     def slot_id(self, s: int) -> int:
@@ -229,6 +236,8 @@ class Tracker:
                 matched_touch[s] = t
                 tt = touches[t]
                 st = sl[s]
+                self.op_seq += 1
+                st.last_op = self.op_seq
                 typ = "move"
                 if st.tent:
                     st.seen = min(st.seen + 1, CONFIRM_MAX)
@@ -266,16 +275,28 @@ class Tracker:
                 st.miss += 1
                 st.px += st.vx
                 st.py += st.vy
-        # 5. news
+        # 5. news (a contact in hold-off seen longest ago makes room when no slot is free)
+        fresh = [False] * n
         for t in range(nt):
             if t_used[t] or touches[t].strength < p.on_threshold:
                 continue
             s = self._alloc()
             if s < 0:
-                self.stats.no_slot += 1
-                continue
+                held = [k for k in range(n) if sl[k].active and matched_touch[k] < 0 and not fresh[k]]
+                if not held:
+                    self.stats.no_slot += 1
+                    continue
+                k = min(held, key=lambda k: sl[k].last_op)
+                sl[k].active = False
+                self.stats.lift_ops += 1
+                self.stats.evictions += 1
+                events.append(TouchEvent(frame, self.slot_id(k), "lift", sl[k].lx, sl[k].ly))
+                s = self._alloc()
             tt = touches[t]
             st = sl[s]
+            fresh[s] = True
+            self.op_seq += 1
+            st.last_op = self.op_seq
             self.stats.new_ops += 1
             st.active = True
             st.gen = (st.gen + 1) & ((1 << (p.id_w - p.slot_bits)) - 1)

@@ -202,8 +202,38 @@ def test_17_touches_limit_16():
     tr4 = Tracker(TrackParams(max_touches=4))
     track_fixed([[tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)],
            [tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)]], tr4.p, tracker=tr4)
+    ids = ids_of(track_fixed([[tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)]], tr4.p,
+                             tracker=tr4)[0])
     out = track_fixed([[tq(10, 10), tq(30, 10), tq(100, 50), tq(50, 10)]], tr4.p, tracker=tr4)
-    assert tr4.stats.no_slot == 1                  # (70,10) is in hold-off, no slot for (100,50)
+    # (70,10) is in hold-off and the only slot (100,50) can have: lifted for it
+    assert tr4.stats.no_slot == 0 and tr4.stats.evictions == 1
+    assert [e.type for e in out[0]] == ["move", "move", "move", "lift", "new"]
+    assert out[0][3].id == ids[3] and out[0][4].id != ids[3]
+    # a touch finds a slot whenever the frame has no more touches than slots: every
+    # slot not matched is free, lifted or in hold-off
+
+
+def test_new_touches_take_slots_in_hold_off():
+    """More new touches than free slots while contacts are in hold-off (issue #11 item
+    3): each takes the slot of the contact seen longest ago (lifted first), in arrival
+    order; with the confirmation the new ones are tentative, so they are reported a frame
+    later; contacts matched in the frame are never taken."""
+    p = TrackParams(max_touches=4, hold_off_frames=33, confirm_frames=2)
+    tr = Tracker(p)
+    old = [tq(10, 10), tq(30, 10), tq(50, 10), tq(70, 10)]
+    track_fixed([old, old, old], p, tracker=tr)                # four confirmed contacts
+    ids = ids_of(track_fixed([old], p, tracker=tr)[0])
+    track_fixed([old[:2]], p, tracker=tr)                      # (50,10), (70,10) missing
+    track_fixed([[old[0]]], p, tracker=tr)                     # then (30,10) too
+    new = [tq(100, 60), tq(130, 60), tq(160, 60)]
+    out = track_fixed([[old[0]] + new], p, tracker=tr)[0]
+    lifts = [e.id for e in out if e.type == "lift"]
+    assert lifts == [ids[2], ids[3], ids[1]]                   # seen longest ago first
+    assert [e.type for e in out] == ["move", "lift", "lift", "lift"]   # news tentative
+    assert tr.stats.evictions == 3 and tr.stats.no_slot == 0
+    out = track_fixed([[old[0]] + new], p, tracker=tr)[0]
+    assert [e.type for e in out] == ["move", "new", "new", "new"]
+    assert ids[0] in ids_of(out)
 
 
 def test_flicker_absorbed():

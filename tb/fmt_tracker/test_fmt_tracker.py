@@ -436,7 +436,8 @@ async def gate_boundaries(dut):
 
 @cocotb.test()
 async def over_limit_touches(dut):
-    """MAX_TOUCHES + 1 touches in a frame, then a new touch while all slots are taken."""
+    """MAX_TOUCHES + 1 touches in a frame, then a new touch while all slots are taken,
+    one by a contact in hold-off: that contact is lifted for it (no touch without a slot)."""
     tb = TB(dut)
     mt = tb.mt
     p = TrackParams(hold_off_frames=3, vel_shift=4, max_touches=mt)
@@ -444,10 +445,36 @@ async def over_limit_touches(dut):
     await tb.reset()
     full = [Touch(q(10 + 9 * (i % 8)), q(10 + 9 * (i // 8)), 1000 + i) for i in range(mt + 1)]
     frames = [full, full, full[:mt - 1], full[:mt - 1] + [Touch(q(190), q(140), 77)], [], [], []]
-    await run_frames(tb, p, frames)
+    model, _ = await run_frames(tb, p, frames)
+    assert model.stats.evictions == 1 and model.stats.no_slot == 0
     assert int(dut.drop_flag_o.value) == 1
-    assert int(dut.noslot_flag_o.value) == 1
+    assert int(dut.noslot_flag_o.value) == 0
     assert int(dut.overrun_flag_o.value) == 0
+
+
+@cocotb.test()
+async def hold_off_eviction(dut):
+    """More new touches than free slots while contacts are in hold-off: each takes the
+    slot of the contact seen longest ago (its lift first), with and without the
+    confirmation; contacts that lost their touch in different frames, and in one frame
+    (then the order of their last moves decides)."""
+    tb = TB(dut)
+    mt = tb.mt
+    for confirm in (1, 2):
+        p = TrackParams(hold_off_frames=20, vel_shift=4, confirm_frames=confirm, max_touches=mt)
+        tb.set_params(p)
+        await tb.reset()
+        old = [Touch(q(10 + 12 * (i % 8)), q(10 + 12 * (i // 8)), 3000 + 7 * i) for i in range(mt)]
+        new = [Touch(q(15 + 12 * (i % 8)), q(100 + 12 * (i // 8)), 5000 + i) for i in range(mt)]
+        h = mt // 2
+        frames = [old] * 3 + [old[:h + 1]] * 2 + [old[:h]] * 2
+        frames += [old[:h - 1] + new[:h + 1]] * 3          # h + 1 new: h + 1 evictions
+        frames += [new[:mt]] * 3                           # the rest: the last hold-offs go
+        model, _ = await run_frames(tb, p, frames)
+        # every old contact made room for a new one (h + 1, then the other mt - h - 1)
+        assert model.stats.evictions == mt and model.stats.no_slot == 0
+        dut._log.info(f"confirm {confirm}: {model.stats.evictions} evictions")
+    assert int(dut.noslot_flag_o.value) == 0
 
 
 @cocotb.test()
