@@ -37,11 +37,12 @@
 //            active, unmatched, tentative or miss + 1 >= hold_off_i), then one new
 //            per cycle (unmatched touches at least on_thr_i strong, in arrival order;
 //            the first free slot after the round-robin pointer; generation + 1).  No
-//            free slot: first a lift of the contact in hold-off seen longest ago (its
-//            last move or new issued earliest: an age order of the slots, older_q[j][i]
-//            = slot j's last move or new came before slot i's, set when a move or new
-//            is issued), then the new takes that slot; none in hold-off either: dropped,
-//            sticky noslot_flag_o.  Every mask keeps its lowest set bit (the hold-off
+//            free slot: the contact in hold-off seen longest ago (its last move or new
+//            issued earliest: an age order of the slots, older_q[j][i] = slot j's last
+//            move or new came before slot i's, set when a move or new is issued) is put
+//            into the lift mask (one cycle without an issue), lifted in the next cycle
+//            like any lift, and the new takes its slot; none in hold-off either:
+//            dropped, sticky noslot_flag_o.  Every mask keeps its lowest set bit (the hold-off
 //            mask its oldest slot: the next pick) and "not empty" in registers,
 //            computed the cycle before.
 //   Confirmation (confirm_i >= 2): a new slot is tentative (seen 1 frame); its moves
@@ -62,7 +63,9 @@
 //
 // Latency (tp_eof in cycle c, the frame's last touch in cycle a <= c; SB = 4 at 16
 // slots): first MATCH decision in cycle d0 = max(c + 1, a + SB + 3); without stale
-// pops MATCH ends m cycles later (m moves); l lifts and n news take one cycle each;
+// pops MATCH ends m cycles later (m moves); l lifts and n news take one cycle each,
+// an eviction one more (its lift is one of the l; in the frames that evict, add their
+// number to l + n below: at most the number of touches, so the worst case stays);
 // the last event is on the output in cycle d0 + m + l + n + 2 + e (e = 1 if l + n > 0:
 // lifts and news start the cycle after MATCH ends, so that their masks and picks come
 // from registers only; l and n count every lift and new operation, also the silent
@@ -520,11 +523,12 @@ module fmt_tracker #(
     // picks update from registers only; a frame with none ends in the m_done cycle
     wire          iss_lift = state_q[2] & l_any_q;
     wire          iss_new  = state_q[2] & ~l_any_q & u_any_q & f_any_q;
-    // no free slot for the next new: the oldest contact in hold-off is lifted for it
-    wire          iss_evl  = state_q[2] & ~l_any_q & u_any_q & ~f_any_q & o_any_q;
+    // no free slot for the next new: the oldest contact in hold-off goes into the lift
+    // mask (this cycle issues nothing; its lift is the next)
+    wire          evict    = state_q[2] & ~l_any_q & u_any_q & ~f_any_q & o_any_q;
     wire          ev_done  = (m_done | state_q[2]) & ~l_any_q & ~(u_any_q & (f_any_q | o_any_q));
     wire          iss_upd  = state_q[3] & p_any_q;
-    wire          iss      = q_asg | iss_lift | iss_new | iss_upd | iss_evl;
+    wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
     wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
 
     // next masks and their picks
@@ -552,18 +556,17 @@ module fmt_tracker #(
             fm_d  = fm_q | l_pick_q;
             hm_d  = fm_d & therm_q;
             src_d = (|hm_d) ? hm_d : fm_d;
-        end else if (iss_evl) begin
-            // the evicted slot is the only free one: the next new takes it
-            ho_d  = ho_q & ~o_pick_q;
-            fm_d  = o_pick_q;
-            hm_d  = o_pick_q & therm_q;
-            src_d = o_pick_q;
         end else if (iss_new) begin
             // src: free slots after the last pick (from the pointer), else all free slots
             um_d  = um_q & ~u_pick_q;
             fm_d  = fm_q & ~f_pick_q;
             hm_d  = src_q & ~f_pick_q;
             src_d = (|hm_d) ? hm_d : fm_d;
+        end
+        // an eviction: the oldest contact in hold-off is the next lift (lm_q is empty)
+        if (evict) begin
+            lm_d = o_pick_q;
+            ho_d = ho_q & ~o_pick_q;
         end
         // hold-off updates: tracked from the registers until UPD (act_q and sused_q are
         // final in the ev_done cycle, which issues nothing), then one pick per update
@@ -596,12 +599,11 @@ module fmt_tracker #(
 
     // the issued operation: the four issue conditions exclude each other (MATCH, EV with
     // a lift pending or not, UPD), so each field is an AND-OR of its four sources
-    wire [1:0]    iss_typ = {iss_lift | iss_evl | iss_upd, q_asg | iss_upd};   // T_MOVE 1, T_LIFT 2, T_UPD 3
+    wire [1:0]    iss_typ = {iss_lift | iss_upd, q_asg | iss_upd};   // T_MOVE 1, T_LIFT 2, T_UPD 3
     wire [SB-1:0] iss_s   = ({SB{q_asg}} & h_s) | ({SB{iss_lift}} & enc(l_pick_q)) |
-                            ({SB{iss_new}} & enc(f_pick_q)) | ({SB{iss_upd}} & enc(p_pick_q)) |
-                            ({SB{iss_evl}} & enc(o_pick_q));
+                            ({SB{iss_new}} & enc(f_pick_q)) | ({SB{iss_upd}} & enc(p_pick_q));
     wire [MT-1:0] iss_so  = asg_s | ({MT{iss_lift}} & l_pick_q) | ({MT{iss_new}} & f_pick_q) |
-                            ({MT{iss_upd}} & p_pick_q) | ({MT{iss_evl}} & o_pick_q);
+                            ({MT{iss_upd}} & p_pick_q);
     // the slot a move or a new is issued for: it becomes the youngest in the age order
     wire [MT-1:0] seen_so = asg_s | ({MT{iss_new}} & f_pick_q);
     wire [SB-1:0] iss_t   = ({SB{q_asg}} & h_t) | ({SB{iss_new}} & enc(u_pick_q));
@@ -826,8 +828,6 @@ module fmt_tracker #(
             // ---- lifts, then news (first free slot from the round-robin pointer) --------
             if (iss_lift)
                 act_q <= act_q & ~l_pick_q;
-            if (iss_evl)
-                act_q <= act_q & ~o_pick_q;
             // the age order (no reset: every pair of slots in hold-off has been set by
             // their moves or news since the reset)
             for (s_i = 0; s_i < MT; s_i = s_i + 1)
@@ -866,8 +866,7 @@ module fmt_tracker #(
                 op_cnf_q  <= h_conf;
                 op_seen_q <= h_seen1;
                 op_typ_q  <= iss_typ;
-                op_vis_q  <= (q_asg & (~h_tent | h_conf)) | (iss_lift & ~l_tent) | (iss_new & cf1_q) |
-                             iss_evl;                   // a contact in hold-off is confirmed
+                op_vis_q  <= (q_asg & (~h_tent | h_conf)) | (iss_lift & ~l_tent) | (iss_new & cf1_q);
                 op_etyp_q <= (q_asg & h_tent) ? T_NEW : iss_typ;
                 op_s_q    <= iss_s;
                 op_so_q   <= iss_so;

@@ -188,7 +188,8 @@ class TrackerStats:
     frames: int = 0
     lift_ops: int = 0             # slots freed in the last frame (also tentative ones: no event)
     new_ops: int = 0              # slots allocated in the last frame (also tentative ones)
-    evictions: int = 0            # contacts in hold-off lifted early for a new touch
+    evictions: int = 0            # contacts in hold-off lifted early for a new touch (all frames)
+    evict_ops: int = 0            # ... in the last frame (each costs the RTL one cycle more)
 
 
 class Tracker:
@@ -214,7 +215,7 @@ class Tracker:
             self.stats.dropped_touches += len(touches) - n
             touches = touches[:n]
         self.stats.frames += 1
-        self.stats.lift_ops = self.stats.new_ops = 0
+        self.stats.lift_ops = self.stats.new_ops = self.stats.evict_ops = 0
         nt = len(touches)
         sl = self.slots
         events: list[TouchEvent] = []
@@ -290,6 +291,7 @@ class Tracker:
                 sl[k].active = False
                 self.stats.lift_ops += 1
                 self.stats.evictions += 1
+                self.stats.evict_ops += 1
                 events.append(TouchEvent(frame, self.slot_id(k), "lift", sl[k].lx, sl[k].ly))
                 s = self._alloc()
             tt = touches[t]

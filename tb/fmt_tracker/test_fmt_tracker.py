@@ -204,7 +204,7 @@ def tail_latency(ops, dm, eof: int, last_touch, sb: int) -> tuple[int, int]:
     d0 = max(1, last_touch + sb + 3 - eof) cycles after it; then match_cycles; then, if
     the frame has lifts or news, one cycle (they issue from the cycle after MATCH ends)
     and one cycle per lift and new (``ops`` = lift + new operations, also the tentative
-    contacts' silent ones); the cycle that ends the events, and the event hold's cycle
+    contacts' silent ones, plus one per eviction); the cycle that ends the events, and the event hold's cycle
     that marks the last event.  Returns (lat, stale pops)."""
     mc, pops = match_cycles(dm, sb) if dm is not None else (0, 0)
     d0 = max(1, last_touch + sb + 3 - eof) if last_touch is not None else 1
@@ -232,7 +232,8 @@ async def run_frames(tb, p: TrackParams, frames, rng=None, start_frame=0, model=
             # tp_eof high in cycle c (sampled by edge `eof`) -> last event valid in
             # cycle c + lat (a plain register would be lat = 1)
             lat = got[-1][0] - eof + 1
-            ops = model.stats.lift_ops + model.stats.new_ops
+            # an eviction (a new touch taking a hold-off slot) costs one cycle more
+            ops = model.stats.lift_ops + model.stats.new_ops + model.stats.evict_ops
             exp_lat, pops = tail_latency(ops, dm, eof, tb.last_touch, tree_stages(tb.mt))
             assert lat == exp_lat, \
                 f"tail latency {lat} (model {exp_lat}) for {len(got)} events, {pops} stale pops"
