@@ -172,6 +172,8 @@ async def adc_skew_extremes_and_dds(dut):
 def test_fpga_xc5v(sim, seed):
     if sim == "verilator" and seed != 1:
         pytest.skip("one seed under Verilator (its build of fmt_core takes minutes); all under Icarus")
+    if seed != 1 and os.environ.get("FMT_LONG", "0") in ("", "0"):
+        pytest.skip("seeds 2 and 3 in make test-long (FMT_LONG=1), for make test's time")
     cfg = params.get("small")
     run_cocotb(sim=sim, toplevel="fpga_core", sources=board_sources(),
                test_module="test_fpga_xc5v", test_dir=Path(__file__).parent,
