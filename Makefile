@@ -92,7 +92,7 @@ mutate: setup
 
 # ---- tests ---------------------------------------------------------------------
 test: setup lint formal
-	$(VPY) -m pytest -q -n $(JOBS) sim/tests tb
+	$(VPY) -m pytest -q -n $(JOBS) --durations=12 sim/tests tb
 
 test-model: setup
 	$(VPY) -m pytest -q -n $(JOBS) sim/tests
@@ -101,7 +101,9 @@ test-rtl: setup
 	$(VPY) -m pytest -q -n $(JOBS) tb
 
 # full-size builds that make test leaves out (Verilator only): among them the default
-# 30 x 40 core against the 8 us budget (FMT_CORE_DEFAULT) and the full-size fmt_touch
+# 30 x 40 core against the 8 us budget (FMT_CORE_DEFAULT) and the full-size fmt_touch;
+# with FMT_LONG=1 also the tests marked long_only (tb/conftest.py) and the other simulator
+# or seeds that make test skips for its time
 test-long: setup
 	FMT_LONG=1 FFT_LONG=1 FMT_CORE_DEFAULT=1 FMT_TOUCH_DEFAULT=1 FMT_RX_FULL=1 FMT_DDS_FULL=1 \
 	  $(VPY) -m pytest -q -n $(JOBS) sim/tests tb

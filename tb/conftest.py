@@ -2,7 +2,9 @@
 
 The ``sim`` parameter runs each test under Icarus and Verilator; ``SIM=icarus`` or
 ``SIM=verilator`` picks one.  A test that is Verilator-only (full-size builds, which
-Icarus is too slow for) marks itself with ``@pytest.mark.verilator_only``.
+Icarus is too slow for) marks itself with ``@pytest.mark.verilator_only``.  A test marked
+``@pytest.mark.long_only`` runs only when ``FMT_LONG`` is set (``make test-long``): slow
+duplicates of what ``make test`` already covers at a smaller size, kept out of its 20 minutes.
 """
 import os
 import sys
@@ -29,6 +31,17 @@ def _selected_sims():
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "verilator_only: run under Verilator only (too slow for Icarus)")
+    config.addinivalue_line("markers", "long_only: run only in make test-long (FMT_LONG=1)")
+
+
+def pytest_collection_modifyitems(config, items):
+    from common.runner import long_run
+    if long_run():
+        return
+    skip = pytest.mark.skip(reason="make test-long (FMT_LONG=1) runs it; make test covers it at a smaller size")
+    for item in items:
+        if item.get_closest_marker("long_only"):
+            item.add_marker(skip)
 
 
 def pytest_generate_tests(metafunc):

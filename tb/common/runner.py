@@ -60,6 +60,11 @@ def build_digest(sim: str, toplevel: str, sources, includes, parameters: dict, a
     return h.hexdigest()
 
 
+def long_run() -> bool:
+    """True in make test-long (FMT_LONG set and not 0): the slow duplicates run too."""
+    return os.environ.get("FMT_LONG", "0") not in ("", "0")
+
+
 def waves_requested() -> bool:
     return os.environ.get("WAVES", "0") not in ("", "0", "no", "false")
 

@@ -29,6 +29,7 @@ SEED = 15
 
 
 @pytest.mark.verilator_only
+@pytest.mark.long_only       # also `make fuzz`; the port's own cocotb and formal checks run in make test
 def test_fuzz_ctrl(sim, tmp_path):
     assert sim == "verilator"
     r = subprocess.run([sys.executable, str(ROOT / "scripts" / "fuzz_ctrl.py"), "--bytes", str(BYTES),

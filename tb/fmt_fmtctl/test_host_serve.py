@@ -39,6 +39,7 @@ TAG = "tb_tuio"
 
 
 @pytest.mark.verilator_only
+@pytest.mark.long_only       # tuio / view / record against the model server run in make test
 def test_host_tools_on_the_simulated_core(sim, tmp_path):
     assert sim == "verilator"
     cfg = params.SMALL

@@ -247,6 +247,7 @@ def test_fmt_rx_array_post_on_ce(sim):
 
 
 @pytest.mark.verilator_only
+@pytest.mark.long_only       # make test: small and medium; fmt_core_default also covers 30 x 40
 def test_fmt_rx_array_default(sim):
     """Full 30 x 40, N = 256 at the real clocking: ce = 1 in 3, CLK_PER_SAMPLE = 3
     (MAG_UNITS 4): bit-exact (M = 1, 3), latency, hard cases."""

@@ -24,7 +24,7 @@ import pytest
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, RisingEdge
 
-from common.runner import ROOT, rom_define, run_cocotb
+from common.runner import ROOT, long_run, rom_define, run_cocotb
 from common.sources import _dedup, _parse
 from fmt import board, params
 from fmt import channel as _channel
@@ -172,8 +172,9 @@ async def adc_skew_extremes_and_dds(dut):
 def test_fpga_xc5v(sim, seed):
     if sim == "verilator" and seed != 1:
         pytest.skip("one seed under Verilator (its build of fmt_core takes minutes); all under Icarus")
-    if seed != 1 and os.environ.get("FMT_LONG", "0") in ("", "0"):
-        pytest.skip("seeds 2 and 3 in make test-long (FMT_LONG=1), for make test's time")
+    if (seed != 1 or sim == "verilator") and not long_run():
+        pytest.skip("make test: seed 1 under Icarus; seeds 2 and 3 and the Verilator build in "
+                    "make test-long (FMT_LONG=1), for make test's time")
     cfg = params.get("small")
     run_cocotb(sim=sim, toplevel="fpga_core", sources=board_sources(),
                test_module="test_fpga_xc5v", test_dir=Path(__file__).parent,
