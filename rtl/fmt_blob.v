@@ -1094,6 +1094,9 @@ module fmt_blob #(
             localparam HI = (ga == 0) ? O_SX : (ga == 1) ? O_SY : (ga == 2) ? O_RMIN
                           : (ga == 3) ? O_PEAK : E_W;
             localparam SW = HI - LO;
+            // distributed RAM (as Yosys maps it for xc5v anyway): read A's register is a
+            // flip-flop, not a block RAM's output, in front of combine()'s compares
+            (* ram_style = "distributed" *)
             reg  [SW-1:0]    acc_q [0:NL];    // (0: never written, keeps the reads in range)
             reg  [LBL_W-1:0] ra_q, rb_q, wa_q;
             reg              we_q, nw_q, mrg_q, pkv_q, fa_q, fb_q;
