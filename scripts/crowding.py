@@ -33,44 +33,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "sim"))
 
-from fmt import chain, params, run_sim, touch  # noqa: E402
+from fmt import chain, run_sim, touch  # noqa: E402
 from fmt import settings as _settings  # noqa: E402
-from fmt.scene import Contact, Scene  # noqa: E402
-
-LAND = 10               # frame of the first landing
-LATE = 150              # frames after it that the extra finger lands (one_lands), or
-                        # that the N fingers lift (relands; the others land 5 later)
-RELAND = 5
-
-
-def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0) -> Scene:
-    cfg = params.DEFAULT
-    rng = np.random.default_rng(1000 * seed + n)
-    w, h = cfg.cols * cfg.pitch_mm, cfg.rows * cfg.pitch_mm
-    grid = [(x, y) for y in np.arange(15.0, h - 10.0, 20.0) for x in np.arange(15.0, w - 10.0, 20.0)]
-    if len(grid) < n + 1:
-        raise ValueError(f"crowding: {n + 1} fingers do not fit the {w:g} x {h:g} mm sensor")
-    pick = rng.choice(len(grid), size=2 * n if case == "relands" else n + 1, replace=False)
-    t_end = frames * cfg.window_s
-    contacts = []
-    for k, g in enumerate(pick):
-        x0, y0 = grid[g][0] + rng.uniform(-3, 3), grid[g][1] + rng.uniform(-3, 3)
-        late = case == "one_lands" and k == n
-        vx, vy = (rng.uniform(-0.2, 0.2, 2) * 1e3) if k % 3 == 0 else (0.0, 0.0)   # mm/s
-        t0 = (LAND + (LATE if late else 0)) * cfg.window_s + rng.uniform(0, cfg.window_s)
-        t1 = t_end + 1.0
-        if case == "relands":
-            lift = (LAND + LATE) * cfg.window_s + rng.uniform(0, cfg.window_s)
-            t0, t1 = ((t0, lift) if k < n else
-                      ((LAND + LATE + RELAND) * cfg.window_s + rng.uniform(0, cfg.window_s), t1))
-        contacts.append(Contact(
-            name=f"F{k}", diameter_mm=10.0 if late else float(rng.uniform(7.0, 9.0)),
-            strength=1.0 if late else float(rng.uniform(0.85, 1.0)),
-            path=[[0.0, x0, y0], [t_end, x0 + vx * t_end, y0 + vy * t_end]],
-            active=[[t0, t1]]))
-    return Scene(name=f"crowd_{case}_{n}_{seed}", sensor="default", frames=frames, seed=seed,
-                 effects={"noise": {"snr_db": snr_db}, "pn": {"enable": True, "chip_len": 1}},
-                 contacts=contacts)
+from fmt.scene import LAND, LATE, RELAND, crowd_scene  # noqa: E402
 
 
 def count(frame_events: list, n: int, settle: int, first: int | None = None) -> dict:
@@ -86,7 +51,7 @@ def count(frame_events: list, n: int, settle: int, first: int | None = None) -> 
     return {"frames_not_n": bad, "new_ids": new, "lifts": lifts}
 
 
-def events(sc: Scene, st) -> list:
+def events(sc, st) -> list:
     """Per frame, the fixed-point pipeline's events (calibrated as fmt.run_sim does)."""
     res = chain.heatmaps_float(sc)
     return touch.process_frames(np.rint(res.heatmaps).astype(np.int64), sc.cfg, st, fixed=True,

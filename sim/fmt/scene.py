@@ -561,11 +561,61 @@ def taps8_scene() -> Scene:
                              "alternating taps 8 mm apart, 20 frames each, B lands as A lifts")
 
 
+# crowding above the contact limit (issue #11 item 3; scripts/crowding.py runs the cases)
+LAND = 10               # frame of the first landing
+LATE = 150              # frames after it that the extra finger lands (one_lands), or
+                        # that the N fingers lift (relands; the others land 5 later)
+RELAND = 5
+
+
+def crowd_scene(case: str, n: int, seed: int, frames: int, snr_db: float = 30.0) -> Scene:
+    """N fingers (or 2 N) on a jittered 20 mm grid of the default sensor, 7-10 mm, some
+    drifting at up to 0.2 m/s, 30 dB, M = 1; ``case``: ``together`` (N + 1 land at
+    frame LAND), ``one_lands`` (N at LAND, the largest and strongest LATE frames later),
+    ``relands`` (N lift at LAND + LATE, N others land RELAND frames later, while the
+    first are in hold-off)."""
+    if case not in ("together", "one_lands", "relands"):
+        raise ValueError(f"crowding: unknown case {case!r} (together, one_lands, relands)")
+    cfg = _params.DEFAULT
+    rng = np.random.default_rng(1000 * seed + n)
+    w, h = cfg.cols * cfg.pitch_mm, cfg.rows * cfg.pitch_mm
+    grid = [(x, y) for y in np.arange(15.0, h - 10.0, 20.0) for x in np.arange(15.0, w - 10.0, 20.0)]
+    if len(grid) < n + 1:
+        raise ValueError(f"crowding: {n + 1} fingers do not fit the {w:g} x {h:g} mm sensor")
+    pick = rng.choice(len(grid), size=2 * n if case == "relands" else n + 1, replace=False)
+    t_end = frames * cfg.window_s
+    contacts = []
+    for k, g in enumerate(pick):
+        x0, y0 = grid[g][0] + rng.uniform(-3, 3), grid[g][1] + rng.uniform(-3, 3)
+        late = case == "one_lands" and k == n
+        vx, vy = (rng.uniform(-0.2, 0.2, 2) * 1e3) if k % 3 == 0 else (0.0, 0.0)   # mm/s
+        t0 = (LAND + (LATE if late else 0)) * cfg.window_s + rng.uniform(0, cfg.window_s)
+        t1 = t_end + 1.0
+        if case == "relands":
+            lift = (LAND + LATE) * cfg.window_s + rng.uniform(0, cfg.window_s)
+            t0, t1 = ((t0, lift) if k < n else
+                      ((LAND + LATE + RELAND) * cfg.window_s + rng.uniform(0, cfg.window_s), t1))
+        contacts.append(Contact(
+            name=f"F{k}", diameter_mm=10.0 if late else float(rng.uniform(7.0, 9.0)),
+            strength=1.0 if late else float(rng.uniform(0.85, 1.0)),
+            path=[[0.0, x0, y0], [t_end, x0 + vx * t_end, y0 + vy * t_end]],
+            active=[[t0, t1]]))
+    return Scene(name=f"crowd_{case}_{n}_{seed}", sensor="default", frames=frames, seed=seed,
+                 effects={"noise": {"snr_db": snr_db}, "pn": {"enable": True, "chip_len": 1}},
+                 contacts=contacts)
+
+
+def crowd_scene_shipped() -> Scene:
+    """Sixteen fingers (the default contact limit), then a seventeenth, larger and
+    stronger than all, lands among them: the same 16 contacts in every frame."""
+    return crowd_scene("one_lands", 16, 1, 200)
+
+
 SHIPPED = {
     "default.json": default_scene, "small.json": small_scene, "small.yaml": small_scene,
     "hard_clip.json": hard_clip_scene, "interferer.json": interferer_scene,
     "pinch.json": pinch_scene, "thumb.yaml": thumb_scene, "drumroll.json": drumroll_scene,
-    "taps8.json": taps8_scene,
+    "taps8.json": taps8_scene, "crowd.json": crowd_scene_shipped,
 }
 
 
