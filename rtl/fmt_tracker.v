@@ -139,6 +139,7 @@ module fmt_tracker #(
 
     // ---- sizes ----------------------------------------------------------------------
     localparam MT    = MAX_TOUCHES;
+    localparam NSP   = 1 << SB;               // slot selects padded to 2^SB
     localparam MTP   = 1 << SB;              // slots padded to a power of two (tree leaves)
     localparam TCW   = $clog2(MT + 1);       // touch counter width
     localparam GEN_W = ID_W - SB;            // generation bits
@@ -412,9 +413,12 @@ module fmt_tracker #(
     // inflight_q: a key is on its way (A2 or a tree stage valid this cycle)
     reg  inflight_q;
     wire in_match = state_q[1];
-    wire q_asg    = in_match & qv_q[0] & ~qst_q[0] & ~inflight_q; // head is the greedy pair
+    // (keep: q_asg and q_pop each one LUT of the same four registers, which their many
+    // users read, so the mapper builds neither from the other nor in a chain of gates)
+    (* keep *) wire q_asg, q_pop;
+    assign q_asg  = in_match & qv_q[0] & ~qst_q[0] & ~inflight_q; // head is the greedy pair
     wire q_stale  = in_match & qv_q[0] & qst_q[0];                // head: recompute its key
-    wire q_pop    = q_asg | q_stale;
+    assign q_pop  = in_match & qv_q[0] & (qst_q[0] | ~inflight_q); // = q_asg | q_stale
     wire m_done   = in_match & ~qv_q[0] & ~inflight_q;            // no candidate pair left
     wire key_ins  = rv_q[SB] & ~key_q[NW-1];
     wire [SB-1:0] h_t = qt_q[0 +: SB];
@@ -519,6 +523,15 @@ module fmt_tracker #(
     // after MATCH, long after
     wire [MT-1:0] tstr_n  = tstr_q | ((a1_v_q && a1_str_q) ? (one << a1_t_q) : {MT{1'b0}});
 
+    // The masks of IDLE and MATCH from registers (their _b forms): exact in the cycle
+    // MATCH ends (m_done: no assignment, no arrival and nothing in A1 then), and held
+    // into EV.  In the m_done cycle itself ev_done reads their "not empty" bits from
+    // these forms, not from the registered ones, so no assignment of the cycle before
+    // has to reach the any-bits (the assignment stays off these paths).
+    wire [MT-1:0] lm_b = act_q & ~sused_q & (lexp_q | tent_q);
+    wire [MT-1:0] ho_b = act_q & ~sused_q & ~(lexp_q | tent_q);
+    wire [MT-1:0] um_b = tval_q & tstr_q & ~tused_q;
+
     // lifts and news issue from the cycle after MATCH ends (EV), so the masks and their
     // picks update from registers only; a frame with none ends in the m_done cycle
     wire          iss_lift = state_q[2] & l_any_q;
@@ -526,7 +539,9 @@ module fmt_tracker #(
     // no free slot for the next new: the oldest contact in hold-off goes into the lift
     // mask (this cycle issues nothing; its lift is the next)
     wire          evict    = state_q[2] & ~l_any_q & u_any_q & ~f_any_q & o_any_q;
-    wire          ev_done  = (m_done | state_q[2]) & ~l_any_q & ~(u_any_q & (f_any_q | o_any_q));
+    wire          u_any_m  = |um_b;        // (u_any_q's value in EV, read in m_done)
+    wire          ev_done  = (m_done & ~(|lm_b) & ~(u_any_m & (f_any_q | (|ho_b))))
+                           | (state_q[2] & ~l_any_q & ~(u_any_q & (f_any_q | o_any_q)));
     wire          iss_upd  = state_q[3] & p_any_q;
     wire          iss      = q_asg | iss_lift | iss_new | iss_upd;
     wire          drained  = ~op_v_q & ~e2_v_q & ~e3_v_q & ~e4_v_q;
@@ -542,11 +557,10 @@ module fmt_tracker #(
         hm_d  = src_q;
         ho_d  = ho_q;
         if (state_q[0] || state_q[1]) begin
-            // shadows of the pending lifts and news, exact when MATCH ends (no
-            // assignment in that cycle, so they hold into EV)
-            lm_d  = act_q & ~sused_n & (lexp_q | tent_q);
-            ho_d  = act_q & ~sused_n & ~(lexp_q | tent_q);
-            um_d  = tval_n & tstr_n & ~tused_n;
+            // shadows of the pending lifts and news (above)
+            lm_d  = lm_b;
+            ho_d  = ho_b;
+            um_d  = um_b;
             fm_d  = ~act_q;
             hm_d  = ~act_q & therm_q;
             src_d = (|hm_d) ? hm_d : fm_d;
@@ -581,20 +595,23 @@ module fmt_tracker #(
     // one slot otherwise): a tentative slot's move counts one more frame seen and is
     // reported as 'new' when that makes confirm_i, else not at all; a tentative slot's
     // lift is not reported; a new is reported only with confirmation off (cf1_q)
-    reg           h_tent;                 // the head's slot: tentative, frames seen
-    reg  [2:0]    h_seen;
-    always @* begin : c_hsel
+    // Each slot's count after one more frame and its confirmation are formed beside the
+    // queue (from registers), and the head's slot then picks them with one mux (padded
+    // to 2^SB slots, NSP): the select does not wait on the increment and the compare.
+    reg  [NSP*5-1:0] sc_all;              // per slot {tent, conf, seen + 1 (saturating)}
+    always @* begin : c_sconf
         integer s_i;
-        h_tent = 1'b0;
-        h_seen = 3'd0;
-        for (s_i = 0; s_i < MT; s_i = s_i + 1)
-            if (h_s == s_i[SB-1:0]) begin
-                h_tent = tent_q[s_i];
-                h_seen = seen_q[s_i*3 +: 3];
-            end
+        reg [2:0] s1;
+        sc_all = {(NSP*5){1'b0}};
+        for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
+            s1 = (seen_q[s_i*3 +: 3] == 3'd7) ? 3'd7 : seen_q[s_i*3 +: 3] + 1'b1;
+            sc_all[s_i*5 +: 5] = {tent_q[s_i], s1 >= confirm_i, s1};
+        end
     end
-    wire [2:0]    h_seen1 = (h_seen == 3'd7) ? 3'd7 : h_seen + 1'b1;
-    wire          h_conf  = h_seen1 >= confirm_i;
+    wire [4:0]    h_sc    = sc_all[h_s*5 +: 5];  // the head's slot
+    wire          h_tent  = h_sc[4];             // tentative
+    wire          h_conf  = h_sc[3];             // one more frame confirms it
+    wire [2:0]    h_seen1 = h_sc[2:0];
     wire          l_tent  = |(tent_q & l_pick_q);
 
     // the issued operation: the four issue conditions exclude each other (MATCH, EV with
@@ -847,7 +864,7 @@ module fmt_tracker #(
             end
             if (m_done) state_q <= S_EV;
             if (ev_done) begin
-                if (u_any_q) noslot_flag_o <= 1'b1;
+                if (state_q[2] ? u_any_q : u_any_m) noslot_flag_o <= 1'b1;
                 state_q <= S_UPD;
             end
             if (state_q[3] && !p_any_q && drained) begin
