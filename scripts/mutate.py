@@ -102,8 +102,8 @@ MUTATIONS = {
         "a touch at distance D <= gate (equal included) is a match candidate"),
     "tracker_confirm_late": (
         "rtl/fmt_tracker.v",
-        "wire          h_conf  = h_seen1 >= confirm_i;",
-        "wire          h_conf  = h_seen1 > confirm_i;",
+        "sc_all[s_i*5 +: 5] = {tent_q[s_i], s1 >= confirm_i, s1};",
+        "sc_all[s_i*5 +: 5] = {tent_q[s_i], s1 > confirm_i, s1};",
         "fmt_tracker/test_fmt_tracker.py::test_fmt_tracker[icarus-small-5]",
         "a new contact is reported in the frame it is seen for the confirm_frames-th time"),
 }

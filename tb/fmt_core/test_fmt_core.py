@@ -70,8 +70,9 @@ def _run(sim, scene, cps, uart, settings, model_settings=None, extra_params=None
 
 @pytest.mark.parametrize("cps", [1, 3])
 def test_fmt_core(sim, cps):
-    if sim == "icarus" and cps == 3 and not long_run():
-        pytest.skip("Verilator runs cps 3 (with the UART) in make test; Icarus in make test-long")
+    if not long_run() and (sim, cps) in (("icarus", 3), ("verilator", 1)):
+        pytest.skip("make test: cps 1 under Icarus, cps 3 (with the UART) under Verilator; "
+                    "the other two in make test-long")
     frames = 14
     # lifts within the run (small frames are 1.536 us); a gate below the tap-drag distance
     st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
