@@ -139,7 +139,6 @@ module fmt_tracker #(
 
     // ---- sizes ----------------------------------------------------------------------
     localparam MT    = MAX_TOUCHES;
-    localparam NSP   = 1 << SB;               // slot selects padded to 2^SB
     localparam MTP   = 1 << SB;              // slots padded to a power of two (tree leaves)
     localparam TCW   = $clog2(MT + 1);       // touch counter width
     localparam GEN_W = ID_W - SB;            // generation bits
@@ -597,12 +596,12 @@ module fmt_tracker #(
     // lift is not reported; a new is reported only with confirmation off (cf1_q)
     // Each slot's count after one more frame and its confirmation are formed beside the
     // queue (from registers), and the head's slot then picks them with one mux (padded
-    // to 2^SB slots, NSP): the select does not wait on the increment and the compare.
-    reg  [NSP*5-1:0] sc_all;              // per slot {tent, conf, seen + 1 (saturating)}
+    // to 2^SB slots, MTP): the select does not wait on the increment and the compare.
+    reg  [MTP*5-1:0] sc_all;              // per slot {tent, conf, seen + 1 (saturating)}
     always @* begin : c_sconf
         integer s_i;
         reg [2:0] s1;
-        sc_all = {(NSP*5){1'b0}};
+        sc_all = {(MTP*5){1'b0}};
         for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
             s1 = (seen_q[s_i*3 +: 3] == 3'd7) ? 3'd7 : seen_q[s_i*3 +: 3] + 1'b1;
             sc_all[s_i*5 +: 5] = {tent_q[s_i], s1 >= confirm_i, s1};
