@@ -16,7 +16,7 @@ import sys
 import pytest
 
 from bench.core import run_sim_rtl as rsr
-from common.runner import run_cocotb
+from common.runner import long_run, run_cocotb
 from fmt import scene as _scene
 from fmt.settings import TouchSettings
 
@@ -35,8 +35,7 @@ def _run_job(sim, cfg, cps, d) -> dict:
 
 
 def test_fmt_core_m3(sim):
-    import os
-    if sim == "verilator" and os.environ.get("FMT_LONG", "0") in ("", "0"):
+    if sim == "verilator" and not long_run():
         pytest.skip("the Verilator build runs in make test-long (FMT_LONG=1); Icarus here")
     frames, cps = 5, 3
     scene = _scene.small_scene().replace(frames=frames, m=M)
@@ -79,9 +78,8 @@ def test_fmt_core_m_written_during_run(sim):
     its first window (the core's rule, fmt_core m_act_q), seen here from the frame ends
     (fe.log: M = the spacing / N / clk per sample) against the write cycles; then the heat
     maps and events must be bit-exact with the model given that M for each frame."""
-    import os
     import numpy as np
-    if sim == "verilator" and os.environ.get("FMT_LONG", "0") in ("", "0"):
+    if sim == "verilator" and not long_run():
         pytest.skip("the Verilator build runs in make test-long (FMT_LONG=1); Icarus here")
     rng = np.random.default_rng(5)
     frames, cps, m0 = 12, 3, 3

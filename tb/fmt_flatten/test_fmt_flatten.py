@@ -11,7 +11,6 @@ an exact half, so a round-half-down mutation passed the random tests).
 """
 from __future__ import annotations
 
-import os
 import random
 from pathlib import Path
 
@@ -20,7 +19,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
-from common.runner import run_cocotb, sources
+from common.runner import long_run, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.flatten import GAIN_MAX, GAIN_ONE, flatten_fixed, identity
@@ -438,7 +437,7 @@ def test_fmt_flatten(sim, cfg, cal_bram):
 
 
 @pytest.mark.verilator_only
-@pytest.mark.skipif(os.environ.get("FMT_LONG", "0") in ("", "0"),
+@pytest.mark.skipif(not long_run(),
                     reason="full-size build: set FMT_LONG=1 (the datapath is per column, "
                            "SMALL and MEDIUM cover it)")
 def test_fmt_flatten_default(sim):

@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import RisingEdge
 
-from common.runner import run_cocotb, sources
+from common.runner import long_run, run_cocotb, sources
 from common.tb_util import env_int
 from fmt import flatten, params, sensor
 from fmt.settings import TouchSettings
@@ -320,7 +320,7 @@ def test_cocotb_test_list():
 def _run_touch(sim, cfg_name):
     p = params.get(cfg_name).verilog_params()
     tests = COCOTB_TESTS
-    if os.environ.get("FMT_LONG", "0") in ("", "0"):
+    if not long_run():
         icarus_only = ("settings_midframe",)
         tests = [t for t in COCOTB_TESTS if (t in icarus_only) == (sim == "icarus")]
     run_cocotb(
