@@ -11,15 +11,16 @@ fixed-point model in lockstep as the reference.
 
 The simulation top ``bench/core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
 channel (DAC words through the channel delay x coupling matrix + counter-based noise,
-DC, interferers -> clip -> ENOB -> ADC words) + a coupling-update player + loggers;
+DC, interferers, display and charger noise -> clip -> ENOB -> ADC words) + a coupling-update player + loggers;
 nothing in Python is on the per-sample path:
 
 0. :func:`check_scene`: every effect of the scene is applied by the RTL path
-   (``fmt.channel.fixed_effects``: noise, DC offset, ENOB, channel delay, interferers;
+   (``fmt.channel.fixed_effects``: noise, DC offset, ENOB, channel delay, interferers
+   (sweeping, bursty), display noise, charger noise (weights in the coupling plan);
    PN in the core's registers; coupling effects in the plan) or the run stops before
    anything is built: ``main`` prints ONE line naming the effect and returns 2
    (``tone_phases`` other than "zero": the DDS has no phase register; a delay over 63
-   samples, more than 8 interferers, a PN setting outside its register).
+   samples, more than 64 oscillators, a PN setting outside its register).
 1. The scene becomes a coupling plan (:func:`coupling_plan`): the channel matrix G (16
    fraction bits, ADC LSB per DAC LSB) at sample 0 and stamped updates -- at every window
    boundary where the coupling changed (moving contacts: the map at the window's first
@@ -136,12 +137,22 @@ def quantise_g(g: np.ndarray, scale: float) -> np.ndarray:
 def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
     """(g0, updates): the integer matrix in effect from sample 0 and the list of
     (stamp, G) updates, spaced so that the simulation top's player loads each one (one
-    write per changed cell, then the commit) before its stamp."""
+    write per changed cell, then the commit) before its stamp.  With charger noise in
+    the scene every matrix has a row ROWS more: the charger weight of each column
+    (``channel.charger_column_weights`` of the same coupling, CHG_W_FRAC fraction bits),
+    loaded by kind-3 records, so it changes exactly when the coupling does."""
     cfg = scene.cfg
     n = cfg.n_fft
     nw = -(-n_samples // n)
     wc = _channel.window_coupling(scene, 0, nw)
     scale = coupling_scale(cfg)
+    chg = any(o.charger for o in _channel.oscillators(scene))
+    if chg:                          # charger weights from the coupling above the baseline
+        eff = scene.effects
+        base = eff.get("baseline", _sensor.BASELINE) * _sensor.attenuation(
+            cfg, eff.get("row_db_per_cell", 0.0), eff.get("col_db_per_cell", 0.0))
+        wq = lambda g: np.clip(np.rint(_channel.charger_column_weights(cfg, g - base)
+                                       * (1 << _channel.CHG_W_FRAC)), 0, (1 << COUP_BITS) - 1).astype(np.int64)
     by_w = {}
     for w, mask, m0, _m1 in wc.partial:
         by_w.setdefault(w, []).append((mask, m0))
@@ -157,7 +168,8 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
             for mask, m0 in parts:
                 if mask[s]:
                     g += m0
-            raw.append((w * n + s, quantise_g(g, scale)))
+            q = quantise_g(g, scale)
+            raw.append((w * n + s, np.vstack([q, wq(g)[None, :]]) if chg else q))
     g0 = raw[0][1]
     kept = [(0, g0)]
     for stamp, g in raw[1:]:
@@ -177,13 +189,15 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
 
 
 def plan_records(cfg, g0, updates) -> list[int]:
-    """64-bit player records (see fmt_core_sim_top.v)."""
+    """64-bit player records (see fmt_core_sim_top.v): kind 1 coupling writes, kind 3
+    charger-weight writes (the matrix's row ROWS), kind 2 commits, 0 the end."""
     rec = []
     prev = np.zeros_like(g0)
     for stamp, g in [(0, g0)] + list(updates):
         rr, cc = np.nonzero(g != prev)
         for r, c in zip(rr.tolist(), cc.tolist()):
-            rec.append((1 << 60) | (r << 52) | (c << 44) | int(g[r, c]))
+            kind = 3 if r == cfg.rows else 1         # row ROWS: a charger weight
+            rec.append((kind << 60) | (r << 52) | (c << 44) | int(g[r, c]))
         rec.append((2 << 60) | int(stamp))
         prev = g
     rec.append(0)
@@ -220,7 +234,8 @@ def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, ad
                   noise=None):
     """int64 twin of ``fmt_channel_sim`` / ``channel.channel_sim_fixed`` (same formula:
     round half up of sum_r dac[k - delay]*G + additive effects, >> 16, clip, ENOB mask);
-    int64 is exact here (|dac| < 2^11, G < 2^16, ROWS <= 64, additive < 2^40).
+    int64 is exact here (|dac| < 2^11, G < 2^16, ROWS <= 64, additive < 2^40; charger
+    sum < 2^38 times W < 2^16).  Matrices with ROWS + 1 rows carry the charger weights.
     ``noise``: file words as channel_sim_fixed's (tests).  Returns (adc, clipped samples)."""
     dac = np.asarray(dac, dtype=np.int64)
     n = dac.shape[0]
@@ -228,13 +243,17 @@ def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, ad
         dd = np.zeros_like(dac)
         dd[eff.delay:] = dac[:max(n - eff.delay, 0)]
         dac = dd
+    rows = dac.shape[1]
     out = np.empty((n, g0.shape[1]), dtype=np.int64)
     stamps = [0] + [int(s) for s, _ in updates] + [n]
     mats = [g0] + [g for _, g in updates]
+    chg = eff.charger(0, n) if eff is not None and eff.has_charger else None
     for i, g in enumerate(mats):
         a, b = min(stamps[i], n), min(stamps[i + 1], n)
         if b > a:
-            out[a:b] = dac[a:b] @ g
+            out[a:b] = dac[a:b] @ g[:rows]
+            if chg is not None and g.shape[0] > rows:    # charger weights in row ROWS
+                out[a:b] += (chg[a:b, None] * g[rows][None, :]) >> _channel.CHG_W_FRAC
     if noise is not None:
         out += noise[np.arange(n) % noise.shape[0]] << (COUP_FRAC - NOISE_FRAC)
     if eff is not None:
@@ -310,7 +329,10 @@ def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings
     dds = _dds.dds_bank_fixed(n, tx_sign=np.concatenate([[0], tx[:-1]]).astype(np.int64), cfg=cfg)
     dac = np.zeros_like(dds)
     dac[DAC_DELAY:] = dds[:n - DAC_DELAY]
-    adc_ch, clipped = channel_fixed(dac, g0, updates, eff, cfg.adc_bits)
+    # the initial matrix is committed at the first clk edge after the reset and copied at
+    # the next ce edge: channel sample 0 still sees G = 0, W = 0 (no DAC word is there yet
+    # either, DAC_DELAY; only a charger weight would show it)
+    adc_ch, clipped = channel_fixed(dac, np.zeros_like(g0), [(1, g0)] + list(updates), eff, cfg.adc_bits)
     adc = np.zeros_like(adc_ch)
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)

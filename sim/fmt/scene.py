@@ -38,8 +38,27 @@ Effects (every one costs nothing when absent)
   :func:`fmt.channel.noise_sigma_for_snr`) or ``{"rms_lsb": sigma}``.
   ``enob``: effective bits (the low ADC_BITS - enob bits of every sample are cleared).
   ``dc_lsb``: DC offset added before quantisation.  ``interferer``: ``{"freq_hz": f}`` or
-  ``{"bin": b}`` (fractional bins allowed), ``"amp_lsb"``, ``"phase_rad"``; a list of them
-  is allowed.  ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
+  ``{"bin": b}`` (fractional bins allowed; 0 .. Nyquist), ``"amp_lsb"``, ``"phase_rad"``;
+  a list of them is allowed.  Optional per interferer: ``"sweep_hz_per_s"`` (a linear
+  chirp: the frequency is f + sweep * t, t = n / fs from ADC sample 0; it aliases at the
+  ADC like any tone once it leaves 0 .. Nyquist; |sweep| <= fs^2 / 4) and ``"burst":
+  {"period_s": P, "on_s": D, "start_s": S}`` (the interferer is present on samples n >=
+  round(S fs) with (n - round(S fs)) mod round(P fs) < round(D fs); S defaults to 0; the
+  oscillator runs on while gated off, so each burst continues its phase).
+  ``display``: display noise on every column, ``{"line_hz": f, "harmonics": [[h, amp_lsb],
+  [h, amp_lsb, phase_rad], ...]}``: a sine of amp_lsb at h * f for each listed harmonic h
+  (a whole number >= 1; h * f must not exceed Nyquist), e.g. a 60 kHz line rate's
+  harmonics inside the tone band.  ``charger``: charger / common-mode noise that couples
+  only through touching contacts, ``{"freq_hz": f0, "level": x, "harmonics": "square"}``
+  (a square wave of peak amplitude x times a finger's tone, ``channel.finger_tone_lsb``,
+  with all its odd harmonics, aliased above Nyquist) or ``"harmonics": [[h, a], ...]``
+  (sines of x * a finger tones at h * f0, each below Nyquist); column c receives it
+  multiplied by ``channel.charger_column_weights``: the touching contacts' coupling summed
+  over the column's rows relative to a default finger centred on a cell (1 on that
+  finger's column, 0 when nothing touches; it follows contacts as they move, land and
+  lift).  Interferers, display and charger harmonics together: at most
+  ``channel.IF_MAX`` (64) for the RTL path.
+  ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
   ``baseline``: untouched coupling (default ``sensor.BASELINE``).  ``fringe_mm``: the
   disk profile's Gaussian fringe.  ``delay_samples``: channel delay.  ``pn``:
   ``{"enable": bool, "chip_len": L, "rx_delay": d}`` (rx_delay defaults to the channel
@@ -216,6 +235,9 @@ class Scene:
         if unknown:
             raise ValueError(f"scene '{self.name}': unknown effects {sorted(unknown)}")
         self.settings = dict(self.settings or {})
+        if any(k in self.effects for k in ("interferer", "display", "charger")):
+            from .channel import oscillators
+            oscillators(self)          # ValueError (one line naming the field) for a bad value
 
     def touch_settings(self):
         """The scene's touch settings (``settings`` key; defaults for the fields it leaves
@@ -310,7 +332,7 @@ class Scene:
 
 
 EFFECT_KEYS = {"noise", "enob", "dc_lsb", "interferer", "row_db_per_cell", "col_db_per_cell",
-               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases"}
+               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases", "display", "charger"}
 
 
 def edge_distance_mm(cfg: SensorConfig, x, y):

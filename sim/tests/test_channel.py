@@ -1,4 +1,5 @@
 """Channel and ADC: orthogonal comb, exact onset sample, clipping, ENOB, DC, PN."""
+import json
 import math
 
 import numpy as np
@@ -212,7 +213,8 @@ def test_fixed_effects_words():
     e = ch.fixed_effects(sc, adc_delay=1)
     assert (e.key, e.sigma_q, e.dc_q, e.enob_clear, e.delay) == (1005, 2560, 5 << 15, 3, 4)
     inc0, inc1 = 43 << 24, int(53.5 * (1 << 24))
-    assert e.interferers == ((inc0, inc0, 51200), (inc1, (inc1 + (1 << 30)) & 0xFFFFFFFF, 384))
+    assert e.interferers == ((inc0, inc0, 51200, 0, 0, 0, 0, 0),
+                             (inc1, (inc1 + (1 << 30)) & 0xFFFFFFFF, 384, 0, 0, 0, 0, 0))
     assert e.param_words()[:6] == [1005, 2560, 5 << 15, 7, 4, 2]
     # the interferer sum follows the float sine within the table's phase truncation
     k = np.arange(2000)
@@ -232,3 +234,135 @@ def test_channel_sim_fixed_effects_hand_values():
     # samples 0, 1: no row words yet, 0.5 -> 1 (half up) -> 0 after ENOB;
     # 2: 100 (1 - 2^-16) + 0.5 = 100.4985 -> 100; 3: -6.4999 -> -6 -> -8; 4: 13.4998 -> 13 -> 12
     assert adc[:, 0].tolist() == [0, 0, 100, -8, 12] and not clip.any()
+
+
+# ---- issue #12 item 2: sweeping and bursty interferers, display and charger noise --------
+def _osc_scene(cfg=params.SMALL, contacts=(), frames=2, **eff):
+    return S.Scene(name="o", sensor=cfg.name, frames=frames, seed=3, contacts=list(contacts), effects=eff)
+
+
+def test_sweep_words_hand_values():
+    """A sweep of fs^2 / 2^32 Hz/s is dinc = 2^32: the top 32 phase bits are then ph0 +
+    k inc + k (k - 1) / 2 (the increment grows by one every sample); a falling sweep is the
+    two's complement."""
+    cfg = params.SMALL
+    fs = cfg.fs_hz
+    sc = _osc_scene(interferer=[{"bin": 10, "amp_lsb": 100.0, "sweep_hz_per_s": fs * fs / 2 ** 32},
+                                {"bin": 10, "amp_lsb": 100.0, "sweep_hz_per_s": -fs * fs / 2 ** 32}])
+    e = ch.fixed_effects(sc, adc_delay=0)
+    (inc, ph0, amp, dinc, bper, bon, bst, fl), o2 = e.interferers
+    assert dinc == 1 << 32 and o2[3] == (1 << 64) - (1 << 32)
+    # inc = 10 bins (10 * 2^32 / 64) plus half a step of the sweep (0.5 in 2^-32 units: rounds to even)
+    assert inc in (10 << 26, (10 << 26) + 1) and ph0 == 0 and (amp, bper, fl) == (25600, 0, 0)
+    k = np.arange(3000)
+    top = (ph0 + k * inc + k * (k - 1) // 2) % (1 << 32)
+    want = (100 * 256 * ch.if_sine_table()[top >> 20]) >> 7
+    assert np.array_equal(e.interference(0, 3000) - ch.FixedEffects(interferers=(o2,)).interference(0, 3000), want)
+
+
+def test_sweep_and_burst_follow_the_float_model():
+    """The fixed-point chirp and burst gate follow the float model's (Osc.wave) to the
+    sine table's phase truncation (< 0.4 LSB at 150 LSB), across 20k samples (the
+    frequency moves 0.8 MHz), with the ADC delay's time shift."""
+    cfg = params.SMALL
+    fs = cfg.fs_hz
+    it = {"freq_hz": 5.0e6, "amp_lsb": 150.0, "phase_rad": 0.4, "sweep_hz_per_s": 1.7e12,
+          "burst": {"period_s": 1000 / fs, "on_s": 300 / fs, "start_s": 250 / fs}}
+    sc = _osc_scene(interferer=[it])
+    (o,) = ch.oscillators(sc)
+    e = ch.fixed_effects(sc, adc_delay=1)
+    k = np.arange(20000)
+    fix = e.interference(0, k.size) / 65536.0
+    flt = o.wave(k + 1, fs)
+    assert np.abs(fix - flt).max() < 0.4
+    # gate by hand: ADC samples n = k + 1 in [250 + 1000 j, 550 + 1000 j)
+    n = k + 1
+    on = (n >= 250) & ((n - 250) % 1000 < 300)
+    assert not fix[~on].any() and np.abs(fix[on]).max() > 140
+
+
+def test_display_harmonics_and_limits():
+    cfg = params.DEFAULT
+    sc = _osc_scene(cfg, display={"line_hz": 62.5e3, "harmonics": [[90, 30.0], [100, 20.0, 1.0]]})
+    osc = ch.oscillators(sc)
+    assert [(o.freq_hz, o.amp_lsb, o.phase_rad, o.charger) for o in osc] == [
+        (5.625e6, 30.0, 0.0, False), (6.25e6, 20.0, 1.0, False)]
+    e = ch.fixed_effects(sc, adc_delay=0)
+    # 6.25 MHz = fs * 3 / 20: inc = round(2^32 * 0.15); every column gets the same sum
+    assert e.interferers[1][0] == round(0.15 * 2 ** 32)
+    r = ch.adc_streams(sc, n_samples=512)
+    assert (r.adc == r.adc[:, :1]).all() and np.abs(r.adc).max() >= 40
+
+
+@pytest.mark.parametrize("eff,word", [
+    ({"interferer": [{"bin": 10, "amp_lsb": 1.0, "sweep_hz_per_s": "fast"}]}, "sweep_hz_per_s"),
+    ({"interferer": [{"bin": 40, "amp_lsb": 1.0}]}, "bin"),
+    ({"interferer": [{"freq_hz": 3e7, "amp_lsb": 1.0}]}, "freq_hz"),
+    ({"interferer": [{"bin": 10, "amp_lsb": -1.0}]}, "amp_lsb"),
+    ({"interferer": [{"bin": 10, "amp_lsb": 1.0, "burst": {"period_s": -1e-6, "on_s": 0}}]}, "burst"),
+    ({"interferer": [{"bin": 10, "amp_lsb": 1.0, "burst": {"period_s": 1e-6, "on_s": 2e-6}}]}, "burst"),
+    ({"display": {"line_hz": 6e4, "harmonics": [[400, 1.0]]}}, "above Nyquist"),
+    ({"display": {"line_hz": 6e4, "harmonics": [[2.5, 1.0]]}}, "harmonics[0]"),
+    ({"charger": {"freq_hz": 1e5, "level": -1}}, "level"),
+    ({"charger": {"freq_hz": 1e5, "level": 1, "harmonics": "triangle"}}, "harmonics"),
+    ({"charger": {"freq_hz": 1e5, "level": 1, "harmonics": [[300, 0.5]]}}, "above Nyquist"),
+])
+def test_noise_effects_bad_values_one_line(tmp_path, eff, word):
+    from fmt.inputs import InputError
+    p = tmp_path / "s.json"
+    p.write_text(json.dumps({"name": "bad", "sensor": "small", "frames": 1, "effects": eff, "contacts": []}))
+    with pytest.raises(InputError) as ei:
+        S.load(p)
+    msg = str(ei.value)
+    assert "\n" not in msg and word in msg and "effect" in msg, msg
+
+
+def _finger_at(cfg, col, row, **kw):
+    return {"name": "f", "path": [[0.0, col * cfg.pitch_mm, row * cfg.pitch_mm]], **kw}
+
+
+def test_charger_only_through_touching_fingers():
+    """Noise-free: with no contact the charger changes nothing; a finger centred on
+    column 5 gets the square wave of peak level x a finger's tone on column 5 (weight 1,
+    within the ADC rounding), less on the neighbours, nothing 4 columns away; a tap
+    gets it from its onset sample on."""
+    cfg = params.MEDIUM
+    chg = {"charger": {"freq_hz": 1.0e5, "level": 0.5}}
+    none0 = ch.adc_streams(_osc_scene(cfg, frames=3)).adc.astype(int)
+    none1 = ch.adc_streams(_osc_scene(cfg, frames=3, **chg)).adc.astype(int)
+    assert np.array_equal(none0, none1)
+    fing = [_finger_at(cfg, 5, cfg.rows // 2)]
+    a = ch.adc_streams(_osc_scene(cfg, fing, frames=3)).adc.astype(int)
+    b = ch.adc_streams(_osc_scene(cfg, fing, frames=3, **chg)).adc.astype(int)
+    d = b - a
+    peak = 0.5 * ch.finger_tone_lsb(cfg)
+    assert abs(np.abs(d[:, 5]).max() - peak) <= 1.0
+    assert np.abs(d[:, 4]).max() < 0.9 * peak and np.abs(d[:, 6]).max() < 0.9 * peak
+    assert np.abs(d[:, 4]).max() > 0.05 * peak
+    assert not d[:, 9:].any() and not d[:, :1].any()
+    # the square wave: + on the first half period of 100 kHz (fs / 1e5 = 416.7 samples)
+    assert (d[5:200, 5] > 0.9 * peak).all() and (d[215:400, 5] < -0.9 * peak).all()
+    n0 = cfg.n_fft + 77
+    tap = [_finger_at(cfg, 5, cfg.rows // 2, active=[[n0, None]], active_units="samples")]
+    a = ch.adc_streams(_osc_scene(cfg, tap, frames=3)).adc.astype(int)
+    b = ch.adc_streams(_osc_scene(cfg, tap, frames=3, **chg)).adc.astype(int)
+    assert not (b - a)[:n0].any() and np.abs((b - a)[n0:n0 + 300, 5]).min() > 0.9 * peak
+
+
+def test_charger_weights_in_the_coupling_plan():
+    """The RTL plan carries the charger weights as a row ROWS more (kind-3 records): 0
+    before the tap lands, the float model's weights (to 2^-12) after; none without a charger."""
+    from bench.core import run_sim_rtl as rsr
+    cfg = params.SMALL
+    n0 = 3 * cfg.n_fft + 11
+    tap = [_finger_at(cfg, 2, 1, active=[[n0, None]], active_units="samples")]
+    sc = _osc_scene(cfg, tap, frames=6, charger={"freq_hz": 1.0e5, "level": 1.0})
+    g0, ups = rsr.coupling_plan(sc, 6 * cfg.n_fft, 3)
+    assert g0.shape == (cfg.rows + 1, cfg.cols) and not g0[cfg.rows].any()
+    (stamp, g1), = ups
+    w = g1[cfg.rows] / 4096.0
+    assert stamp == n0 and w.argmax() == 2 and abs(w[2] - 1.0) < 0.05 and w[5] == 0
+    rec = rsr.plan_records(cfg, g0, ups)
+    assert sum(1 for r in rec if r >> 60 == 3) == np.count_nonzero(g1[cfg.rows])
+    g0n, upsn = rsr.coupling_plan(sc.replace(effects={}), 6 * cfg.n_fft, 3)
+    assert g0n.shape == (cfg.rows, cfg.cols) and np.array_equal(upsn[0][1], g1[:cfg.rows])
