@@ -129,7 +129,7 @@ def window_coupling(scene: Scene, w0: int, w1: int) -> WindowCoupling:
         if not frac.any():
             continue
         use = np.nonzero(frac > 0)[0]
-        if c.stationary:     # one map for every boundary
+        if c.fixed:          # one map for every boundary
             m = _sensor.contact_maps(cfg, [tuple(c.position(0.0)) + c.shape_row()],
                                      c.profile, fringe)[0] * att
             full = use[frac[use] == 1.0]
@@ -139,7 +139,7 @@ def window_coupling(scene: Scene, w0: int, w1: int) -> WindowCoupling:
         else:
             bidx = np.unique(np.concatenate([use, use + 1]))
             pos = c.position(t[bidx])
-            rows = np.column_stack([pos, np.broadcast_to(c.shape_row(), (bidx.size, 4))])
+            rows = np.column_stack([pos, c.shape_rows(t[bidx])])
             maps = _sensor.contact_maps(cfg, rows, c.profile, fringe) * att
             lut = np.full(nw + 1, -1, dtype=np.int64)
             lut[bidx] = np.arange(bidx.size)

@@ -31,6 +31,12 @@ Contacts
   anywhere inside a window (``onset_samples`` lists them).
   ``diameter_mm`` (8 = the default finger), ``strength`` (1), ``profile`` ("disk" or
   "gaussian"), optional ``minor_diameter_mm`` and ``angle_deg`` (elliptical contact).
+  ``size_path``: optional ``[[t_s, strength, diameter_mm], ...]``, strength and diameter
+  over time (a finger landing: strength 0.2 -> 1 and 5 -> 8 mm over a few ms; a palm
+  growing), linearly interpolated like the path and held before the first / after the
+  last point; it replaces ``strength`` and ``diameter_mm`` (an ellipse keeps its minor /
+  major ratio).  Only the coupling changes: the float model evaluates the map at every
+  window boundary (linear in between), the RTL plan holds it per window.
 
 Effects (every one costs nothing when absent)
   ``noise``: ``{"snr_db": s}`` (white Gaussian ADC noise set from the model so that a
@@ -110,6 +116,7 @@ class Contact:
     angle_deg: float = 0.0
     active: object = None           # None, [[on, off], ...] or {"repeat": {...}}
     active_units: str = "s"         # "s" or "samples"
+    size_path: list | None = None   # [[t_s, strength, diameter_mm], ...] (a landing finger, a palm growing)
 
     def __post_init__(self):
         p = np.asarray(self.path, dtype=np.float64)
@@ -120,6 +127,16 @@ class Contact:
         self._p = p
         if self.profile not in ("disk", "gaussian"):
             raise ValueError(f"contact '{self.name}': unknown profile '{self.profile}'")
+        self._s = None
+        if self.size_path is not None:
+            q = np.asarray(self.size_path, dtype=np.float64)
+            if q.ndim != 2 or q.shape[1] != 3 or q.shape[0] < 1:
+                raise ValueError(f"contact '{self.name}': size_path must be [[t_s, strength, diameter_mm], ...]")
+            if np.any(np.diff(q[:, 0]) < 0):
+                raise ValueError(f"contact '{self.name}': size_path times must not decrease")
+            if np.any(q[:, 1] < 0) or np.any(q[:, 2] <= 0):
+                raise ValueError(f"contact '{self.name}': size_path needs strength >= 0 and diameter_mm > 0")
+            self._s = q
 
     # -- geometry ---------------------------------------------------------------------
     @property
@@ -128,13 +145,35 @@ class Contact:
         return bool(np.all(self._p[:, 1:] == self._p[0, 1:]))
 
     @property
+    def fixed(self) -> bool:
+        """True when the contact's map never changes: stationary, constant size and strength."""
+        return self.stationary and (self._s is None or bool(np.all(self._s[:, 1:] == self._s[0, 1:])))
+
+    @property
     def elliptical(self) -> bool:
         return self.minor_diameter_mm is not None
 
+    def size(self, t) -> tuple:
+        """(strength, diameter_mm) at time(s) t (seconds): ``size_path`` linearly
+        interpolated (held before the first / after the last point), else the constants."""
+        t = np.asarray(t, dtype=np.float64)
+        if self._s is None:
+            return np.full(t.shape, self.strength), np.full(t.shape, self.diameter_mm)
+        q = self._s
+        return np.interp(t, q[:, 0], q[:, 1]), np.interp(t, q[:, 0], q[:, 2])
+
     def shape_row(self) -> tuple:
-        """(diameter, strength, minor_diameter, angle_rad) for ``sensor.contact_maps``."""
-        minor = self.diameter_mm if self.minor_diameter_mm is None else self.minor_diameter_mm
-        return (self.diameter_mm, self.strength, minor, math.radians(self.angle_deg))
+        """(diameter, strength, minor_diameter, angle_rad) for ``sensor.contact_maps``
+        (at time 0 for a contact with a ``size_path``)."""
+        return tuple(self.shape_rows(np.zeros(1))[0])
+
+    def shape_rows(self, t) -> np.ndarray:
+        """(len(t), 4) shape rows at times t: with a ``size_path`` the diameter and
+        strength follow it and the minor diameter keeps its ratio to the diameter."""
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        st, d = self.size(t)
+        ratio = 1.0 if self.minor_diameter_mm is None else self.minor_diameter_mm / self.diameter_mm
+        return np.column_stack([d, st, d * ratio, np.full(t.shape, math.radians(self.angle_deg))])
 
     def position(self, t) -> np.ndarray:
         """(..., 2) x, y in mm at time(s) t (seconds)."""
@@ -196,6 +235,8 @@ class Contact:
             d["active"] = self.active
             if self.active_units != "s":
                 d["active_units"] = self.active_units
+        if self.size_path is not None:
+            d["size_path"] = [list(map(float, w)) for w in self._s]
         return d
 
 
@@ -291,7 +332,7 @@ class Scene:
                 continue
             x, y = c.position(t)
             out.append({"index": i, "name": c.name, "x_mm": float(x), "y_mm": float(y),
-                        "diameter_mm": c.diameter_mm, "x_cells": float(x / cfg.pitch_mm),
+                        "diameter_mm": float(c.size(t)[1]), "x_cells": float(x / cfg.pitch_mm),
                         "y_cells": float(y / cfg.pitch_mm),
                         "edge_mm": float(edge_distance_mm(cfg, x, y))})
         return out
@@ -372,7 +413,13 @@ def check_dict(d, where: str = "scene") -> None:
             "angle_deg": I.is_num(-360, 360),
             "active": lambda v: None if v is None or isinstance(v, (list, dict)) else
             "must be null, [[on, off], ...] or {\"repeat\": {...}}",
-            "active_units": I.is_str(("s", "samples"))}, cw)
+            "active_units": I.is_str(("s", "samples")),
+            "size_path": I.is_type(list, name="[[t_s, strength, diameter_mm], ...]")}, cw)
+        for j, w in enumerate(c.get("size_path") or []):
+            if (not isinstance(w, list) or len(w) != 3 or any(I.is_num()(x) for x in w)
+                    or w[1] < 0 or w[2] <= 0):
+                raise I.InputError(f"{cw}: key 'size_path': point {j} must be [t_s, strength >= 0, "
+                                   f"diameter_mm > 0] numbers, got {w!r}")
         _check_active(c.get("active"), cw, I)
         if "path" not in c:
             raise I.InputError(f"{cw}: key 'path' missing")

@@ -366,3 +366,54 @@ def test_charger_weights_in_the_coupling_plan():
     assert sum(1 for r in rec if r >> 60 == 3) == np.count_nonzero(g1[cfg.rows])
     g0n, upsn = rsr.coupling_plan(sc.replace(effects={}), 6 * cfg.n_fft, 3)
     assert g0n.shape == (cfg.rows, cfg.cols) and np.array_equal(upsn[0][1], g1[:cfg.rows])
+
+
+# ---- contacts whose strength and size change (issue #12 item 2, part 4) -------------------
+def test_size_path_landing_finger():
+    """A finger landing (strength 0.1 -> 1, 4 -> 8 mm over frames 2..6): noise-free ADC
+    words equal those of the constant first size before the first point and of the
+    constant last size after the last (held), and the peak cell grows in between."""
+    cfg = params.MEDIUM
+    win = cfg.n_fft / cfg.fs_hz
+    xy = [[0.0, 5 * cfg.pitch_mm, 4 * cfg.pitch_mm]]
+    land = S.Scene(name="land", sensor="medium", frames=9, contacts=[
+        {"path": xy, "size_path": [[2 * win, 0.1, 4.0], [6 * win, 1.0, 8.0]]}])
+    small = land.replace(contacts=[{"path": xy, "strength": 0.1, "diameter_mm": 4.0}])
+    full = land.replace(contacts=[{"path": xy}])
+    a, s0, s1 = (ch.adc_streams(x).adc for x in (land, small, full))
+    n = cfg.n_fft
+    assert np.array_equal(a[:2 * n], s0[:2 * n]) and np.array_equal(a[6 * n:], s1[6 * n:])
+    hm = rx_array.receive(a, cfg)[:, 4, 5]
+    assert (np.diff(hm[1:7]) > 0.05 * hm[6]).all()
+    assert not land.contacts[0].fixed and land.contacts[0].stationary
+    assert land.truth(7 * win)[0]["diameter_mm"] == 8.0 and land.truth(4 * win)[0]["diameter_mm"] == 6.0
+
+
+def test_size_path_reaches_the_rtl_plan():
+    """The RTL coupling plan holds each window's map: an update at every window boundary
+    while the size changes, each equal to the float model's coupling at that boundary
+    (quantised), none after the last size point."""
+    from bench.core import run_sim_rtl as rsr
+    cfg = params.SMALL
+    win = cfg.n_fft / cfg.fs_hz
+    sc = S.Scene(name="grow", sensor="small", frames=8, contacts=[
+        {"path": [[0.0, 8.0, 6.0]], "diameter_mm": 12.0, "size_path": [[0.0, 0.2, 6.0], [4 * win, 1.0, 12.0]]}])
+    g0, ups = rsr.coupling_plan(sc, 8 * cfg.n_fft, 3)
+    assert [s for s, _ in ups] == [w * cfg.n_fft for w in range(1, 5)]
+    wc = ch.window_coupling(sc, 0, 8)
+    scale = rsr.coupling_scale(cfg)
+    for w, (s, g) in enumerate([(0, g0)] + ups):
+        assert np.array_equal(g, rsr.quantise_g(wc.g0[w], scale))
+    assert (ups[-1][1] > g0).sum() >= 4
+
+
+@pytest.mark.parametrize("sp,word", [([[0, 1.0]], "size_path"), ([[0, -1, 8]], "strength >= 0"),
+                                     ([[0, 1, 0]], "diameter_mm > 0"), ("big", "size_path")])
+def test_size_path_bad_values_one_line(tmp_path, sp, word):
+    from fmt.inputs import InputError
+    p = tmp_path / "s.json"
+    p.write_text(json.dumps({"name": "bad", "sensor": "small", "frames": 1, "effects": {},
+                             "contacts": [{"path": [[0, 1, 1]], "size_path": sp}]}))
+    with pytest.raises(InputError) as ei:
+        S.load(p)
+    assert "\n" not in str(ei.value) and word in str(ei.value) and "contacts[0]" in str(ei.value)

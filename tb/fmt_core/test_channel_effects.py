@@ -310,6 +310,24 @@ def test_effect_through_core_icarus(tmp_path, name):
 
 
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
+def test_size_path_through_core_icarus(tmp_path):
+    """A finger landing (strength and diameter over time, ``size_path``) with charger noise
+    through the core: the plan's per-window coupling and charger weights, bit-exact."""
+    sc = _scene.small_scene()
+    win = sc.cfg.n_fft / sc.cfg.fs_hz
+    still = dict(sc.contacts[0].to_dict(), size_path=[[win, 0.2, 4.0], [4 * win, 1.0, 9.0]])
+    sc = sc.replace(frames=6, contacts=[still, sc.contacts[1].to_dict()],
+                    effects={**sc.effects, **EFFECTS["charger"]})
+    n = sc.frames * sc.samples_per_frame
+    g0, ups = rsr.coupling_plan(sc, n, 3)
+    assert len(ups) >= 4 and g0.shape[0] == sc.cfg.rows + 1
+    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag="fx_size_path")
+    assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+
+
+@pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
 @pytest.mark.parametrize("cps,chip_len", [(1, 3), (2, 4)])
 def test_pn_chip_len_through_core_icarus(tmp_path, cps, chip_len):
     """chip_len > 1 at other clk per sample: the model's PN signs follow the core's
