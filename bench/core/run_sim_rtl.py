@@ -148,10 +148,7 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
     scale = coupling_scale(cfg)
     chg = any(o.charger for o in _channel.oscillators(scene))
     if chg:                          # charger weights from the coupling above the baseline
-        eff = scene.effects
-        base = eff.get("baseline", _sensor.BASELINE) * _sensor.attenuation(
-            cfg, eff.get("row_db_per_cell", 0.0), eff.get("col_db_per_cell", 0.0))
-        wq = lambda g: np.clip(np.rint(_channel.charger_column_weights(cfg, g - base)
+        wq = lambda g, base: np.clip(np.rint(_channel.charger_column_weights(cfg, g - base)
                                        * (1 << _channel.CHG_W_FRAC)), 0, (1 << COUP_BITS) - 1).astype(np.int64)
     by_w = {}
     for w, mask, m0, _m1 in wc.partial:
@@ -169,7 +166,7 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
                 if mask[s]:
                     g += m0
             q = quantise_g(g, scale)
-            raw.append((w * n + s, np.vstack([q, wq(g)[None, :]]) if chg else q))
+            raw.append((w * n + s, np.vstack([q, wq(g, wc.b0[w])[None, :]]) if chg else q))
     g0 = raw[0][1]
     kept = [(0, g0)]
     for stamp, g in raw[1:]:

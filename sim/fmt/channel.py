@@ -104,11 +104,31 @@ class WindowCoupling:
 
     ``g0[w]``, ``g1[w]``: the always-touching part at the window's first sample and at the
     next window's first sample (linear in between).  ``partial``: a list of
-    (window, mask (N,), map0, map1) for contacts that touch only part of the window."""
+    (window, mask (N,), map0, map1) for contacts that touch only part of the window.
+    ``b0[w]``, ``b1[w]``: the untouched baseline at the same two instants (it moves only
+    with a ``drift`` effect); g - b is the touching contacts' part (charger weights)."""
 
     g0: np.ndarray
     g1: np.ndarray
     partial: list
+    b0: np.ndarray | None = None
+    b1: np.ndarray | None = None
+
+
+def drift_rates(scene: Scene):
+    """(gain, offset) drift rates per cell, (rows, cols) each, in fractions per second, or
+    None without a ``drift`` effect: each cell's gain drifts at a rate drawn uniformly from
+    +-gain_pct_per_s %/s and its offset at +-offset_pct_per_s % of its untouched coupling
+    per second, from a generator seeded by the scene's seed (the same cells drift the same
+    way in every run of the scene)."""
+    d = scene.effects.get("drift")
+    if not d:
+        return None
+    cfg = scene.cfg
+    rng = np.random.default_rng([int(scene.seed), 0xD21F7])
+    ga = float(d.get("gain_pct_per_s", 0.0)) / 100.0 * rng.uniform(-1.0, 1.0, (cfg.rows, cfg.cols))
+    of = float(d.get("offset_pct_per_s", 0.0)) / 100.0 * rng.uniform(-1.0, 1.0, (cfg.rows, cfg.cols))
+    return ga, of
 
 
 def window_coupling(scene: Scene, w0: int, w1: int) -> WindowCoupling:
@@ -150,7 +170,21 @@ def window_coupling(scene: Scene, w0: int, w1: int) -> WindowCoupling:
         for w in use[frac[use] < 1.0]:
             mask = c.active_mask(int(edges[w]), int(edges[w + 1]), fs)
             partial.append((int(w), mask, at(w), at(w + 1)))   # w: index within w0..w1-1
-    return WindowCoupling(g0, g1, partial)
+    base = level * att
+    dr = drift_rates(scene)
+    if dr is None:
+        b = np.broadcast_to(base, g0.shape)
+        return WindowCoupling(g0, g1, partial, b, b)
+    # drift: G(t) = G_0(t) (1 + gain t) + base offset t at every window boundary t
+    ga, of = dr
+    tb = (edges / fs)[:, None, None]
+    fac = 1.0 + ga[None] * tb                         # (nw + 1, R, C)
+    off = base[None] * of[None] * tb
+    g0 = g0 * fac[:-1] + off[:-1]
+    g1 = g1 * fac[1:] + off[1:]
+    partial = [(w, mask, m0 * fac[w], m1 * fac[w + 1]) for w, mask, m0, m1 in partial]
+    bb = base[None] * fac + off
+    return WindowCoupling(g0, g1, partial, bb[:-1], bb[1:])
 
 
 def coupling_per_sample(scene: Scene, n_samples: int) -> np.ndarray:
@@ -254,9 +288,6 @@ def adc_streams(scene: Scene, cfg: SensorConfig | None = None, n_samples: int | 
     oscs = oscillators(scene)
     common_osc = [o for o in oscs if not o.charger]
     chg_osc = [o for o in oscs if o.charger]
-    if chg_osc:
-        base = eff.get("baseline", _sensor.BASELINE) * _sensor.attenuation(
-            cfg, eff.get("row_db_per_cell", 0.0), eff.get("col_db_per_cell", 0.0))
     dc = float(eff.get("dc_lsb", 0.0))
     bits = cfg.adc_bits
     lo, hi = -(1 << (bits - 1)), (1 << (bits - 1)) - 1
@@ -282,7 +313,7 @@ def adc_streams(scene: Scene, cfg: SensorConfig | None = None, n_samples: int | 
                 v += o.wave(nn, cfg.fs_hz)[:, None]
             if chg_osc:      # through the touching contacts: weight per column and sample
                 cw = lambda g: charger_column_weights(cfg, g)
-                wgt = (1.0 - f)[None] * cw(wc.g0 - base)[:, None, :] + f[None] * cw(wc.g1 - base)[:, None, :]
+                wgt = (1.0 - f)[None] * cw(wc.g0 - wc.b0)[:, None, :] + f[None] * cw(wc.g1 - wc.b1)[:, None, :]
                 for w, mask, m0, m1 in wc.partial:
                     wgt[w] += mask[:, None] * ((1.0 - f) * cw(m0) + f * cw(m1))
                 chg = sum(o.wave(nn, cfg.fs_hz) for o in chg_osc)

@@ -64,6 +64,12 @@ Effects (every one costs nothing when absent)
   finger's column, 0 when nothing touches; it follows contacts as they move, land and
   lift).  Interferers, display and charger harmonics together: at most
   ``channel.IF_MAX`` (64) for the RTL path.
+  ``drift``: a baseline that drifts, ``{"gain_pct_per_s": g, "offset_pct_per_s": o}``:
+  each cell's coupling becomes G(t) (1 + a t) + G_untouched b t, with per-cell rates a
+  uniform in +-g %/s and b uniform in +-o %/s, drawn once from the scene's seed
+  (``channel.drift_rates``); applied at every window boundary (linear in between), so it
+  reaches the RTL through the coupling plan (whose integer matrices change once the drift
+  is larger than their quantum, about 0.3 % of the untouched coupling).
   ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
   ``baseline``: untouched coupling (default ``sensor.BASELINE``).  ``fringe_mm``: the
   disk profile's Gaussian fringe.  ``delay_samples``: channel delay.  ``pn``:
@@ -276,6 +282,13 @@ class Scene:
         if unknown:
             raise ValueError(f"scene '{self.name}': unknown effects {sorted(unknown)}")
         self.settings = dict(self.settings or {})
+        dr = self.effects.get("drift")
+        if dr is not None:
+            if not isinstance(dr, dict) or set(dr) - {"gain_pct_per_s", "offset_pct_per_s"}:
+                raise ValueError(f"effect drift: must be {{\"gain_pct_per_s\": g, \"offset_pct_per_s\": o}}, got {dr!r}")
+            for k, v in dr.items():
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1e6:
+                    raise ValueError(f"effect drift: {k} must be a number 0 .. 1e6 (% per second), got {v!r}")
         if any(k in self.effects for k in ("interferer", "display", "charger")):
             from .channel import oscillators
             oscillators(self)          # ValueError (one line naming the field) for a bad value
@@ -373,7 +386,8 @@ class Scene:
 
 
 EFFECT_KEYS = {"noise", "enob", "dc_lsb", "interferer", "row_db_per_cell", "col_db_per_cell",
-               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases", "display", "charger"}
+               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases", "display", "charger",
+               "drift"}
 
 
 def edge_distance_mm(cfg: SensorConfig, x, y):

@@ -417,3 +417,55 @@ def test_size_path_bad_values_one_line(tmp_path, sp, word):
     with pytest.raises(InputError) as ei:
         S.load(p)
     assert "\n" not in str(ei.value) and word in str(ei.value) and "contacts[0]" in str(ei.value)
+
+
+# ---- a baseline that drifts (issue #12 item 2, part 5) ---------------------------------
+def test_drift_rates_and_coupling():
+    """Per-cell rates within +-g and +-o (fractions per second), fixed by the seed; the
+    window-boundary coupling of an untouched sensor is base (1 + a t) + base b t."""
+    cfg = params.SMALL
+    sc = S.Scene(name="d", sensor="small", frames=4, seed=11, contacts=[],
+                 effects={"drift": {"gain_pct_per_s": 5.0, "offset_pct_per_s": 2.0}})
+    a, b = ch.drift_rates(sc)
+    assert np.abs(a).max() <= 0.05 and np.abs(b).max() <= 0.02 and np.abs(a).max() > 0.03
+    a2, _ = ch.drift_rates(sc.replace(seed=11))
+    a3, _ = ch.drift_rates(sc.replace(seed=12))
+    assert np.array_equal(a, a2) and not np.array_equal(a, a3)
+    assert ch.drift_rates(sc.replace(effects={})) is None
+    wc = ch.window_coupling(sc, 0, 4)
+    base = 1.0 / 32
+    for w in range(4):
+        t0, t1 = w * cfg.n_fft / cfg.fs_hz, (w + 1) * cfg.n_fft / cfg.fs_hz
+        assert np.allclose(wc.g0[w], base * (1 + a * t0) + base * b * t0, rtol=1e-12, atol=0)
+        assert np.allclose(wc.g1[w], base * (1 + a * t1) + base * b * t1, rtol=1e-12, atol=0)
+        assert np.array_equal(wc.g0[w], wc.b0[w])
+
+
+def test_drift_moves_the_untouched_heat_map():
+    """Noise-free, untouched, 1e5 %/s (+-25 % over the run): each cell's heat map moves by (a + b) (t1 - t0)
+    relative to its first frame (the ADC rounds a 10 LSB baseline tone: cells scatter by
+    ~1 %, the fit over 80 cells within 3 %); no drift = no change."""
+    cfg = params.MEDIUM
+    sc = S.Scene(name="d", sensor="medium", frames=60, seed=4, contacts=[],
+                 effects={"drift": {"gain_pct_per_s": 1e5, "offset_pct_per_s": 5e4}})
+    hm = rx_array.receive(ch.adc_streams(sc).adc, cfg)
+    a, b = ch.drift_rates(sc)
+    win = cfg.n_fft / cfg.fs_hz
+    want = (1 + (a + b) * 59.5 * win) / (1 + (a + b) * 0.5 * win) - 1.0
+    rel = hm[-1] / hm[0] - 1.0
+    slope = float((rel * want).sum() / (want * want).sum())
+    assert abs(slope - 1.0) < 0.03 and np.abs(rel - want).max() < 0.03 and np.abs(want).max() > 0.08
+    h0 = rx_array.receive(ch.adc_streams(sc.replace(effects={})).adc, cfg)
+    assert np.array_equal(h0[-1], h0[0])
+
+
+def test_drift_bad_values_one_line(tmp_path):
+    from fmt.inputs import InputError
+    for eff, word in (({"gain_pct_per_s": -1}, "gain_pct_per_s"), ({"rate": 1}, "effect drift"),
+                      ({"offset_pct_per_s": "x"}, "offset_pct_per_s")):
+        p = tmp_path / "s.json"
+        p.write_text(json.dumps({"name": "bad", "sensor": "small", "frames": 1, "effects": {"drift": eff},
+                                 "contacts": []}))
+        with pytest.raises(InputError) as ei:
+            S.load(p)
+        assert "\n" not in str(ei.value) and word in str(ei.value)

@@ -310,19 +310,21 @@ def test_effect_through_core_icarus(tmp_path, name):
 
 
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
-def test_size_path_through_core_icarus(tmp_path):
-    """A finger landing (strength and diameter over time, ``size_path``) with charger noise
+def test_coupling_effects_through_core_icarus(tmp_path):
+    """A finger landing (strength and diameter over time, ``size_path``), a drifting
+    baseline (1e5 %/s: the integer matrices move within a few windows) and charger noise
     through the core: the plan's per-window coupling and charger weights, bit-exact."""
     sc = _scene.small_scene()
     win = sc.cfg.n_fft / sc.cfg.fs_hz
     still = dict(sc.contacts[0].to_dict(), size_path=[[win, 0.2, 4.0], [4 * win, 1.0, 9.0]])
-    sc = sc.replace(frames=6, contacts=[still, sc.contacts[1].to_dict()],
-                    effects={**sc.effects, **EFFECTS["charger"]})
+    sc = sc.replace(frames=8, contacts=[still, sc.contacts[1].to_dict()],
+                    effects={**sc.effects, **EFFECTS["charger"],
+                             "drift": {"gain_pct_per_s": 1e5, "offset_pct_per_s": 5e4}})
     n = sc.frames * sc.samples_per_frame
     g0, ups = rsr.coupling_plan(sc, n, 3)
-    assert len(ups) >= 4 and g0.shape[0] == sc.cfg.rows + 1
+    assert g0.shape[0] == sc.cfg.rows + 1 and sum(1 for s, _ in ups if s >= 6 * sc.cfg.n_fft) >= 2
     rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
-                  tag="fx_size_path")
+                  tag="fx_coupling")
     assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
 
