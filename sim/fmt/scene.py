@@ -694,11 +694,61 @@ def crowd_scene_shipped() -> Scene:
     return crowd_scene("one_lands", 16, 1, 200)
 
 
+def noise_scene() -> Scene:
+    """Realistic noise (issue #12 item 2) on the default sensor: a still finger and a
+    finger landing at frame 60 (strength 0.2 -> 1, 5 -> 8 mm over 6 frames); charger
+    noise at 0.5 finger tones (120 kHz square wave, only through the fingers), display
+    noise (67.5 kHz line rate, three harmonics inside the tone band), a 100 LSB
+    interferer sweeping up from 5 MHz at 2 GHz/s in 50 us bursts every 200 us, and a
+    baseline drifting 1 %/s (gain and offset)."""
+    cfg = _params.DEFAULT
+    t_land = _frames_s(cfg, 60)
+    return Scene(
+        name="noise", sensor="default", frames=240, seed=9,
+        description="still finger + a finger landing (size_path); charger 0.5 finger tones, display "
+                    "harmonics, a sweeping bursty interferer, 1 %/s drift; 30 dB, PN on",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1},
+                 "charger": {"freq_hz": 120e3, "level": 0.5},
+                 "display": {"line_hz": 67.5e3, "harmonics": [[90, 30.0], [110, 20.0], [130, 15.0]]},
+                 "interferer": [{"freq_hz": 5.0e6, "amp_lsb": 100.0, "sweep_hz_per_s": 2.0e9,
+                                 "burst": {"period_s": 2.0e-4, "on_s": 5.0e-5, "start_s": 2.0e-5}}],
+                 "drift": {"gain_pct_per_s": 1.0, "offset_pct_per_s": 1.0}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 61.3, 43.8]]),
+            Contact(name="landing", path=[[0.0, 140.0, 100.0]], active=[[t_land, None]],
+                    size_path=[[t_land, 0.2, 5.0], [t_land + _frames_s(cfg, 6), 1.0, 8.0]]),
+        ])
+
+
+def noise_small_scene() -> Scene:
+    """``noise_scene`` on the 4 x 6 sensor for fast tests: a finger landing at frame 5
+    (size_path), charger noise at 1 finger tone, display harmonics, a sweeping bursty
+    interferer and a fast drift (100 %/s, so that a short run shows it)."""
+    cfg = _params.SMALL
+    t_land = _frames_s(cfg, 5) + 21 / cfg.fs_hz
+    return Scene(
+        name="noise_small", sensor="small", frames=40, seed=10,
+        description="a still finger + a finger landing; charger 1 finger tone, display harmonics, "
+                    "a sweeping bursty interferer, 100 %/s drift; 30 dB, PN on",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1},
+                 "charger": {"freq_hz": 95e3, "level": 1.0},
+                 "display": {"line_hz": 65e3, "harmonics": [[95, 30.0], [105, 20.0]]},
+                 "interferer": [{"freq_hz": 5.5e6, "amp_lsb": 80.0, "sweep_hz_per_s": 2.0e10,
+                                 "burst": {"period_s": 2.0e-5, "on_s": 6.0e-6}}],
+                 "drift": {"gain_pct_per_s": 100.0, "offset_pct_per_s": 100.0}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 6.3, 6.9]]),
+            Contact(name="landing", path=[[0.0, 19.0, 8.0]], active=[[t_land, None]],
+                    size_path=[[t_land, 0.2, 5.0], [t_land + _frames_s(cfg, 3), 1.0, 8.0]]),
+        ])
+
+
 SHIPPED = {
     "default.json": default_scene, "small.json": small_scene, "small.yaml": small_scene,
     "hard_clip.json": hard_clip_scene, "interferer.json": interferer_scene,
     "pinch.json": pinch_scene, "thumb.yaml": thumb_scene, "drumroll.json": drumroll_scene,
     "taps8.json": taps8_scene, "crowd.json": crowd_scene_shipped,
+    "noise.json": noise_scene, "noise_small.json": noise_small_scene,
 }
 
 

@@ -330,6 +330,18 @@ def test_coupling_effects_through_core_icarus(tmp_path):
 
 
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
+def test_noise_small_scene_through_core_icarus(tmp_path):
+    """The shipped sim/scenes/noise_small.json (every noise effect of issue #12 item 2 at
+    once: charger, display, sweeping bursty interferer, drift, a landing finger), its first
+    10 frames through the core: golden 0."""
+    sc = _scene.load(ROOT / "sim" / "scenes" / "noise_small.json")
+    rep = rsr.run(sc, tmp_path, frames=10, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag="fx_noise_small")
+    assert rep["frames"] >= 10 and rep["frames_dropped"] == 0
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+
+
+@pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
 @pytest.mark.parametrize("cps,chip_len", [(1, 3), (2, 4)])
 def test_pn_chip_len_through_core_icarus(tmp_path, cps, chip_len):
     """chip_len > 1 at other clk per sample: the model's PN signs follow the core's
