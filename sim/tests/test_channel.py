@@ -469,3 +469,28 @@ def test_drift_bad_values_one_line(tmp_path):
         with pytest.raises(InputError) as ei:
             S.load(p)
         assert "\n" not in str(ei.value) and word in str(ei.value)
+
+
+def test_charger_wave_float_and_fixed():
+    """The charger's square wave and harmonics: the fixed-point sum (at weight 1) follows
+    the float model's at the ADC-delayed time base: the square wave to its amplitude's
+    1/256 LSB (+ the >> 7 floor), except samples whose edge falls between the two phases
+    (< 0.5 % of them); the harmonics (330 LSB in all) to the sine table's phase truncation
+    (330 * 2 pi / 4096 = 0.51 LSB)."""
+    cfg = params.DEFAULT
+    for harm in ("square", [[45, 0.7], [47, 0.3]]):
+        sc = _osc_scene(cfg, charger={"freq_hz": 1.13e5, "level": 1.0, "harmonics": harm})
+        osc = ch.oscillators(sc)
+        assert all(o.charger for o in osc)
+        e = ch.fixed_effects(sc, adc_delay=1)
+        assert e.has_charger and not e.interference(0, 100).any()
+        k = np.arange(40000)
+        fix = e.charger(0, k.size) / 65536.0
+        flt = sum(o.wave(k + 1, cfg.fs_hz) for o in osc)
+        err = np.abs(fix - flt)
+        if harm == "square":
+            bad = err > 0.02
+            assert bad.mean() < 0.005 and set(np.round(flt[bad] / np.abs(flt).max()).tolist()) <= {-1.0, 1.0}
+        else:
+            assert err.max() < 0.52
+        assert np.abs(flt).max() > 0.9 * ch.finger_tone_lsb(cfg)
