@@ -3,8 +3,9 @@
 Column c at ADC sample n (before quantisation, in LSB):
 
     v[n, c] = TONE_LSB * sum_r G[n, r, c] * p(n - d) * sin(2 pi k_r (n - d) / N + phi_r)
-              + interferer(n) + dc + noise[n, c]
+              + oscillators(n) + charger(n) * w_c(n) + dc + noise[n, c]
     G[n]    = (baseline + sum_k touching_k(n) * map_k(n)) * attenuation      (sensor.py)
+              (* (1 + a t) + baseline * b t with a ``drift``)
     adc     = enob_mask(clip(round_half_even(v), -2**(B-1), 2**(B-1) - 1))
 
 * Row tones: exact FFT bins k_r = cfg.bins[r], equal amplitude, phase phi_r = 0 (the DDS
@@ -18,15 +19,20 @@ Column c at ADC sample n (before quantisation, in LSB):
   (``touching_k(n)``).  Moving contacts: the contact map is evaluated exactly at every
   window boundary and linearly interpolated in between (a contact moves 6 um per window
   at 1 m/s; the interpolation error is second order in that, < 1e-6 of a cell).
+* Oscillators (:func:`oscillators`): interferers (fixed, sweeping, in bursts) and display
+  harmonics on every column; charger harmonics or a square wave on column c weighted by
+  w_c(n) = the touching contacts' coupling to the column over a default finger's
+  (:func:`charger_column_weights`, from G - baseline: 0 when nothing touches).
 * ADC: round half to even (numpy rint), clip to the B-bit range (counted: ``clipped``),
   ENOB = clear the low B - enob bits (floor), DC offset and noise before quantisation.
   Noise: white Gaussian, sigma from ``noise_sigma_for_snr`` (the default physics).
 
 The RTL bench (``make sim``) applies the same effects in integers (``FixedEffects``,
 ``channel_sim_fixed`` below; bit-exact with bench/core's C++ and Verilog channels): a
-counter-based noise generator instead of numpy's, interferers from a 32-bit phase
-accumulator and a 4096-word sine table, round half up, row words before the channel
-delay are 0 (docs/simulation.md lists the differences).
+counter-based noise generator instead of numpy's, oscillators from a 64-bit phase
+accumulator and a 4096-word sine table, the charger weights held per coupling update,
+round half up, row words before the channel delay are 0 (docs/simulation.md lists the
+differences).
 """
 from __future__ import annotations
 
