@@ -52,10 +52,11 @@ def count(frame_events: list, n: int, settle: int, first: int | None = None) -> 
 
 
 def events(sc, st) -> list:
-    """Per frame, the fixed-point pipeline's events (calibrated as fmt.run_sim does)."""
+    """Per frame, the fixed-point pipeline's events (calibrated as fmt.run_sim did when the
+    figures were measured: noiseless)."""
     res = chain.heatmaps_float(sc)
     return touch.process_frames(np.rint(res.heatmaps).astype(np.int64), sc.cfg, st, fixed=True,
-                                flatten_cal=run_sim.calibration(sc),
+                                flatten_cal=run_sim.calibration(sc, mode="noiseless"),   # as measured
                                 frame_period_s=sc.frame_period_s)
 
 

@@ -83,7 +83,8 @@ def finger_peaks(diameter_mm: float, snr_db: float = 30.0, frames: int = 400) ->
                                  path=[[0.0, 80.0, 70.0], [frames * cfg.window_s, 85.0, 75.0]])])
     res = chain.heatmaps_float(sc)
     pp = touch.TouchPipeline(cfg, _settings.TouchSettings(), fixed=True,
-                             flatten_cal=run_sim.calibration(sc), frame_period_s=sc.frame_period_s)
+                             flatten_cal=run_sim.calibration(sc, mode="noiseless"),   # as measured
+                             frame_period_s=sc.frame_period_s)
     flat = pp.flatten(np.rint(res.heatmaps).astype(np.int64))
     return [max([t.strength for t in pp.touches(flat[k], k)[0]], default=0)
             for k in range(flat.shape[0])]

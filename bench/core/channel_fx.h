@@ -1,7 +1,7 @@
 // channel_fx.h -- the additive effects of the `make sim` channel in C++ (counter-based
-// Gaussian noise, DC offset, interferers; the delay length and ENOB mask are carried
-// here too), bit-exact with sim/fmt/channel.py FixedEffects (numpy) and
-// bench/core/fmt_channel_sim.v fx_noise / fx_common (Verilog).  Used by sim_main.cpp;
+// Gaussian noise, DC offset, oscillators: interferers that may sweep and burst, display
+// and charger harmonics; the delay length and ENOB mask are carried here too), bit-exact with sim/fmt/channel.py FixedEffects (numpy) and
+// bench/core/fmt_channel_sim.v fx_noise / fx_osc (Verilog).  Used by sim_main.cpp;
 // tb/fmt_core/test_channel_effects.py compiles it alone to compare the words.
 #pragma once
 #include <cstdint>
@@ -15,8 +15,11 @@ struct Effects {
     uint64_t key = 0;
     int64_t sigma_q = 0, dc_q = 0, enob_mask = 0;
     int delay = 0;
-    struct If { uint32_t inc, ph0; int64_t amp; };
+    // one oscillator (interferer, display or charger harmonic): 32-bit phase step and
+    // start, amplitude, 64-bit step of the step (sweep), burst gate, flags (1 square, 2 charger)
+    struct If { uint32_t inc, ph0; int64_t amp; uint64_t dinc, bper, bon; int64_t bstart; uint64_t flags; };
     std::vector<If> ifs;
+    bool has_charger = false;
     std::vector<int64_t> gauss, sine;         // 2^16 and 2^12 signed table words
 
     static uint64_t mix64(uint64_t z) {
@@ -31,15 +34,28 @@ struct Effects {
         const uint64_t z = mix64(key + (ctr + 1) * 0x9E3779B97F4A7C15ull);
         return (gauss[z >> 48] * sigma_q) >> 4;
     }
-    // DC plus the interferers at channel sample k (2^-16 LSB), the same in every column.
-    int64_t common(uint32_t k) const {
-        int64_t v = dc_q;
+    // Sum of the oscillators with (charger) or without the charger flag at channel sample
+    // k (2^-16 LSB): 64-bit phase ((ph0 + k inc) mod 2^32) << 32 + dinc k (k - 1) / 2.
+    int64_t osc_sum(uint32_t k, bool charger) const {
+        int64_t v = 0;
+        const uint64_t k64 = k;
+        const uint64_t tk = (k64 * (k64 - 1)) >> 1;        // exact: k < 2^32
         for (const If& i : ifs) {
-            const uint32_t ph = i.ph0 + k * i.inc;          // mod 2^32
-            v += (i.amp * sine[ph >> 20]) >> 7;
+            if (((i.flags & 2) != 0) != charger) continue;
+            if (i.bper != 0) {
+                const int64_t d = static_cast<int64_t>(k64) - i.bstart;
+                if (d < 0 || static_cast<uint64_t>(d) % i.bper >= i.bon) continue;
+            }
+            const uint64_t ph = (static_cast<uint64_t>(i.ph0 + k * i.inc) << 32) + i.dinc * tk;   // mod 2^64
+            const int64_t w = (i.flags & 1) ? ((ph >> 63) ? -32767 : 32767) : sine[ph >> 52];
+            v += (i.amp * w) >> 7;
         }
         return v;
     }
+    // DC plus the oscillators added to every column at channel sample k (2^-16 LSB).
+    int64_t common(uint32_t k) const { return dc_q + osc_sum(k, false); }
+    // The charger oscillators at channel sample k; column c adds (charger * W_c) >> 12.
+    int64_t charger(uint32_t k) const { return has_charger ? osc_sum(k, true) : 0; }
 
     // Hex words of a $readmemh file, one per line (files written by sim/fmt; no
     // comments or @ addresses); empty on a missing file.
@@ -65,8 +81,8 @@ struct Effects {
         if (in) out.push_back(v);
         return out;
     }
-    // Load the parameter words (key, sigma_q, dc_q, enob_mask, delay, n_if, then inc, ph0,
-    // amp per interferer) and the two tables; returns "" or what is wrong.
+    // Load the parameter words (key, sigma_q, dc_q, enob_mask, delay, n_osc, then inc, ph0,
+    // amp, dinc, bper, bon, bstart, flags per oscillator) and the two tables; returns "" or what is wrong.
     std::string load(const std::string& chan, const std::string& gauss_file, const std::string& sine_file) {
         const std::vector<uint64_t> w = read_hex(chan);
         if (w.size() < 6) return "chan file " + chan + " missing or short";
@@ -76,11 +92,15 @@ struct Effects {
         enob_mask = static_cast<int64_t>(w[3]);
         delay = static_cast<int>(w[4]);
         const size_t n_if = static_cast<size_t>(w[5]);
-        if (w[4] > static_cast<uint64_t>(DELAY_MAX) || w.size() < 6 + 3 * n_if) return "bad chan file " + chan;
+        if (w[4] > static_cast<uint64_t>(DELAY_MAX) || n_if > 64 || w.size() < 6 + 8 * n_if) return "bad chan file " + chan;
         ifs.clear();
-        for (size_t i = 0; i < n_if; ++i)
-            ifs.push_back(If{static_cast<uint32_t>(w[6 + 3 * i]), static_cast<uint32_t>(w[7 + 3 * i]),
-                             static_cast<int64_t>(w[8 + 3 * i])});
+        has_charger = false;
+        for (size_t i = 0; i < n_if; ++i) {
+            const uint64_t* p = &w[6 + 8 * i];
+            ifs.push_back(If{static_cast<uint32_t>(p[0]), static_cast<uint32_t>(p[1]), static_cast<int64_t>(p[2]),
+                             p[3], p[4], p[5], static_cast<int64_t>(p[6]), p[7]});
+            if (p[7] & 2) has_charger = true;
+        }
         const auto table = [](const std::string& path, size_t n, std::vector<int64_t>& t) -> bool {
             const std::vector<uint64_t> v = read_hex(path);
             if (v.size() != n) return false;

@@ -1,6 +1,6 @@
 // fmt_core_sim_top -- SIMULATION-ONLY full-chain top: fmt_core + fmt_channel_sim (the
 // DAC words through the channel delay and a coupling matrix with stamped updates, plus
-// counter-based noise, DC offset and interferers, clipped, ENOB-masked, back into the
+// counter-based noise, DC offset, interferers and charger noise, clipped, ENOB-masked, back into the
 // ADC inputs; effects from CHAN_FILE / GAUSS_FILE / SINE_FILE) + a coupling-update
 // player + loggers, so that a whole scene runs with no testbench code on the
 // per-sample path.
@@ -8,6 +8,7 @@
 // Coupling-update player (runs while play_i = 1): UPD_FILE ($readmemh, 64-bit records, UPD_LEN entries) is
 // executed from the first cycle after reset, one record per cycle:
 //   [63:60] = 1  write G_pending[row = [59:52]][col = [51:44]] = [15:0]
+//   [63:60] = 3  write the pending charger weight W_pending[col = [51:44]] = [15:0]
 //   [63:60] = 2  commit the pending matrix, stamped with sample [31:0]; the player then
 //                waits until the channel has copied it (its armed flag clears) before the
 //                next record, so the next writes cannot reach the armed copy
@@ -122,7 +123,7 @@ module fmt_core_sim_top #(
         reg  [63:0]      upd_mem [0:UPD_LEN-1];
         reg  [31:0]      upd_ptr_q;
         reg              upd_wait_q;
-        reg              upd_we, upd_commit;
+        reg              upd_we, upd_chg, upd_commit;
         reg  [ROW_W-1:0] upd_row;
         reg  [COL_W-1:0] upd_col;
         reg  [15:0]      upd_data;
@@ -141,13 +142,15 @@ module fmt_core_sim_top #(
         assign upd_done_o = (kind == 4'd0);
         always @(*) begin
             upd_we     = 1'b0;
+            upd_chg    = 1'b0;
             upd_commit = 1'b0;
             upd_row    = rec[52 +: ROW_W];
             upd_col    = rec[44 +: COL_W];
             upd_data   = rec[15:0];
             upd_stamp  = rec[31:0];
             if (play_i && !upd_wait_q) begin
-                if (kind == 4'd1) upd_we = 1'b1;
+                if (kind == 4'd1 || kind == 4'd3) upd_we = 1'b1;
+                if (kind == 4'd3) upd_chg = 1'b1;
                 if (kind == 4'd2 && !rst) upd_commit = 1'b1;
             end
         end
@@ -175,7 +178,7 @@ module fmt_core_sim_top #(
             .CHAN_FILE(CHAN_FILE), .GAUSS_FILE(GAUSS_FILE), .SINE_FILE(SINE_FILE)
         ) u_ch (
             .clk(clk), .rst(rst), .ce(ce), .dac_i(dac),
-            .upd_we_i(upd_we), .upd_row_i(upd_row), .upd_col_i(upd_col), .upd_data_i(upd_data),
+            .upd_we_i(upd_we), .upd_chg_i(upd_chg), .upd_row_i(upd_row), .upd_col_i(upd_col), .upd_data_i(upd_data),
             .upd_commit_i(upd_commit), .upd_stamp_i(upd_stamp),
             .adc_o(adc), .clip_o(ch_clip), .clip_sticky_o(clip_o), .sample_o(ch_sample));
         wire unused_ch = &{1'b0, ch_sample, ch_clip, rec};

@@ -3,7 +3,7 @@ fixed-point model in lockstep as the reference.
 
     python -m bench.core.run_sim_rtl --scene sim/scenes/default.json [--out build/sim]
         [--frames F] [--cps 3] [--engine cpp|cocotb] [--sim verilator|icarus]
-        [--no-plot] [--quiet] [--serve PORT [--serve-seconds S] [--serve-once]]
+        [--cal scene|noiseless] [--no-plot] [--quiet] [--serve PORT [--serve-seconds S] [--serve-once]]
 
 (from the repository root with the repository, ``sim`` and ``tb`` on PYTHONPATH:
 ``source scripts/env.sh``; ``make sim`` sets them).  The files of the bench are in
@@ -11,15 +11,16 @@ fixed-point model in lockstep as the reference.
 
 The simulation top ``bench/core/fmt_core_sim_top.v`` is fmt_core + the simulation-only
 channel (DAC words through the channel delay x coupling matrix + counter-based noise,
-DC, interferers -> clip -> ENOB -> ADC words) + a coupling-update player + loggers;
+DC, interferers, display and charger noise -> clip -> ENOB -> ADC words) + a coupling-update player + loggers;
 nothing in Python is on the per-sample path:
 
 0. :func:`check_scene`: every effect of the scene is applied by the RTL path
-   (``fmt.channel.fixed_effects``: noise, DC offset, ENOB, channel delay, interferers;
+   (``fmt.channel.fixed_effects``: noise, DC offset, ENOB, channel delay, interferers
+   (sweeping, bursty), display noise, charger noise (weights in the coupling plan);
    PN in the core's registers; coupling effects in the plan) or the run stops before
    anything is built: ``main`` prints ONE line naming the effect and returns 2
    (``tone_phases`` other than "zero": the DDS has no phase register; a delay over 63
-   samples, more than 8 interferers, a PN setting outside its register).
+   samples, more than 64 oscillators, a PN setting outside its register).
 1. The scene becomes a coupling plan (:func:`coupling_plan`): the channel matrix G (16
    fraction bits, ADC LSB per DAC LSB) at sample 0 and stamped updates -- at every window
    boundary where the coupling changed (moving contacts: the map at the window's first
@@ -35,7 +36,10 @@ nothing in Python is on the per-sample path:
    reset) -> ``dds_bank_fixed`` -> 3-sample DAC delay -> :func:`channel_fixed` (int64
    twin of ``channel_sim_fixed``, with the effects) -> 1-sample ADC register ->
    ``rx_heatmaps_fixed`` (PN receive delay 4 samples + the scene's rx_delay) ->
-   ``touch.process_frames(fixed=True)`` with the scene's calibration.
+   ``touch.process_frames(fixed=True)`` with the scene's calibration: by default the real
+   procedure (:func:`calibration_fixed`: 16 untouched and 16 calibration-sheet frames with
+   the scene's noise and additive effects through this fixed-point chain, averaged);
+   ``--cal noiseless``: the old noiseless render (always perfect).
 3. The RTL run.  Engine ``cpp`` (default): the standalone Verilator harness
    ``bench/core/sim_main.cpp`` (:func:`run_harness`; built once per sensor size and
    CLK_PER_SAMPLE under ``build/sim_cpp/`` with -O3 and rebuilt only when a source
@@ -136,12 +140,19 @@ def quantise_g(g: np.ndarray, scale: float) -> np.ndarray:
 def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
     """(g0, updates): the integer matrix in effect from sample 0 and the list of
     (stamp, G) updates, spaced so that the simulation top's player loads each one (one
-    write per changed cell, then the commit) before its stamp."""
+    write per changed cell, then the commit) before its stamp.  With charger noise in
+    the scene every matrix has a row ROWS more: the charger weight of each column
+    (``channel.charger_column_weights`` of the same coupling, CHG_W_FRAC fraction bits),
+    loaded by kind-3 records, so it changes exactly when the coupling does."""
     cfg = scene.cfg
     n = cfg.n_fft
     nw = -(-n_samples // n)
     wc = _channel.window_coupling(scene, 0, nw)
     scale = coupling_scale(cfg)
+    chg = any(o.charger for o in _channel.oscillators(scene))
+    if chg:                          # charger weights from the coupling above the baseline
+        wq = lambda g, base: np.clip(np.rint(_channel.charger_column_weights(cfg, g - base)
+                                       * (1 << _channel.CHG_W_FRAC)), 0, (1 << COUP_BITS) - 1).astype(np.int64)
     by_w = {}
     for w, mask, m0, _m1 in wc.partial:
         by_w.setdefault(w, []).append((mask, m0))
@@ -157,7 +168,8 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
             for mask, m0 in parts:
                 if mask[s]:
                     g += m0
-            raw.append((w * n + s, quantise_g(g, scale)))
+            q = quantise_g(g, scale)
+            raw.append((w * n + s, np.vstack([q, wq(g, wc.b0[w])[None, :]]) if chg else q))
     g0 = raw[0][1]
     kept = [(0, g0)]
     for stamp, g in raw[1:]:
@@ -177,13 +189,15 @@ def coupling_plan(scene: _scene.Scene, n_samples: int, cps: int):
 
 
 def plan_records(cfg, g0, updates) -> list[int]:
-    """64-bit player records (see fmt_core_sim_top.v)."""
+    """64-bit player records (see fmt_core_sim_top.v): kind 1 coupling writes, kind 3
+    charger-weight writes (the matrix's row ROWS), kind 2 commits, 0 the end."""
     rec = []
     prev = np.zeros_like(g0)
     for stamp, g in [(0, g0)] + list(updates):
         rr, cc = np.nonzero(g != prev)
         for r, c in zip(rr.tolist(), cc.tolist()):
-            rec.append((1 << 60) | (r << 52) | (c << 44) | int(g[r, c]))
+            kind = 3 if r == cfg.rows else 1         # row ROWS: a charger weight
+            rec.append((kind << 60) | (r << 52) | (c << 44) | int(g[r, c]))
         rec.append((2 << 60) | int(stamp))
         prev = g
     rec.append(0)
@@ -220,7 +234,8 @@ def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, ad
                   noise=None):
     """int64 twin of ``fmt_channel_sim`` / ``channel.channel_sim_fixed`` (same formula:
     round half up of sum_r dac[k - delay]*G + additive effects, >> 16, clip, ENOB mask);
-    int64 is exact here (|dac| < 2^11, G < 2^16, ROWS <= 64, additive < 2^40).
+    int64 is exact here (|dac| < 2^11, G < 2^16, ROWS <= 64, additive < 2^40; charger
+    sum < 2^38 times W < 2^16).  Matrices with ROWS + 1 rows carry the charger weights.
     ``noise``: file words as channel_sim_fixed's (tests).  Returns (adc, clipped samples)."""
     dac = np.asarray(dac, dtype=np.int64)
     n = dac.shape[0]
@@ -228,13 +243,17 @@ def channel_fixed(dac, g0, updates, eff: _channel.FixedEffects | None = None, ad
         dd = np.zeros_like(dac)
         dd[eff.delay:] = dac[:max(n - eff.delay, 0)]
         dac = dd
+    rows = dac.shape[1]
     out = np.empty((n, g0.shape[1]), dtype=np.int64)
     stamps = [0] + [int(s) for s, _ in updates] + [n]
     mats = [g0] + [g for _, g in updates]
+    chg = eff.charger(0, n) if eff is not None and eff.has_charger else None
     for i, g in enumerate(mats):
         a, b = min(stamps[i], n), min(stamps[i + 1], n)
         if b > a:
-            out[a:b] = dac[a:b] @ g
+            out[a:b] = dac[a:b] @ g[:rows]
+            if chg is not None and g.shape[0] > rows:    # charger weights in row ROWS
+                out[a:b] += (chg[a:b, None] * g[rows][None, :]) >> _channel.CHG_W_FRAC
     if noise is not None:
         out += noise[np.arange(n) % noise.shape[0]] << (COUP_FRAC - NOISE_FRAC)
     if eff is not None:
@@ -302,6 +321,38 @@ def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings
     """The model's heat maps and events of the run; ``m_frames``: M of each frame when
     WINDOWS_M changes during the run (default: the scene's M throughout)."""
     from fmt import touch as _touch
+    hm, clipped = model_heatmaps(scene, g0, updates, eff, frames, cps, m_frames)
+    evs = _touch.process_frames(hm, scene.cfg, settings, fixed=True, flatten_cal=cal,
+                                frame_period_s=scene.frame_period_s)
+    return Reference(hm, evs, clipped)
+
+
+CAL_SKIP = 1            # calibration captures: start-up frames dropped before the average
+
+
+def calibration_fixed(scene: _scene.Scene, cps: int = 3, sheet: float = 0.25, frames: int | None = None):
+    """(offset, gain) by the real procedure through the bench's fixed-point chain (the
+    heat maps the core itself would measure): the captures of
+    ``fmt.run_sim.calibration_scenes`` (untouched, uniform sheet; the scene's noise and
+    additive effects, no charger noise) through the coupling plan, the fixed-point channel
+    and ``rx_heatmaps_fixed``; the first CAL_SKIP frames (the chain's start-up: no DAC word
+    in the first samples) dropped, the next ``frames`` averaged by ``flatten.calibrate``."""
+    from fmt import flatten as _flatten
+    from fmt import run_sim as _run_sim
+    frames = _run_sim.CAL_FRAMES if frames is None else frames
+    hms = []
+    for sc in _run_sim.calibration_scenes(scene, sheet, frames + CAL_SKIP):
+        n = sc.frames * sc.samples_per_frame
+        g0, ups = coupling_plan(sc, n, cps)
+        hm, _clip = model_heatmaps(sc, g0, ups, check_scene(sc), sc.frames, cps)
+        hms.append(hm[CAL_SKIP:])
+    off, gain = _flatten.calibrate(hms[0], hms[1], None, scene.cfg)
+    return np.asarray(off, dtype=np.int64), np.asarray(gain, dtype=np.int64)
+
+
+def model_heatmaps(scene: _scene.Scene, g0, updates, eff, frames: int, cps: int = 3, m_frames=None):
+    """(heat maps (frames, rows, cols), clipped samples) of the bench's fixed-point chain:
+    PN as the core makes it, DDS, DAC delay, channel, ADC register, fixed receiver."""
     cfg = scene.cfg
     spf = scene.samples_per_frame
     n = frames * spf
@@ -310,15 +361,16 @@ def model_reference(scene: _scene.Scene, g0, updates, eff, frames: int, settings
     dds = _dds.dds_bank_fixed(n, tx_sign=np.concatenate([[0], tx[:-1]]).astype(np.int64), cfg=cfg)
     dac = np.zeros_like(dds)
     dac[DAC_DELAY:] = dds[:n - DAC_DELAY]
-    adc_ch, clipped = channel_fixed(dac, g0, updates, eff, cfg.adc_bits)
+    # the initial matrix is committed at the first clk edge after the reset and copied at
+    # the next ce edge: channel sample 0 still sees G = 0, W = 0 (no DAC word is there yet
+    # either, DAC_DELAY; only a charger weight would show it)
+    adc_ch, clipped = channel_fixed(dac, np.zeros_like(g0), [(1, g0)] + list(updates), eff, cfg.adc_bits)
     adc = np.zeros_like(adc_ch)
     adc[ADC_DELAY:] = adc_ch[:n - ADC_DELAY]
     rx_in = np.concatenate([[0], rx[:-1]]).astype(np.int64)
     hm, _order, _flags = _rx.rx_heatmaps_fixed(adc, rx_in, cfg,
                                                m=scene.m if m_frames is None else m_frames)
-    evs = _touch.process_frames(hm, cfg, settings, fixed=True, flatten_cal=cal,
-                                frame_period_s=scene.frame_period_s)
-    return Reference(hm, evs, clipped)
+    return hm, clipped
 
 
 def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
@@ -698,7 +750,9 @@ def run_harness(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="
 
 
 def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scene", tag: str = ""):
-    """Write the job folder (records, noise, job.json) and compute the reference."""
+    """Write the job folder (records, noise, job.json) and compute the reference.  ``cal``:
+    "scene" (the real procedure, :func:`calibration_fixed`), "noiseless" (the old
+    noiseless render), None (none loaded) or an (offset, gain) pair."""
     from fmt import run_sim as _run_sim
     cfg = scene.cfg
     eff = check_scene(scene)
@@ -712,8 +766,10 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
         raise ValueError(f"{len(rec)} update records > capacity {upd_len(cfg)}: fewer frames")
     write_records(d / "upd.hex", rec)
     write_channel_files(d, eff)
-    if cal == "scene":
-        cal = _run_sim.calibration(scene)
+    if cal == "scene":              # the real procedure on noisy frames, fixed point
+        cal = calibration_fixed(scene, cps)
+    elif cal == "noiseless":        # the old, always perfect one (noiseless renders)
+        cal = _run_sim.calibration(scene, mode="noiseless")
         cal = (np.asarray(cal[0], dtype=np.int64), np.asarray(cal[1], dtype=np.int64))
     ref = model_reference(scene, g0, updates, eff, frames, settings, cal, cps)
     # cycles: all frames end, plus the post-processing tail
@@ -731,7 +787,7 @@ def prepare(scene: _scene.Scene, frames: int, cps: int, settings=None, cal="scen
 def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int = 3,
         sim: str = "verilator", plot: bool = True, quiet: bool = False, settings=None,
         engine: str = "cpp", serve: dict | None = None, tag: str = "cpp",
-        cflags: str = HARNESS_CFLAGS, pre: dict | None = None) -> dict:
+        cflags: str = HARNESS_CFLAGS, pre: dict | None = None, cal="scene") -> dict:
     """engine "cpp": the standalone C++ harness (Verilator only, the default of
     ``make sim``); "cocotb": the cocotb test run_scene (Verilator or Icarus).
     serve (engine cpp only): serve the UART after the scene (write_cpp_job); tag and
@@ -746,7 +802,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
     check_scene(scene)                 # refuse an effect the RTL cannot apply, before any build
     if engine == "cpp" and sim == "verilator":
         t0 = time.perf_counter()
-        d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, quiet=quiet,
+        d, ref, cal, n_upd, res, build_s = run_harness(scene, frames, cps, settings, cal=cal, quiet=quiet,
                                                       tag=tag, cflags=cflags, serve=serve, pre=pre)
         rep = analyse(scene, ref, d, cps, res.get("status", {}), frames, res["wall_s"], out_dir, plot, cal,
                       max_cycle=res.get("serve_start_cycle"), confirm_frames=settings.confirm_frames)
@@ -767,7 +823,7 @@ def run(scene: _scene.Scene, out_dir=None, frames: int | None = None, cps: int =
     # the job folder: one per simulator, and per tag when a caller gives one (tests that
     # run at the same time under pytest-xdist must not share job.json and the logs)
     jtag = ("" if sim == "verilator" else sim) + ("" if tag == "cpp" else f"_{tag}")
-    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, tag=jtag.lstrip("_"))
+    d, ref, cal, n_upd = prepare(scene, frames, cps, settings, cal=cal, tag=jtag.lstrip("_"))
     t1 = time.perf_counter()
     env = {"FMT_CORE_JOB": str(d / "job.json"), "FMT_QUIET": int(quiet)}
     run_cocotb(sim=sim, toplevel="fmt_core_sim_top", sources=sim_sources(),
@@ -839,6 +895,9 @@ def main(argv=None) -> int:
                          "cocotb: the cocotb test run_scene (Verilator or Icarus, ~40x slower)")
     ap.add_argument("--settings", default=None,
                     help="touch settings file (JSON, TouchSettings fields); default the scene's")
+    ap.add_argument("--cal", default="scene", choices=("scene", "noiseless"),
+                    help="calibration: scene (the real procedure on noisy untouched / sheet frames "
+                         "through the fixed-point chain, default) or noiseless (the old perfect one)")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     ap.add_argument("--serve", type=int, default=None, metavar="PORT",
@@ -876,7 +935,7 @@ def main(argv=None) -> int:
                  "log_clk": -1 if a.serve_log_frames < 0 else a.serve_log_frames * spf_clk}
     try:
         rep = run(sc, a.out, frames=a.frames, cps=a.cps, sim=a.sim, plot=not a.no_plot, quiet=a.quiet,
-                  settings=st, engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags)
+                  settings=st, engine=a.engine, serve=serve, tag=a.tag, cflags=a.cflags, cal=a.cal)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130

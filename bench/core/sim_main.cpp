@@ -19,19 +19,21 @@
 //
 // The channel (bench/core/fmt_channel_sim.v, bit-exact, in C++): at every clk edge
 // with rst low and ce_o high (sample k = k-th such edge since reset)
-//   acc[c] = sum_r dac[k - delay][r] * G[r][c] + noise(k, c) + dc + sum_i interferer_i(k)
+//   acc[c] = sum_r dac[k - delay][r] * G[r][c] + noise(k, c) + dc + sum_i osc_i(k)
+//            + (charger(k) * W[c]) >> 12
 //   adc[c] = clip((acc[c] + 2^15) >> 16, -2048, 2047) & ~enob_mask  (>>: floor)
 // registered (the core sees it from the next edge on), rst clears it (and the delay
 // line: dac[j] = 0 for j < 0).  The additive terms (2^-16 LSB) are those of
 // sim/fmt/channel.py FixedEffects: noise(k, c) = (GAUSS[z >> 48] * sigma_q) >> 4 with
 // z = splitmix64 mix of key + (((k << 8) | c) + 1) * 0x9E3779B97F4A7C15 (a counter-based
-// generator: nothing repeats); interferer i = (amp_i * SINE[(ph0_i + k * inc_i) >> 20]) >> 7
-// (32-bit phase).  Parameters from chan_file (64-bit hex words: key, sigma_q, dc_q,
-// enob_mask, delay, n_if, then inc, ph0, amp per interferer), the tables from
+// generator: nothing repeats); oscillator i = (amp_i * SINE[ph_i(k) >> 52]) >> 7 (64-bit
+// phase with a sweep term, a burst gate, or a square wave; charger oscillators summed
+// into charger(k); channel_fx.h).  Parameters from chan_file (64-bit hex words: key,
+// sigma_q, dc_q, enob_mask, delay, n_osc, then 8 words per oscillator), the tables from
 // gauss_file (2^16 words) and sine_file (2^12 words), all written by run_sim_rtl.py.  G is 0 until
 // phase 2; the coupling updates come from the same record file as the Verilog player's
-// (upd.hex: kind 1 = pending write, kind 2 = commit stamped with a sample, 0 = end):
-// a commit arms a copy G := pending at the first ce edge whose sample index is >= the
+// (upd.hex: kind 1 = pending write, kind 3 = pending charger weight W[c] write, kind 2 =
+// commit stamped with a sample, 0 = end): a commit arms a copy G, W := pending at the first ce edge whose sample index is >= the
 // stamp.  The first commit (the initial matrix) is armed by the first edge after the
 // phase-2 reset, as the player does; the later ones are armed right after the previous
 // copy (no load time here), and a copy at a sample later than its stamp counts as late.
@@ -108,6 +110,7 @@ inline int32_t get_field(const uint32_t* w, int lsb, int width) {
 struct Update {
     uint32_t stamp;
     std::vector<int32_t> g;   // column-major [c * rows + r]
+    std::vector<int32_t> w;   // charger weight per column
 };
 
 struct Job {
@@ -197,6 +200,7 @@ Job read_job(const char* path) {
 struct Channel {
     int rows, cols;
     std::vector<int32_t> g, pending;          // column-major
+    std::vector<int32_t> w, pending_w;        // charger weights per column (12 fraction bits)
     Effects fx;
     std::vector<int32_t> dline;               // [(k mod DELAY_MAX) * rows + r]
     std::vector<Update> updates;              // commits in record order
@@ -210,7 +214,7 @@ struct Channel {
 
     Channel(const Job& j, size_t adc_nwords)
         : rows(j.rows), cols(j.cols),
-          g(static_cast<size_t>(rows) * cols, 0), pending(g.size(), 0),
+          g(static_cast<size_t>(rows) * cols, 0), pending(g.size(), 0), w(cols, 0), pending_w(cols, 0),
           dline(static_cast<size_t>(Effects::DELAY_MAX) * rows, 0), dac(rows, 0), adc_words(adc_nwords, 0) {
         if (!j.chan_file.empty()) load_effects(j);
         if (!j.upd_file.empty()) load_updates(j.upd_file);
@@ -231,15 +235,18 @@ struct Channel {
     }
 
     void load_updates(const std::string& path) {
-        std::vector<int32_t> pend(g.size(), 0);
+        std::vector<int32_t> pend(g.size(), 0), pend_w(cols, 0);
         for (const uint64_t rec : read_hex(path)) {
             const unsigned kind = static_cast<unsigned>(rec >> 60);
             if (kind == 0) break;
             if (kind == 1) {
                 const int r = static_cast<int>((rec >> 52) & 0xFF), c = static_cast<int>((rec >> 44) & 0xFF);
                 if (r < rows && c < cols) pend[static_cast<size_t>(c) * rows + r] = static_cast<int32_t>(rec & 0xFFFF);
+            } else if (kind == 3) {
+                const int c = static_cast<int>((rec >> 44) & 0xFF);
+                if (c < cols) pend_w[static_cast<size_t>(c)] = static_cast<int32_t>(rec & 0xFFFF);
             } else if (kind == 2) {
-                updates.push_back(Update{static_cast<uint32_t>(rec & 0xFFFFFFFFu), pend});
+                updates.push_back(Update{static_cast<uint32_t>(rec & 0xFFFFFFFFu), pend, pend_w});
             }
         }
     }
@@ -261,6 +268,7 @@ struct Channel {
         if (ce) {
             if (armed && k >= stamp) {
                 g = pending;
+                w = pending_w;
                 ++copies;
                 if (k > stamp && stamp != 0) ++late;   // as the player: stamp 0 = at once
                 armed = false;
@@ -276,6 +284,7 @@ struct Channel {
                 for (int r = 0; r < rows; ++r) slot[r] = get_field(dw, r * 12, 12);
             }
             const int64_t common = fx.common(k);
+            const int64_t chg = fx.charger(k);
             std::fill(adc_words.begin(), adc_words.end(), 0u);
             bool clip = false;
             for (int c = 0; c < cols; ++c) {
@@ -283,6 +292,7 @@ struct Channel {
                 int64_t acc = 0;
                 for (int r = 0; r < rows; ++r) acc += static_cast<int64_t>(dac[r]) * gc[r];
                 acc += fx.noise(k, c) + common;
+                if (chg != 0) acc += (chg * w[static_cast<size_t>(c)]) >> 12;
                 int64_t y = (acc + (1 << 15)) >> 16;
                 if (y > 2047) { y = 2047; clip = true; }
                 if (y < -2048) { y = -2048; clip = true; }
@@ -298,6 +308,7 @@ struct Channel {
         if (arm_next || arm_now) {          // registered: takes effect from the next edge
             if (next_upd < updates.size()) {
                 pending = updates[next_upd].g;
+                pending_w = updates[next_upd].w;
                 stamp = updates[next_upd].stamp;
                 ++next_upd;
                 armed = true;

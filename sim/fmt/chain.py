@@ -11,8 +11,9 @@
   rows' bins, and the motion inside a window are exact), and n is complex Gaussian with
   sigma * sqrt(N/2) * hm_scale per quadrature (sigma^2 = ADC noise^2 + 1/12 quantisation
   (+ ENOB step^2 / 12)): the statistics of a DFT bin of white noise (bins and windows
-  independent).  Not modelled by the render: clipping, interferers, DC (it never reaches a
-  comb bin anyway), PN misalignment.  Noiseless, it differs from the ADC path only by the
+  independent).  Not modelled by the render: clipping, interferers and the other
+  oscillators (display and charger noise), DC (it never reaches a comb bin anyway), PN
+  misalignment (a drift and a contact's size_path are: they are coupling).  Noiseless, it differs from the ADC path only by the
   ADC rounding: |error| <= 0.5 LSB * N * hm_scale = 2**(HM_W - ADC_BITS + 1) counts (32)
   per cell, RMS sqrt(N/24) * hm_scale (0.82 counts at N = 256); sim/tests/test_chain.py.
 * :func:`events` -- heat maps through ``fmt.touch.process_frames(hm, cfg, settings,

@@ -1,11 +1,14 @@
 """``make sim``: a scene through the floating-point model, with an accuracy report.
 
     python -m fmt.run_sim --scene sim/scenes/default.json [--out build/sim] [--frames F]
-                          [--render] [--no-plot] [--quiet]
+                          [--render] [--cal noisy|noiseless] [--cal-frames K] [--no-plot] [--quiet]
 
-1. Calibration of the field flattening from the model itself (``fmt.flatten.calibrate``):
-   untouched frames and frames with a uniform calibration sheet (coupling 0.25 on every
-   cell), both rendered noiselessly with the scene's baseline, attenuation and tones.
+1. Calibration of the field flattening (``calibration``, ``fmt.flatten.calibrate``): the
+   real procedure on CAL_FRAMES (16) untouched frames and 16 frames with a uniform
+   calibration sheet (coupling 0.25 on every cell), each through the ADC and the float
+   receiver with the scene's noise and additive effects (not the charger noise: no finger
+   touches) and averaged; ``--cal noiseless`` renders one noiseless frame of each instead
+   (the old, always perfect calibration).
 2. ADC streams -> float receiver -> heat maps (``fmt.chain.heatmaps_float``), or the
    render without signal synthesis with ``--render``.
 3. Post-processing: ``fmt.touch.process_frames(heatmaps, cfg, settings, fixed=False)``
@@ -58,21 +61,47 @@ EDGE_LO_MM, EDGE_HI_MM = 1.5, 3.5
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def calibration(scene: _scene.Scene, sheet: float = 0.25):
-    """(offset, gain) of the field flattening from noiseless renders of the scene's sensor:
-    untouched, and covered by a uniform sheet of coupling ``sheet`` (see the module
-    docstring).  Uses ``fmt.flatten.calibrate``."""
-    from . import flatten as _flatten
+CAL_FRAMES = 16          # frames averaged per calibration capture (untouched, sheet)
+CAL_SEED = 7919          # the captures' noise seeds: scene.seed + CAL_SEED (+ 1 for the sheet)
+CAL_MODES = ("noisy", "noiseless")
+
+
+def calibration_scenes(scene: _scene.Scene, sheet: float = 0.25, frames: int = CAL_FRAMES):
+    """(untouched, sheet) capture scenes of the calibration: the scene's sensor and effects
+    (noise, interferers, display noise, DC, drift, ...; charger noise left out, as no
+    finger touches), no contacts / a uniform sheet of coupling ``sheet`` covering every
+    cell, ``frames`` frames of M = 1 from t = 0, noise seeds of their own."""
     cfg = scene.cfg
-    eff = {k: v for k, v in scene.effects.items() if k != "noise"}
-    base = scene.replace(contacts=[], effects=eff, frames=1, m=1)
+    eff = {k: v for k, v in scene.effects.items() if k != "charger"}
+    base = scene.replace(contacts=[], effects=eff, frames=frames, m=1, seed=scene.seed + CAL_SEED)
     # a disk far larger than the sensor covers every cell: coupling = strength exactly
     big = 4.0 * math.hypot(cfg.width_mm, cfg.height_mm)
     sheet_sc = scene.replace(contacts=[{"name": "sheet", "diameter_mm": big, "strength": sheet,
                                         "path": [[0.0, cfg.width_mm / 2, cfg.height_mm / 2]]}],
-                             effects=eff, frames=1, m=1)
-    u = _chain.render_heatmaps(base, noise=False)
-    c = _chain.render_heatmaps(sheet_sc, noise=False)
+                             effects=eff, frames=frames, m=1, seed=scene.seed + CAL_SEED + 1)
+    return base, sheet_sc
+
+
+def calibration(scene: _scene.Scene, sheet: float = 0.25, mode: str = "noisy", frames: int = CAL_FRAMES):
+    """(offset, gain) of the field flattening by ``fmt.flatten.calibrate``, from heat maps
+    of the sensor untouched and covered by a uniform sheet of coupling ``sheet``.
+
+    ``mode`` "noisy" (the real procedure, the default): ``frames`` frames of each capture
+    (``calibration_scenes``) through the ADC streams and the float receiver with the
+    scene's noise and additive effects, averaged.  "noiseless": one noiseless rendered
+    frame of each (always perfect; the behaviour before issue #12, kept for comparison)."""
+    from . import flatten as _flatten
+    cfg = scene.cfg
+    if mode not in CAL_MODES:
+        raise ValueError(f"calibration mode {mode!r}: one of {', '.join(CAL_MODES)}")
+    if mode == "noiseless":
+        base, sheet_sc = calibration_scenes(scene, sheet, 1)
+        u = _chain.render_heatmaps(base, noise=False)
+        c = _chain.render_heatmaps(sheet_sc, noise=False)
+    else:
+        base, sheet_sc = calibration_scenes(scene, sheet, frames)
+        u = _chain.heatmaps_float(base).heatmaps
+        c = _chain.heatmaps_float(sheet_sc).heatmaps
     return _flatten.calibrate(u, c, None, cfg)
 
 
@@ -258,9 +287,10 @@ def tracks(frame_events, cfg) -> dict:
 
 def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None,
         processor=None, render: bool = False, plot: bool = True, quiet: bool = False,
-        frames: int | None = None) -> dict:
+        frames: int | None = None, cal: str = "noisy", cal_frames: int = CAL_FRAMES) -> dict:
     """Run a scene; returns the report (and writes it, with the events, under
-    ``out_dir/<name>/``).  ``settings``: default the scene's (``settings`` key)."""
+    ``out_dir/<name>/``).  ``settings``: default the scene's (``settings`` key);
+    ``cal``, ``cal_frames``: the calibration's mode and frames (``calibration``)."""
     settings = settings or scene.touch_settings()
     processor = processor or default_processor
     cfg = scene.cfg
@@ -283,7 +313,8 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
         if not quiet and scene.frames >= 1000:
             bar.close()
     t1, c1 = time.perf_counter(), time.process_time()
-    cal = calibration(scene)
+    cal_mode = cal
+    cal = calibration(scene, mode=cal_mode, frames=cal_frames)
     evs = processor(res.heatmaps, scene, settings, cal)
     t2 = time.perf_counter()
     det = detections(evs, cfg)
@@ -299,6 +330,7 @@ def run(scene: _scene.Scene, out_dir=None, settings: TouchSettings | None = None
         "clipped_samples": int(res.clipped),
         "noise_sigma_lsb": float(res.noise_sigma),
         "events": int(sum(len(e) for e in evs)),
+        "calibration": {"mode": cal_mode, "frames": cal_frames if cal_mode == "noisy" else 1},
     }
     rep.update(evaluate(scene, det, settings.confirm_frames))
     rep["touches"]["truth_mean"] = rep.pop("truth_touches_mean")
@@ -368,6 +400,11 @@ def main(argv=None) -> int:
                     help="heat maps by render_heatmaps (no ADC synthesis)")
     ap.add_argument("--settings", default=None,
                     help="touch settings file (JSON, TouchSettings fields); default the scene's")
+    ap.add_argument("--cal", default="noisy", choices=CAL_MODES,
+                    help="calibration: noisy (the real procedure on noisy untouched / sheet frames, "
+                         "default) or noiseless (one rendered frame each, always perfect)")
+    ap.add_argument("--cal-frames", type=positive, default=CAL_FRAMES,
+                    help=f"frames averaged per calibration capture (default {CAL_FRAMES})")
     ap.add_argument("--no-plot", action="store_true")
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
@@ -378,7 +415,7 @@ def main(argv=None) -> int:
         print(f"run_sim: {e}", file=sys.stderr)
         return 2
     rep = run(sc, a.out, settings=st, render=a.render, plot=not a.no_plot, quiet=a.quiet,
-              frames=a.frames)
+              frames=a.frames, cal=a.cal, cal_frames=a.cal_frames)
     print(_summary(rep))
     print(f"report: {rep['report']}" + (f", plot: {rep['png']}" if "png" in rep else ""))
     return 0

@@ -31,6 +31,12 @@ Contacts
   anywhere inside a window (``onset_samples`` lists them).
   ``diameter_mm`` (8 = the default finger), ``strength`` (1), ``profile`` ("disk" or
   "gaussian"), optional ``minor_diameter_mm`` and ``angle_deg`` (elliptical contact).
+  ``size_path``: optional ``[[t_s, strength, diameter_mm], ...]``, strength and diameter
+  over time (a finger landing: strength 0.2 -> 1 and 5 -> 8 mm over a few ms; a palm
+  growing), linearly interpolated like the path and held before the first / after the
+  last point; it replaces ``strength`` and ``diameter_mm`` (an ellipse keeps its minor /
+  major ratio).  Only the coupling changes: the float model evaluates the map at every
+  window boundary (linear in between), the RTL plan holds it per window.
 
 Effects (every one costs nothing when absent)
   ``noise``: ``{"snr_db": s}`` (white Gaussian ADC noise set from the model so that a
@@ -38,8 +44,33 @@ Effects (every one costs nothing when absent)
   :func:`fmt.channel.noise_sigma_for_snr`) or ``{"rms_lsb": sigma}``.
   ``enob``: effective bits (the low ADC_BITS - enob bits of every sample are cleared).
   ``dc_lsb``: DC offset added before quantisation.  ``interferer``: ``{"freq_hz": f}`` or
-  ``{"bin": b}`` (fractional bins allowed), ``"amp_lsb"``, ``"phase_rad"``; a list of them
-  is allowed.  ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
+  ``{"bin": b}`` (fractional bins allowed; 0 .. Nyquist), ``"amp_lsb"``, ``"phase_rad"``;
+  a list of them is allowed.  Optional per interferer: ``"sweep_hz_per_s"`` (a linear
+  chirp: the frequency is f + sweep * t, t = n / fs from ADC sample 0; it aliases at the
+  ADC like any tone once it leaves 0 .. Nyquist; |sweep| <= fs^2 / 4) and ``"burst":
+  {"period_s": P, "on_s": D, "start_s": S}`` (the interferer is present on samples n >=
+  round(S fs) with (n - round(S fs)) mod round(P fs) < round(D fs); S defaults to 0; the
+  oscillator runs on while gated off, so each burst continues its phase).
+  ``display``: display noise on every column, ``{"line_hz": f, "harmonics": [[h, amp_lsb],
+  [h, amp_lsb, phase_rad], ...]}``: a sine of amp_lsb at h * f for each listed harmonic h
+  (a whole number >= 1; h * f must not exceed Nyquist), e.g. a 60 kHz line rate's
+  harmonics inside the tone band.  ``charger``: charger / common-mode noise that couples
+  only through touching contacts, ``{"freq_hz": f0, "level": x, "harmonics": "square"}``
+  (a square wave of peak amplitude x times a finger's tone, ``channel.finger_tone_lsb``,
+  with all its odd harmonics, aliased above Nyquist) or ``"harmonics": [[h, a], ...]``
+  (sines of x * a finger tones at h * f0, each below Nyquist); column c receives it
+  multiplied by ``channel.charger_column_weights``: the touching contacts' coupling summed
+  over the column's rows relative to a default finger centred on a cell (1 on that
+  finger's column, 0 when nothing touches; it follows contacts as they move, land and
+  lift).  Interferers, display and charger harmonics together: at most
+  ``channel.IF_MAX`` (64) for the RTL path.
+  ``drift``: a baseline that drifts, ``{"gain_pct_per_s": g, "offset_pct_per_s": o}``:
+  each cell's coupling becomes G(t) (1 + a t) + G_untouched b t, with per-cell rates a
+  uniform in +-g %/s and b uniform in +-o %/s, drawn once from the scene's seed
+  (``channel.drift_rates``); applied at every window boundary (linear in between), so it
+  reaches the RTL through the coupling plan (whose integer matrices change once the drift
+  is larger than their quantum, about 0.3 % of the untouched coupling).
+  ``row_db_per_cell``, ``col_db_per_cell``: electrode attenuation.
   ``baseline``: untouched coupling (default ``sensor.BASELINE``).  ``fringe_mm``: the
   disk profile's Gaussian fringe.  ``delay_samples``: channel delay.  ``pn``:
   ``{"enable": bool, "chip_len": L, "rx_delay": d}`` (rx_delay defaults to the channel
@@ -91,6 +122,7 @@ class Contact:
     angle_deg: float = 0.0
     active: object = None           # None, [[on, off], ...] or {"repeat": {...}}
     active_units: str = "s"         # "s" or "samples"
+    size_path: list | None = None   # [[t_s, strength, diameter_mm], ...] (a landing finger, a palm growing)
 
     def __post_init__(self):
         p = np.asarray(self.path, dtype=np.float64)
@@ -101,6 +133,16 @@ class Contact:
         self._p = p
         if self.profile not in ("disk", "gaussian"):
             raise ValueError(f"contact '{self.name}': unknown profile '{self.profile}'")
+        self._s = None
+        if self.size_path is not None:
+            q = np.asarray(self.size_path, dtype=np.float64)
+            if q.ndim != 2 or q.shape[1] != 3 or q.shape[0] < 1:
+                raise ValueError(f"contact '{self.name}': size_path must be [[t_s, strength, diameter_mm], ...]")
+            if np.any(np.diff(q[:, 0]) < 0):
+                raise ValueError(f"contact '{self.name}': size_path times must not decrease")
+            if np.any(q[:, 1] < 0) or np.any(q[:, 2] <= 0):
+                raise ValueError(f"contact '{self.name}': size_path needs strength >= 0 and diameter_mm > 0")
+            self._s = q
 
     # -- geometry ---------------------------------------------------------------------
     @property
@@ -109,13 +151,35 @@ class Contact:
         return bool(np.all(self._p[:, 1:] == self._p[0, 1:]))
 
     @property
+    def fixed(self) -> bool:
+        """True when the contact's map never changes: stationary, constant size and strength."""
+        return self.stationary and (self._s is None or bool(np.all(self._s[:, 1:] == self._s[0, 1:])))
+
+    @property
     def elliptical(self) -> bool:
         return self.minor_diameter_mm is not None
 
+    def size(self, t) -> tuple:
+        """(strength, diameter_mm) at time(s) t (seconds): ``size_path`` linearly
+        interpolated (held before the first / after the last point), else the constants."""
+        t = np.asarray(t, dtype=np.float64)
+        if self._s is None:
+            return np.full(t.shape, self.strength), np.full(t.shape, self.diameter_mm)
+        q = self._s
+        return np.interp(t, q[:, 0], q[:, 1]), np.interp(t, q[:, 0], q[:, 2])
+
     def shape_row(self) -> tuple:
-        """(diameter, strength, minor_diameter, angle_rad) for ``sensor.contact_maps``."""
-        minor = self.diameter_mm if self.minor_diameter_mm is None else self.minor_diameter_mm
-        return (self.diameter_mm, self.strength, minor, math.radians(self.angle_deg))
+        """(diameter, strength, minor_diameter, angle_rad) for ``sensor.contact_maps``
+        (at time 0 for a contact with a ``size_path``)."""
+        return tuple(self.shape_rows(np.zeros(1))[0])
+
+    def shape_rows(self, t) -> np.ndarray:
+        """(len(t), 4) shape rows at times t: with a ``size_path`` the diameter and
+        strength follow it and the minor diameter keeps its ratio to the diameter."""
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        st, d = self.size(t)
+        ratio = 1.0 if self.minor_diameter_mm is None else self.minor_diameter_mm / self.diameter_mm
+        return np.column_stack([d, st, d * ratio, np.full(t.shape, math.radians(self.angle_deg))])
 
     def position(self, t) -> np.ndarray:
         """(..., 2) x, y in mm at time(s) t (seconds)."""
@@ -177,6 +241,8 @@ class Contact:
             d["active"] = self.active
             if self.active_units != "s":
                 d["active_units"] = self.active_units
+        if self.size_path is not None:
+            d["size_path"] = [list(map(float, w)) for w in self._s]
         return d
 
 
@@ -216,6 +282,16 @@ class Scene:
         if unknown:
             raise ValueError(f"scene '{self.name}': unknown effects {sorted(unknown)}")
         self.settings = dict(self.settings or {})
+        dr = self.effects.get("drift")
+        if dr is not None:
+            if not isinstance(dr, dict) or set(dr) - {"gain_pct_per_s", "offset_pct_per_s"}:
+                raise ValueError(f"effect drift: must be {{\"gain_pct_per_s\": g, \"offset_pct_per_s\": o}}, got {dr!r}")
+            for k, v in dr.items():
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1e6:
+                    raise ValueError(f"effect drift: {k} must be a number 0 .. 1e6 (% per second), got {v!r}")
+        if any(k in self.effects for k in ("interferer", "display", "charger")):
+            from .channel import oscillators
+            oscillators(self)          # ValueError (one line naming the field) for a bad value
 
     def touch_settings(self):
         """The scene's touch settings (``settings`` key; defaults for the fields it leaves
@@ -269,7 +345,7 @@ class Scene:
                 continue
             x, y = c.position(t)
             out.append({"index": i, "name": c.name, "x_mm": float(x), "y_mm": float(y),
-                        "diameter_mm": c.diameter_mm, "x_cells": float(x / cfg.pitch_mm),
+                        "diameter_mm": float(c.size(t)[1]), "x_cells": float(x / cfg.pitch_mm),
                         "y_cells": float(y / cfg.pitch_mm),
                         "edge_mm": float(edge_distance_mm(cfg, x, y))})
         return out
@@ -310,7 +386,8 @@ class Scene:
 
 
 EFFECT_KEYS = {"noise", "enob", "dc_lsb", "interferer", "row_db_per_cell", "col_db_per_cell",
-               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases"}
+               "baseline", "fringe_mm", "delay_samples", "pn", "tone_phases", "display", "charger",
+               "drift"}
 
 
 def edge_distance_mm(cfg: SensorConfig, x, y):
@@ -350,7 +427,13 @@ def check_dict(d, where: str = "scene") -> None:
             "angle_deg": I.is_num(-360, 360),
             "active": lambda v: None if v is None or isinstance(v, (list, dict)) else
             "must be null, [[on, off], ...] or {\"repeat\": {...}}",
-            "active_units": I.is_str(("s", "samples"))}, cw)
+            "active_units": I.is_str(("s", "samples")),
+            "size_path": I.is_type(list, name="[[t_s, strength, diameter_mm], ...]")}, cw)
+        for j, w in enumerate(c.get("size_path") or []):
+            if (not isinstance(w, list) or len(w) != 3 or any(I.is_num()(x) for x in w)
+                    or w[1] < 0 or w[2] <= 0):
+                raise I.InputError(f"{cw}: key 'size_path': point {j} must be [t_s, strength >= 0, "
+                                   f"diameter_mm > 0] numbers, got {w!r}")
         _check_active(c.get("active"), cw, I)
         if "path" not in c:
             raise I.InputError(f"{cw}: key 'path' missing")
@@ -611,11 +694,61 @@ def crowd_scene_shipped() -> Scene:
     return crowd_scene("one_lands", 16, 1, 200)
 
 
+def noise_scene() -> Scene:
+    """Realistic noise (issue #12 item 2) on the default sensor: a still finger and a
+    finger landing at frame 60 (strength 0.2 -> 1, 5 -> 8 mm over 6 frames); charger
+    noise at 0.5 finger tones (120 kHz square wave, only through the fingers), display
+    noise (67.5 kHz line rate, three harmonics inside the tone band), a 100 LSB
+    interferer sweeping up from 5 MHz at 2 GHz/s in 50 us bursts every 200 us, and a
+    baseline drifting 1 %/s (gain and offset)."""
+    cfg = _params.DEFAULT
+    t_land = _frames_s(cfg, 60)
+    return Scene(
+        name="noise", sensor="default", frames=240, seed=9,
+        description="still finger + a finger landing (size_path); charger 0.5 finger tones, display "
+                    "harmonics, a sweeping bursty interferer, 1 %/s drift; 30 dB, PN on",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1},
+                 "charger": {"freq_hz": 120e3, "level": 0.5},
+                 "display": {"line_hz": 67.5e3, "harmonics": [[90, 30.0], [110, 20.0], [130, 15.0]]},
+                 "interferer": [{"freq_hz": 5.0e6, "amp_lsb": 100.0, "sweep_hz_per_s": 2.0e9,
+                                 "burst": {"period_s": 2.0e-4, "on_s": 5.0e-5, "start_s": 2.0e-5}}],
+                 "drift": {"gain_pct_per_s": 1.0, "offset_pct_per_s": 1.0}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 61.3, 43.8]]),
+            Contact(name="landing", path=[[0.0, 140.0, 100.0]], active=[[t_land, None]],
+                    size_path=[[t_land, 0.2, 5.0], [t_land + _frames_s(cfg, 6), 1.0, 8.0]]),
+        ])
+
+
+def noise_small_scene() -> Scene:
+    """``noise_scene`` on the 4 x 6 sensor for fast tests: a finger landing at frame 5
+    (size_path), charger noise at 1 finger tone, display harmonics, a sweeping bursty
+    interferer and a fast drift (100 %/s, so that a short run shows it)."""
+    cfg = _params.SMALL
+    t_land = _frames_s(cfg, 5) + 21 / cfg.fs_hz
+    return Scene(
+        name="noise_small", sensor="small", frames=40, seed=10,
+        description="a still finger + a finger landing; charger 1 finger tone, display harmonics, "
+                    "a sweeping bursty interferer, 100 %/s drift; 30 dB, PN on",
+        effects={"noise": {"snr_db": DEFAULT_SNR_DB}, "pn": {"enable": True, "chip_len": 1},
+                 "charger": {"freq_hz": 95e3, "level": 1.0},
+                 "display": {"line_hz": 65e3, "harmonics": [[95, 30.0], [105, 20.0]]},
+                 "interferer": [{"freq_hz": 5.5e6, "amp_lsb": 80.0, "sweep_hz_per_s": 2.0e10,
+                                 "burst": {"period_s": 2.0e-5, "on_s": 6.0e-6}}],
+                 "drift": {"gain_pct_per_s": 100.0, "offset_pct_per_s": 100.0}},
+        contacts=[
+            Contact(name="still", path=[[0.0, 6.3, 6.9]]),
+            Contact(name="landing", path=[[0.0, 19.0, 8.0]], active=[[t_land, None]],
+                    size_path=[[t_land, 0.2, 5.0], [t_land + _frames_s(cfg, 3), 1.0, 8.0]]),
+        ])
+
+
 SHIPPED = {
     "default.json": default_scene, "small.json": small_scene, "small.yaml": small_scene,
     "hard_clip.json": hard_clip_scene, "interferer.json": interferer_scene,
     "pinch.json": pinch_scene, "thumb.yaml": thumb_scene, "drumroll.json": drumroll_scene,
     "taps8.json": taps8_scene, "crowd.json": crowd_scene_shipped,
+    "noise.json": noise_scene, "noise_small.json": noise_small_scene,
 }
 
 

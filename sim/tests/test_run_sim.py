@@ -154,3 +154,42 @@ def test_scene_settings_and_settings_file(tmp_path, capsys):
     p.write_text(json.dumps(bad))
     with pytest.raises(Exception, match="neighbourhood"):
         S.load(p)
+
+
+# ---- calibration from noisy untouched frames (issue #12 item 2, part 6) -------------------
+def test_calibration_noisy_frames():
+    """The real procedure: without noise it matches the noiseless render within the ADC's
+    rounding of the 10 LSB baseline tones (offsets within 6 counts of ~320, gains within
+    2 %); with the default noise (30 dB, small sensor) the untouched cells' magnitude
+    includes the noise floor (offsets ~500), and the offsets' scatter about a 512-frame
+    average falls as 1 / sqrt(frames) (4 -> 64 frames: ideally a quarter, here under
+    0.35); the charger noise is left out (no finger touches)."""
+    sc = S.small_scene().replace(contacts=[], effects={"pn": {"enable": True, "chip_len": 1}})
+    o0, g0 = run_sim.calibration(sc, mode="noiseless")
+    o1, g1 = run_sim.calibration(sc)
+    assert np.abs(o1 - o0).max() <= 6 and np.abs(g1 / g0 - 1).max() < 0.02 and o0.min() > 300
+    noisy = S.small_scene()
+    ref, _g = run_sim.calibration(noisy, frames=512)
+    assert ref.mean() > o0.mean() + 100
+    err = {}
+    for k in (4, 64):
+        o, _g = run_sim.calibration(noisy, mode="noisy", frames=k)
+        err[k] = float(np.sqrt(np.mean((o - ref) ** 2.0)))
+    assert err[4] > 30 and err[64] < 0.35 * err[4], err
+    chg = noisy.replace(effects={**noisy.effects, "charger": {"freq_hz": 1e5, "level": 2.0}})
+    for a, b in zip(run_sim.calibration(chg, frames=4), run_sim.calibration(noisy, frames=4)):
+        assert np.array_equal(a, b)
+    with pytest.raises(ValueError, match="calibration mode"):
+        run_sim.calibration(sc, mode="perfect")
+
+
+def test_calibration_mode_in_report_and_cli(tmp_path, capsys):
+    sc = S.small_scene().replace(frames=6)
+    rep = run_sim.run(sc, tmp_path, plot=False, quiet=True)
+    assert rep["calibration"] == {"mode": "noisy", "frames": run_sim.CAL_FRAMES}
+    p = tmp_path / "s.json"
+    sc.save(p)
+    assert run_sim.main(["--scene", str(p), "--out", str(tmp_path), "--no-plot", "--quiet",
+                         "--cal", "noiseless"]) == 0
+    out = json.loads((tmp_path / sc.name / "report.json").read_text())
+    assert out["calibration"] == {"mode": "noiseless", "frames": 1}

@@ -33,7 +33,7 @@ class TB(ClockedTB):
         self.cfg = params.get(env_str("CFG", "small"))
         self.rows, self.cols = self.cfg.rows, self.cfg.cols
         self.noise = np.load(env_str("NOISE_NPY", ""))
-        for s in ("ce", "upd_we_i", "upd_row_i", "upd_col_i", "upd_data_i", "upd_commit_i",
+        for s in ("ce", "upd_we_i", "upd_chg_i", "upd_row_i", "upd_col_i", "upd_data_i", "upd_commit_i",
                   "upd_stamp_i", "dac_i"):
             getattr(dut, s).value = 0
 

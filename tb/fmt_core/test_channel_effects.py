@@ -38,14 +38,25 @@ HAS_IVERILOG = shutil.which("iverilog") is not None
 
 
 def fx_all(cfg=params.SMALL, seed: int = 9) -> ch.FixedEffects:
-    """Every additive effect on: noise, DC, two interferers (a row bin and a fractional
-    frequency with a phase), ENOB 10, delay 5."""
+    """Every additive effect on: noise, DC, interferers (a row bin; a fractional frequency
+    with a phase; a rising and a falling sweep, one of them in bursts that started before
+    sample 0), display harmonics, charger noise (a square wave and a harmonic), ENOB 10,
+    delay 5."""
+    fs = cfg.fs_hz
     sc = _scene.Scene(name="fx", sensor=cfg.name, frames=1, seed=seed, contacts=[],
                       effects={"noise": {"rms_lsb": 37.7}, "dc_lsb": -13.3, "enob": 10,
                                "delay_samples": 5,
                                "interferer": [{"bin": cfg.bins[1], "amp_lsb": 150.0},
-                                              {"freq_hz": 1.234e6, "amp_lsb": 77.7, "phase_rad": 1.0}]})
-    return ch.fixed_effects(sc)
+                                              {"freq_hz": 1.234e6, "amp_lsb": 77.7, "phase_rad": 1.0},
+                                              {"freq_hz": 3.0e6, "amp_lsb": 60.0, "sweep_hz_per_s": 2.5e11},
+                                              {"freq_hz": 9.0e6, "amp_lsb": 55.0, "sweep_hz_per_s": -4.0e11,
+                                               "burst": {"period_s": 97 / fs, "on_s": 40 / fs,
+                                                         "start_s": -13 / fs}}],
+                               "display": {"line_hz": 61.5e3, "harmonics": [[83, 20.0], [90, 11.0, 0.3]]},
+                               "charger": {"freq_hz": 97e3, "level": 0.7}})
+    e = ch.fixed_effects(sc)
+    sc2 = sc.replace(effects={"charger": {"freq_hz": 123e3, "level": 1.5, "harmonics": [[41, 0.4]]}})
+    return ch.FixedEffects(**{**e.__dict__, "interferers": e.interferers + ch.fixed_effects(sc2).interferers})
 
 
 # ---- the generator: numpy == C++ == Verilog ------------------------------------------
@@ -61,7 +72,8 @@ def _dump_cpp(tmp: Path, k0: int, n: int, cols: int) -> np.ndarray:
         "  for (long i = 0; i < n; ++i) {\n"
         "    const uint32_t k = static_cast<uint32_t>(k0 + i);\n"
         '    for (int c = 0; c < cols; ++c) std::printf("%lld ", static_cast<long long>(fx.noise(k, c)));\n'
-        '    std::printf("%lld\\n", static_cast<long long>(fx.common(k)));\n  }\n  return 0;\n}\n')
+        '    std::printf("%lld %lld\\n", static_cast<long long>(fx.common(k)), static_cast<long long>(fx.charger(k)));\n'
+        "  }\n  return 0;\n}\n")
     exe = tmp / "dump"
     subprocess.run(["g++", "-O1", "-std=c++17", f"-I{BENCH}", str(src), "-o", str(exe)], check=True)
     out = subprocess.run([str(exe), str(tmp / "chan.hex"), str(tmp / "gauss.hex"), str(tmp / "sine.hex"),
@@ -76,7 +88,7 @@ module tb_fx;
   wire [{cols}*12-1:0] adc; wire cl, cs; wire [31:0] so;
   fmt_channel_sim #(.ROWS(1), .COLS({cols}), .DAC_BITS(12), .ADC_BITS(12),
     .CHAN_FILE("{tmp / 'chan.hex'}"), .GAUSS_FILE("{tmp / 'gauss.hex'}"), .SINE_FILE("{tmp / 'sine.hex'}"))
-  u_ch (.clk(1'b0), .rst(1'b1), .ce(1'b0), .dac_i(12'd0), .upd_we_i(1'b0), .upd_row_i(1'b0),
+  u_ch (.clk(1'b0), .rst(1'b1), .ce(1'b0), .dac_i(12'd0), .upd_we_i(1'b0), .upd_chg_i(1'b0), .upd_row_i(1'b0),
     .upd_col_i({{$clog2({cols}){{1'b0}}}}), .upd_data_i(16'd0), .upd_commit_i(1'b0), .upd_stamp_i(32'd0),
     .adc_o(adc), .clip_o(cl), .clip_sticky_o(cs), .sample_o(so));
   integer i, c, fh;
@@ -87,7 +99,7 @@ module tb_fx;
     for (i = 0; i < {n}; i = i + 1) begin
       k = 32'd{k0 & 0xFFFFFFFF} + i;
       for (c = 0; c < {cols}; c = c + 1) $fwrite(fh, "%0d ", u_ch.fx_noise(k, c[7:0]));
-      $fwrite(fh, "%0d\\n", u_ch.fx_common(k));
+      $fwrite(fh, "%0d %0d\\n", u_ch.fx_common(k), u_ch.fx_osc(k, 1'b1));
     end
     $fclose(fh);
     $finish;
@@ -108,8 +120,10 @@ def test_generator_numpy_cpp_verilog_word_for_word(tmp_path, k0):
     eff = fx_all()
     rsr.write_channel_files(tmp_path, eff)
     n, cols = 1500, 6                                      # 9000 noise words, 1500 common terms
-    py = np.column_stack([eff.noise(k0, n, cols), eff.additive(k0, n, 1)[:, 0] - eff.noise(k0, n, 1)[:, 0]])
+    py = np.column_stack([eff.noise(k0, n, cols), eff.additive(k0, n, 1)[:, 0] - eff.noise(k0, n, 1)[:, 0],
+                          eff.charger(k0, n)])
     assert np.count_nonzero(py[:, :cols]) > 0.99 * n * cols and np.unique(py[:, cols]).size > 100
+    assert np.unique(py[:, cols + 1]).size > 100
     cpp = _dump_cpp(tmp_path, k0, n, cols)
     assert np.array_equal(cpp, py), f"C++ differs at {np.argwhere(cpp != py)[:3].tolist()}"
     ver = _dump_verilog(tmp_path, k0, n, cols)
@@ -165,14 +179,16 @@ def test_channel_fixed_equals_channel_sim_fixed_with_effects():
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
 def test_fmt_channel_sim_effects_icarus(tmp_path):
     """fmt_channel_sim with CHAN_FILE (every effect on) against channel_sim_fixed: random
-    row words on a ce every other clk, G loaded before the stream, a second matrix that
-    clips; every ADC word and clip flag."""
+    row words on a ce every other clk, G and the charger weights W loaded before the
+    stream, a second matrix (and W) that clips; every ADC word and clip flag."""
     cfg = params.SMALL
     rows, cols, n = cfg.rows, cfg.cols, 600
     rng = np.random.default_rng(8)
     dac = rng.integers(-2047, 2048, size=(n, rows))
-    g0 = rng.integers(0, 1 << 14, size=(rows, cols))
-    g1 = rng.integers(0, 1 << 16, size=(rows, cols))
+    g0 = rng.integers(0, 1 << 14, size=(rows + 1, cols))        # row ROWS: charger weights
+    g1 = rng.integers(0, 1 << 16, size=(rows + 1, cols))
+    g0[rows] = rng.integers(1 << 10, 1 << 12, size=cols)         # weights 0.25 .. 1
+    g0[rows, 2] = 0                                               # no charger on column 2
     stamp = 300
     eff = fx_all(cfg, seed=21)
     rsr.write_channel_files(tmp_path, eff)
@@ -180,14 +196,14 @@ def test_fmt_channel_sim_effects_icarus(tmp_path):
         "".join(f"{int(v) & 0xFFF:03x}" for v in row[::-1]) + "\n" for row in dac))
     loads = []
     for g, st in ((g0, 0), (g1, stamp)):
-        for r in range(rows):
+        for r in range(rows + 1):
             for c in range(cols):
-                loads.append(f"ld({r}, {c}, {int(g[r, c])});")
+                loads.append(f"ld({r % rows}, {c}, {int(g[r, c])}, {int(r == rows)});")
         loads.append(f"cm({st});")
     tb = tmp_path / "tb_ch.v"
     tb.write_text(f"""`timescale 1ns/1ps
 module tb_ch;
-  reg clk = 1'b0, rst = 1'b1, ce = 1'b0, we = 1'b0, cmt = 1'b0;
+  reg clk = 1'b0, rst = 1'b1, ce = 1'b0, we = 1'b0, wc = 1'b0, cmt = 1'b0;
   reg [{rows * 12 - 1}:0] dac_i = 0;
   reg [1:0] row = 0; reg [2:0] col = 0; reg [15:0] data = 0; reg [31:0] st = 0;
   wire [{cols * 12 - 1}:0] adc; wire cl, cs; wire [31:0] so;
@@ -195,13 +211,13 @@ module tb_ch;
   fmt_channel_sim #(.ROWS({rows}), .COLS({cols}), .DAC_BITS(12), .ADC_BITS(12),
     .CHAN_FILE("{tmp_path / 'chan.hex'}"), .GAUSS_FILE("{tmp_path / 'gauss.hex'}"),
     .SINE_FILE("{tmp_path / 'sine.hex'}"))
-  u_ch (.clk(clk), .rst(rst), .ce(ce), .dac_i(dac_i), .upd_we_i(we), .upd_row_i(row),
+  u_ch (.clk(clk), .rst(rst), .ce(ce), .dac_i(dac_i), .upd_we_i(we), .upd_chg_i(wc), .upd_row_i(row),
     .upd_col_i(col), .upd_data_i(data), .upd_commit_i(cmt), .upd_stamp_i(st),
     .adc_o(adc), .clip_o(cl), .clip_sticky_o(cs), .sample_o(so));
   always #5 clk = ~clk;
   integer i, fh;
-  task ld(input integer r, input integer c, input integer v);
-    begin @(negedge clk); we = 1; row = r; col = c; data = v; @(negedge clk); we = 0; end
+  task ld(input integer r, input integer c, input integer v, input integer w);
+    begin @(negedge clk); we = 1; wc = w; row = r; col = c; data = v; @(negedge clk); we = 0; wc = 0; end
   endtask
   task cm(input integer s);
     begin @(negedge clk); cmt = 1; st = s; @(negedge clk); cmt = 0; end
@@ -211,13 +227,13 @@ module tb_ch;
     fh = $fopen("{tmp_path / 'adc.txt'}", "w");
     repeat (3) @(negedge clk);
     rst = 0;
-    {" ".join(loads[:rows * cols + 1])}
+    {" ".join(loads[:(rows + 1) * cols + 1])}
     @(negedge clk); @(negedge clk);
     for (i = 0; i < {n}; i = i + 1) begin
       @(negedge clk); ce = 1; dac_i = mem[i];
       @(posedge clk); #1 $fwrite(fh, "%0d %0d %h\\n", so, cl, adc);
       @(negedge clk); ce = 0;
-      if (i == 100) begin {" ".join(loads[rows * cols + 1:])} end
+      if (i == 100) begin {" ".join(loads[(rows + 1) * cols + 1:])} end
     end
     $fclose(fh);
     $finish;
@@ -243,6 +259,10 @@ endmodule
     bad = np.argwhere(got != exp)
     assert bad.size == 0, f"{len(bad)} ADC mismatches, first at {bad[0].tolist()}: {got[bad[0][0]]} vs {exp[bad[0][0]]}"
     assert np.array_equal(clips, clip) and clip.any() and not clip[:stamp].any()
+    # the charger reaches a column only through its weight: W = 0 on column 2 before the stamp
+    noc, _ = ch.channel_sim_fixed(dac, g0[:rows], [(stamp, g1[:rows])], None, adc_bits=12, effects=eff)
+    diff = (noc != exp)[:stamp]
+    assert not diff[:, 2].any() and diff[:, [0, 1, 3, 4, 5]].mean() > 0.5
 
 
 # ---- every effect through the whole core --------------------------------------------------
@@ -254,6 +274,17 @@ EFFECTS = {
     "delay_samples": {"delay_samples": 7},
     "pn_rx_mismatch": {"delay_samples": 3, "pn": {"enable": True, "chip_len": 2, "rx_delay": 1}},
     "noise_rms": {"noise": {"rms_lsb": 80.0}},
+    # a sweep across the comb (row bins 9..12 of the small sensor) in bursts, and a fixed
+    # tone in bursts that start in the second window
+    "interferer_sweep_burst": {"interferer": [
+        {"bin": 8.7, "amp_lsb": 150.0, "sweep_hz_per_s": 3.0e11,
+         "burst": {"period_s": 5.0e-6, "on_s": 2.0e-6, "start_s": 1.0e-6}},
+        {"bin": 11, "amp_lsb": 120.0, "burst": {"period_s": 3.1e-6, "on_s": 0.9e-6, "start_s": 1.6e-6}}]},
+    "display": {"display": {"line_hz": 65.1e3, "harmonics": [[100, 60.0], [150, 40.0, 1.0], [170, 30.0]]}},
+    # the small scene's drag lands in window 5: the charger reaches the RTL through the
+    # weights of both contacts, changing at that onset sample
+    "charger": {"charger": {"freq_hz": 93e3, "level": 1.0}},
+    "charger_harmonics": {"charger": {"freq_hz": 130.2e3, "level": 2.0, "harmonics": [[75, 0.5], [80, 0.3]]}},
 }
 
 
@@ -262,8 +293,13 @@ def effect_scene(name: str, frames: int = 6) -> _scene.Scene:
     return sc.replace(frames=frames, effects={**sc.effects, **EFFECTS[name]})
 
 
+# through the core one by one (~15 s each); display noise and charger harmonics run
+# through the core in noise_small.json (display) and the harness test (both)
+CORE_ONE_BY_ONE = sorted(set(EFFECTS) - {"display", "charger_harmonics"})
+
+
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
-@pytest.mark.parametrize("name", sorted(EFFECTS))
+@pytest.mark.parametrize("name", CORE_ONE_BY_ONE)
 def test_effect_through_core_icarus(tmp_path, name):
     sc = effect_scene(name)
     base = _scene.small_scene().replace(frames=sc.frames)
@@ -275,6 +311,38 @@ def test_effect_through_core_icarus(tmp_path, name):
     rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
                   tag=f"fx_{name}")        # its own job folder: the effects run side by side under xdist
     assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+
+
+@pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
+def test_coupling_effects_through_core_icarus(tmp_path):
+    """A finger landing (strength and diameter over time, ``size_path``), a drifting
+    baseline (1e5 %/s: the integer matrices move within a few windows) and charger noise
+    through the core: the plan's per-window coupling and charger weights, bit-exact."""
+    sc = _scene.small_scene()
+    win = sc.cfg.n_fft / sc.cfg.fs_hz
+    still = dict(sc.contacts[0].to_dict(), size_path=[[win, 0.2, 4.0], [4 * win, 1.0, 9.0]])
+    sc = sc.replace(frames=8, contacts=[still, sc.contacts[1].to_dict()],
+                    effects={**sc.effects, **EFFECTS["charger"],
+                             "drift": {"gain_pct_per_s": 1e5, "offset_pct_per_s": 5e4}})
+    n = sc.frames * sc.samples_per_frame
+    g0, ups = rsr.coupling_plan(sc, n, 3)
+    assert g0.shape[0] == sc.cfg.rows + 1 and sum(1 for s, _ in ups if s >= 6 * sc.cfg.n_fft) >= 2
+    rep = rsr.run(sc, tmp_path, frames=sc.frames, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag="fx_coupling")
+    assert rep["frames"] >= sc.frames and rep["frames_dropped"] == 0
+    assert rep["golden_mismatches"] == 0, rep["golden_detail"]
+
+
+@pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
+def test_noise_small_scene_through_core_icarus(tmp_path):
+    """The shipped sim/scenes/noise_small.json (every noise effect of issue #12 item 2 at
+    once: charger, display, sweeping bursty interferer, drift, a landing finger), its first
+    10 frames through the core: golden 0."""
+    sc = _scene.load(ROOT / "sim" / "scenes" / "noise_small.json")
+    rep = rsr.run(sc, tmp_path, frames=10, cps=3, sim="icarus", engine="cocotb", plot=False, quiet=True,
+                  tag="fx_noise_small")
+    assert rep["frames"] >= 10 and rep["frames_dropped"] == 0
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
 
 
@@ -299,8 +367,9 @@ def test_all_effects_harness(sim, vch):
     assert sim == "verilator"
     sc = _scene.small_scene().replace(frames=10)
     eff = dict(sc.effects)
-    for k in ("interferer", "dc_lsb", "enob"):
+    for k in ("interferer", "dc_lsb", "enob", "display", "charger_harmonics"):
         eff.update(EFFECTS[k])
+    eff["interferer"] = eff["interferer"] + EFFECTS["interferer_sweep_burst"]["interferer"]
     eff.update({"delay_samples": 6, "noise": {"rms_lsb": 70.0}})
     sc = sc.replace(effects=eff)
     d, ref, cal, n_upd, res, _b = rsr.run_harness(sc, sc.frames, 3, None, cal="scene", tag="tb_fx",
@@ -316,7 +385,9 @@ REFUSED = {
     "tone_phases": ({"tone_phases": "schroeder"}, "tone_phases"),
     "delay_samples": ({"delay_samples": 80}, "delay_samples"),
     "pn_rx_delay": ({"pn": {"enable": True, "chip_len": 1, "rx_delay": 70}}, "effect pn"),
-    "interferers": ({"interferer": [{"bin": 10, "amp_lsb": 1.0}] * 9}, "interferer"),
+    "interferers": ({"interferer": [{"bin": 10, "amp_lsb": 1.0}] * 60,
+                     "display": {"line_hz": 1e5, "harmonics": [[h, 1.0] for h in range(1, 6)]}},
+                    "interferer/display: 65 oscillators"),
     "enob": ({"enob": 7.5}, "enob"),
 }
 

@@ -77,3 +77,21 @@ def test_run_sim_rtl_smoke(tmp_path):
     assert rep["frames"] >= 6 and rep["frames_dropped"] == 0
     assert rep["golden_mismatches"] == 0, rep["golden_detail"]
     assert rep["latency_us"]["window_end_to_event"]["n"] > 0
+
+
+def test_calibration_fixed_is_the_default():
+    """run_sim_rtl calibrates by the real procedure through its fixed-point chain: noise
+    free it matches the noiseless render within the rounding; with noise (the scene's) the
+    offsets scatter; prepare(cal="scene") loads exactly that, cal="noiseless" the old one."""
+    from fmt import run_sim
+    sc = _scene.small_scene()
+    clean = sc.replace(contacts=[], effects={"pn": {"enable": True, "chip_len": 1}})
+    o0, g0 = run_sim.calibration(clean, mode="noiseless")
+    o1, g1 = rsr.calibration_fixed(clean, 3)
+    assert np.abs(o1 - o0).max() <= 6 and np.abs(g1 / g0 - 1).max() < 0.02      # 10 LSB tones: ADC rounding
+    o2, _g2 = rsr.calibration_fixed(sc, 3)
+    assert np.sqrt(np.mean((o2 - o0) ** 2.0)) > 5
+    _d, _ref, cal, _n = rsr.prepare(sc.replace(frames=2), 2, 3, None, cal="scene", tag="cal_fixed")
+    assert np.array_equal(cal[0], o2) and np.array_equal(cal[1], _g2)
+    _d, _ref, cal, _n = rsr.prepare(sc.replace(frames=2), 2, 3, None, cal="noiseless", tag="cal_fixed")
+    assert np.array_equal(cal[0], o0) and np.array_equal(cal[1], g0)
