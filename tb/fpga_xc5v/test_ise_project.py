@@ -44,6 +44,11 @@ def test_ise_project(tmp_path):
     assert "project set speed -1" in tcl
     assert 'project set top "fpga"' in tcl
     assert "xc5vsx95t/constraints/fpga.ucf" in tcl
+    # XST keeps the hierarchy (soft), as make timing's per-block depth check assumes
+    src = re.search(r"^source (\S*xst_options\.tcl)$", tcl, re.M)
+    assert src, tcl
+    opts = (BOARD / "xst_options.tcl").read_text()
+    assert re.search(r'^project set "Keep Hierarchy" "Soft" -process "Synthesize - XST"$', opts, re.M)
     for name in _files(BOARD / "rtl" / "fpga_core.f") + ["fpga.v"]:
         assert re.search(rf"xfile add \S*/{re.escape(name)}\b", tcl), name
     assert "ROWS=30|COLS=40" in tcl                  # fmt_core.core's generics reach the top

@@ -101,6 +101,39 @@ def test_walker_lut_chain_and_carry():
     assert r["est_ns"] == pytest.approx(round(max(lut3, carry), 2))
 
 
+def test_abc_delay_hand_netlist():
+    """scripts/abc_delay.py: arrivals by the ABC9 arcs of Yosys's xc5v cell library (hand
+    values from its cells_sim.v specify blocks: LUT2 I0 -> O 238 ps, I1 -> O 127 ps;
+    CARRY4 S[0] -> CO[3] 508 ps, CI -> O[0] 222 ps)."""
+    import abc_delay
+    n = Net()
+    clk = n.bit("clk")
+    n.ports["clk"] = {"direction": "input", "bits": [clk]}
+    r0, r1 = n.ff("r0", n.bit(), clk), n.ff("r1", n.bit(), clk)
+    # r0 -> LUT2 (I0) -> LUT2 (I1) -> a_q: 238 + 127 = 365
+    l1 = n.lut("l1", [r0, r1])
+    l2 = n.lut("l2", [r1, l1])
+    n.ff("a_q", l2, clk)
+    # r0 -> CARRY4 S[0] -> CO[3] -> CARRY4 CI -> O[0] -> b_q: 508 + 222 = 730
+    co0, o0 = [n.bit() for _ in range(4)], [n.bit() for _ in range(4)]
+    n.cell("cy0", "CARRY4", {"CI": "0", "CYINIT": "0", "S": [r0, "0", "0", "0"], "DI": ["0"] * 4},
+           {"CO": co0, "O": o0})
+    co1, o1 = [n.bit() for _ in range(4)], [n.bit() for _ in range(4)]
+    n.cell("cy1", "CARRY4", {"CI": co0[3], "CYINIT": "0", "S": ["0"] * 4, "DI": ["0"] * 4},
+           {"CO": co1, "O": o1})
+    n.ff("b_q", o1[0], clk)
+    ends, names, describe, cells = abc_delay.walk(n.json(), abc_delay.cell_arcs(abc_delay.find_cells_sim()))
+    by_q = {}
+    for e in ends:
+        q = cells[e[1]]["connections"].get("Q", [None])[0]
+        if e[2] == "D":
+            by_q[names.get(q)] = e
+    assert by_q["a_q"][0] == 365 and by_q["b_q"][0] == 730
+    assert ends[0][0] == 730 and "1 LUT levels" not in describe(ends[0])
+    assert " 2 LUT levels,  0 CARRY4  r0 -> a_q" in describe(by_q["a_q"])
+    assert " 0 LUT levels,  2 CARRY4  r0 -> b_q" in describe(by_q["b_q"])
+
+
 def test_walker_ports_lutram_dsp_bram():
     n = Net()
     clk = n.bit("clk")
@@ -209,6 +242,47 @@ def test_walker_on_yosys_netlist():
     # a_q + b_q: bit 0 enters at S[0], the sum's bit 15 leaves at O[3] of the 4th CARRY4
     assert r["worst_carry"] == 16
     assert "s_o" in r["carry_to"]
+    assert r["unknown_cells"] == [] and r["comb_loops"] == 0
+
+
+HIER_V = """`default_nettype none
+module hier_c (input wire clk, input wire [11:0] a_i, output reg p_o);
+    reg [11:0] a_q;
+    always @(posedge clk) begin
+        a_q <= a_i;
+        p_o <= ^a_q;
+    end
+endmodule
+module hier_t (input wire clk, input wire [11:0] a_i, input wire b_i, output reg y_o);
+    wire p;
+    reg  b_q;
+    hier_c u_c (.clk(clk), .a_i(a_i), .p_o(p));
+    always @(posedge clk) begin
+        b_q <= b_i;
+        y_o <= p ^ b_q;
+    end
+endmodule
+"""
+
+
+def test_walker_on_hierarchical_mapping():
+    """"xc5v_hier": each module mapped on its own, then flattened: the walk sees the
+    child's paths under its instance name and the path across the boundary."""
+    WORK.mkdir(parents=True, exist_ok=True)
+    v = WORK / "hier_t.v"
+    v.write_text(HIER_V)
+    js = WORK / "hier_t.json"
+    timing.yosys(f"read_verilog {timing.rel(v)}; {timing.xc5v_mapping('hier_t', True)}"
+                 f"write_json {timing.rel(js)}", WORK / "hier_t.log", "yosys hier_t")
+    nl = json.loads(js.read_text())
+    # flat after the mapping: no instance of the child is left (the rest are cell models)
+    assert "hier_c" not in nl["modules"]
+    m = nl["modules"]["hier_t"]
+    assert not any(c["type"] == "hier_c" for c in m["cells"].values())
+    assert "u_c.a_q" in m["netnames"] and "u_c.p_o" in m["netnames"]
+    r = timing.depth_walk(nl, "hier_t")
+    # a 12-input parity needs 2 levels of 6-input LUTs (the boundary path p -> y_o: 1)
+    assert r["worst_lut_levels"] >= 2 and "u_c.a_q" in r["worst_from"]
     assert r["unknown_cells"] == [] and r["comb_loops"] == 0
 
 
