@@ -29,7 +29,7 @@ import pytest
 from cocotb.triggers import ReadOnly, RisingEdge
 
 from common.hm_stream import drive_hm_schedule, frame_schedule, pack_row
-from common.runner import run_cocotb, sources
+from common.runner import long_run, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params
 from fmt.blob import blob_mask_fixed, blob_stream_fixed, label_regions
@@ -516,6 +516,9 @@ def _run(sim, cfg, seed, testcase=None):
 
 @pytest.mark.parametrize("cfg", [params.SMALL, params.MEDIUM], ids=lambda c: c.name)
 def test_fmt_blob(sim, cfg):
+    if sim == "verilator" and not long_run():
+        pytest.skip("small / medium under Icarus, the default size under Verilator in make test; "
+                    "both simulators for every size in make test-long (FMT_LONG=1)")
     _run(sim, cfg, 1)
 
 
