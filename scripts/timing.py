@@ -154,7 +154,7 @@ def block_ports(block: dict, d: Path) -> dict:
 
 
 # ---- xc5v: synthesis and the depth walk ---------------------------------------------------
-def xc5v_mapping(top: str, hier: bool = False) -> str:
+def xc5v_mapping(top: str, hier: bool = True) -> str:
     """The Yosys commands that map `top` for xc5v into one flat netlist for the walk.
     hier (the default): each module mapped on its own, as XST with Keep Hierarchy = Soft
     (fpga/xc5vsx95t/xst_options.tcl), then flattened.  Flat (-flatten): ABC's area
