@@ -55,7 +55,8 @@ def find_cells_sim() -> Path:
 
 
 def walk(netlist: dict, arcs: dict):
-    """(ends, names, describe): ends = [(ps, end cell, port, bit, net bit)] slowest first."""
+    """(ends, names, describe, cells): ends = [(ps, end cell, port, bit, net bit)], slowest
+    first; names: net bit -> net name; describe(end) -> one line; cells: the top's cells."""
     mods = netlist["modules"]
     tops = [n for n, m in mods.items() if int(m.get("attributes", {}).get("top", "0") or 0)]
     mod = mods[tops[0] if tops else next(iter(mods))]
@@ -156,6 +157,12 @@ def main(argv=None) -> int:
         net = json.loads(a.netlist.read_text())
     except (OSError, ValueError) as e:
         print(f"abc_delay: cannot read {a.netlist}: {e}", file=sys.stderr)
+        return 1
+    if not isinstance(net, dict) or not isinstance(net.get("modules"), dict) or not net["modules"]:
+        print(f"abc_delay: {a.netlist} is not a Yosys JSON netlist (no modules)", file=sys.stderr)
+        return 1
+    if a.top < 0:
+        print("abc_delay: --top must be >= 0", file=sys.stderr)
         return 1
     ends, names, describe, cells = walk(net, cell_arcs(find_cells_sim()))
     print(f"slowest register-to-register paths by ABC9's delay model ({a.netlist}):")
