@@ -90,6 +90,40 @@ def test_renderer_pixels(scene):
     assert rgb(img2, ren.pixel_of(30, 5)) == (255, 0, 255)
 
 
+def test_heatmap_paint_matches_matplotlib(scene):
+    """The renderer writes the heat map into the canvas itself (no image resample): it
+    must give the pixels matplotlib's own nearest-neighbour imshow gives, except on the
+    one-pixel seams between cells where the two roundings may pick the neighbour."""
+    hm, _ = scene
+    s = E.Sensor(CFG.rows, CFG.cols)
+    ren = V.Renderer(s, vmax=VMAX)
+    frame = np.asarray(hm[12], dtype=float)
+    ren.canvas.restore_region(ren.bg)
+    ren.im.set_data(frame)
+    ren.ax.draw_artist(ren.im)
+    want = np.asarray(ren.canvas.buffer_rgba())[:, :, :3].astype(int).copy()
+    ren.canvas.restore_region(ren.bg)
+    ren._paint_heatmap(np.asarray(ren.canvas.buffer_rgba()), frame)
+    got = np.asarray(ren.canvas.buffer_rgba())[:, :, :3].astype(int).copy()
+    r0, r1, c0, c1 = ren.px_r0, ren.px_r1, ren.px_c0, ren.px_c1
+    diff = np.abs(got - want).max(axis=2)
+    assert diff[:r0].max() == 0 and diff[r1:].max() == 0          # outside the axes: untouched
+    assert diff[:, :c0].max() == 0 and diff[:, c1:].max() == 0
+    inner = diff[r0:r1, c0:c1]
+    # a pixel whose cell differs from matplotlib's lies next to a cell seam
+    rows_seam = np.zeros(r1 - r0, bool)
+    cols_seam = np.zeros(c1 - c0, bool)
+    rs, cs = np.sort(ren.cell_row_sorted), ren.cell_col
+    rows_seam[1:] |= rs[1:] != rs[:-1]
+    rows_seam[:-1] |= rs[1:] != rs[:-1]
+    cols_seam[1:] |= cs[1:] != cs[:-1]
+    cols_seam[:-1] |= cs[1:] != cs[:-1]
+    seam = rows_seam[:, None] | cols_seam[None, :]
+    assert inner[~seam].max() <= 1, inner[~seam].max()           # 8-bit rounding only
+    assert (inner > 1).mean() < 0.03, (inner > 1).mean()
+    assert np.unique(ren.cell_row_sorted).size == CFG.rows and np.unique(cs).size == CFG.cols
+
+
 def test_renderer_speed(scene, tmp_path):
     """>= 30 PNG frames per second headless on 30 x 40, measured as CPU time of this
     process (the machine is shared: wall time is printed too), the best of three runs of
