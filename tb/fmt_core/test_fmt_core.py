@@ -135,6 +135,9 @@ def small_palm_scene(frames: int) -> _scene.Scene:
 def test_fmt_core_blobs(sim):
     """TOUCH_MODE bit 2 (blobs on) through the register file: the palm's maximum is
     dropped and blob events follow the tracker's, bit-exact with process_frames(blobs)."""
+    if sim == "icarus" and not long_run():
+        pytest.skip("make test: under Verilator (the core's Icarus run is test_fmt_core[icarus-1]); "
+                    "both simulators in make test-long (FMT_LONG=1), for make test's time")
     frames = 12
     # threshold and size between the finger (3 cells above 3500) and the palm (8 cells)
     st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0, blobs=True,

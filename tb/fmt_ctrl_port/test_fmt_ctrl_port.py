@@ -23,7 +23,7 @@ import cocotb
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import run_cocotb, sources
+from common.runner import long_run, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params, protocol as P, regmap
 from fmt_uart.uart_bfm import UartBfm
@@ -389,6 +389,9 @@ async def event_stream(dut):
 def test_fmt_ctrl_port(sim, cfg_name, div):
     if sim == "verilator" and cfg_name != "small":
         pytest.skip("second size under Icarus only: a Verilator build costs ~20 s of the time budget")
+    if sim == "icarus" and cfg_name != "small" and not long_run():
+        pytest.skip("make test: the small size under both simulators; the second size in "
+                    "make test-long (FMT_LONG=1), for make test's time")
     cfg = params.get(cfg_name)
     tmo, pmax = 20, 64
     vp = cfg.verilog_params()

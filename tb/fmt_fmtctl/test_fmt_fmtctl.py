@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
-from common.runner import run_cocotb, sources
+from common.runner import long_run, run_cocotb, sources
 from common.tb_util import ClockedTB, env_int, env_str
 from fmt import params, protocol as P, regmap
 from fmt_uart.uart_bfm import UartBfm
@@ -214,6 +214,9 @@ async def fmtctl_end_to_end(dut):
 
 
 def test_fmt_fmtctl(sim, tmp_path):
+    if sim == "icarus" and not long_run():
+        pytest.skip("make test: under Verilator (the control port itself runs under both in "
+                    "tb/fmt_ctrl_port); Icarus in make test-long (FMT_LONG=1), for make test's time")
     cfg = params.SMALL
     vp = cfg.verilog_params()
     run_cocotb(

@@ -331,7 +331,7 @@ def _run_touch(sim, cfg_name):
         test_dir=Path(__file__).parent,
         parameters={**{k: p[k] for k in ("ROWS", "COLS", "HM_W", "MAX_TOUCHES")}, "EV_DEPTH": 256},
         extra_env={"CFG": cfg_name, "SEED": 1},
-        build_args=build_args(sim), tag=cfg_name, testcase=tests,
+        build_args=build_args(sim, "-O1"), tag=cfg_name, testcase=tests,
     )
 
 
