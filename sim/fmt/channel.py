@@ -582,6 +582,26 @@ def _num(v, where: str, lo=None, hi=None) -> float:
     return float(v)
 
 
+def _harmonics(w: str, harm, f0: float, nyq: float, second: str, phase: bool) -> list:
+    """A scene's harmonic list [[h, value(, phase_rad)], ...] of fundamental f0 checked
+    (h whole >= 1, h * f0 <= Nyquist, value >= 0; the phase only where ``phase``):
+    (h, h * f0, value, phase_rad) each."""
+    form = f"[h, {second}(, phase_rad)]" if phase else f"[h, {second}]"
+    if not isinstance(harm, list) or not harm:
+        raise ValueError(f"{w}: harmonics must be a list of {form}")
+    out = []
+    for j, h in enumerate(harm):
+        if (not isinstance(h, list) or len(h) not in ((2, 3) if phase else (2,))
+                or int(_num(h[0], f"{w}: harmonics[{j}]", 1)) != h[0]):
+            raise ValueError(f"{w}: harmonics[{j}] must be {form} with h whole >= 1, got {h!r}")
+        f = h[0] * f0
+        if f > nyq:
+            raise ValueError(f"{w}: harmonic {h[0]} at {f:g} Hz above Nyquist ({nyq:g} Hz)")
+        out.append((h[0], f, _num(h[1], f"{w}: harmonics[{j}] {second}", 0.0),
+                    _num(h[2], f"{w}: harmonics[{j}] phase_rad") if len(h) == 3 else 0.0))
+    return out
+
+
 def oscillators(scene: Scene) -> list:
     """The scene's oscillators (:class:`Osc`): its ``interferer`` entries, the harmonics
     of its ``display`` noise and of its ``charger`` noise (see fmt.scene); raises
@@ -614,17 +634,8 @@ def oscillators(scene: Scene) -> list:
         line = _num(disp.get("line_hz", 0.0), f"{w}: line_hz", 0.0, nyq)
         if line <= 0:
             raise ValueError(f"{w}: line_hz must be > 0")
-        harm = disp.get("harmonics")
-        if not isinstance(harm, list) or not harm:
-            raise ValueError(f"{w}: harmonics must be a list of [h, amp_lsb(, phase_rad)]")
-        for j, h in enumerate(harm):
-            if not isinstance(h, list) or len(h) not in (2, 3) or int(_num(h[0], f"{w}: harmonics[{j}]", 1)) != h[0]:
-                raise ValueError(f"{w}: harmonics[{j}] must be [h (whole >= 1), amp_lsb(, phase_rad)], got {h!r}")
-            f = h[0] * line
-            if f > nyq:
-                raise ValueError(f"{w}: harmonic {h[0]} at {f:g} Hz above Nyquist ({nyq:g} Hz)")
-            out.append(Osc(f"{w} harmonic {h[0]}", f, _num(h[1], f"{w}: harmonics[{j}] amp_lsb", 0.0),
-                           _num(h[2], f"{w}: harmonics[{j}] phase_rad") if len(h) == 3 else 0.0))
+        for h, f, amp, ph in _harmonics(w, disp.get("harmonics"), line, nyq, "amp_lsb", True):
+            out.append(Osc(f"{w} harmonic {h}", f, amp, ph))
     chg = eff.get("charger")
     if chg:
         w = "effect charger"
@@ -637,13 +648,8 @@ def oscillators(scene: Scene) -> list:
         if harm == "square":
             out.append(Osc(f"{w} square", f0, a, 0.0, square=True, charger=True))
         elif isinstance(harm, list) and harm:
-            for j, h in enumerate(harm):
-                if not isinstance(h, list) or len(h) != 2 or int(_num(h[0], f"{w}: harmonics[{j}]", 1)) != h[0]:
-                    raise ValueError(f"{w}: harmonics[{j}] must be [h (whole >= 1), relative amplitude]")
-                if h[0] * f0 > nyq:
-                    raise ValueError(f"{w}: harmonic {h[0]} at {h[0] * f0:g} Hz above Nyquist ({nyq:g} Hz)")
-                out.append(Osc(f"{w} harmonic {h[0]}", h[0] * f0, a * _num(h[1], f"{w}: harmonics[{j}]", 0.0),
-                               charger=True))
+            for h, f, rel, _ in _harmonics(w, harm, f0, nyq, "relative amplitude", False):
+                out.append(Osc(f"{w} harmonic {h}", f, a * rel, charger=True))
         else:
             raise ValueError(f"{w}: harmonics must be \"square\" or a list of [h, relative amplitude]")
     return out

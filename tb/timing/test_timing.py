@@ -219,14 +219,21 @@ endmodule
 """
 
 
-def test_walker_on_yosys_netlist():
+def _netlist(name: str, src: str, script) -> dict:
+    """``src`` written to WORK/<name>.v, mapped by Yosys with ``script(path of the .v)``
+    (the commands before write_json), the JSON netlist loaded."""
     WORK.mkdir(parents=True, exist_ok=True)
-    v = WORK / "walk_t.v"
-    v.write_text(WALK_V)
-    js = WORK / "walk_t.json"
-    timing.yosys(f"read_verilog -lib +/xilinx/cells_sim.v; read_verilog {timing.rel(v)}; synth_xilinx -family xc5v -top walk_t -noiopad; "
-                 f"write_json {timing.rel(js)}", WORK / "walk_t.log", "yosys walk_t")
-    nl = json.loads(js.read_text())
+    v = WORK / f"{name}.v"
+    v.write_text(src)
+    js = WORK / f"{name}.json"
+    timing.yosys(f"{script(timing.rel(v))}write_json {timing.rel(js)}", WORK / f"{name}.log",
+                 f"yosys {name}")
+    return json.loads(js.read_text())
+
+
+def test_walker_on_yosys_netlist():
+    nl = _netlist("walk_t", WALK_V, lambda v: "read_verilog -lib +/xilinx/cells_sim.v; "
+                  f"read_verilog {v}; synth_xilinx -family xc5v -top walk_t -noiopad; ")
     r = timing.depth_walk(nl, "walk_t")
     # 6^2 = 36 < 40 inputs: the parity needs at least 3 LUT6 levels (ABC's area mapping
     # may use more); no path of this module is deeper than the parity's
@@ -268,13 +275,7 @@ endmodule
 def test_walker_on_hierarchical_mapping():
     """"xc5v_hier": each module mapped on its own, then flattened: the walk sees the
     child's paths under its instance name and the path across the boundary."""
-    WORK.mkdir(parents=True, exist_ok=True)
-    v = WORK / "hier_t.v"
-    v.write_text(HIER_V)
-    js = WORK / "hier_t.json"
-    timing.yosys(f"read_verilog {timing.rel(v)}; {timing.xc5v_mapping('hier_t', True)}"
-                 f"write_json {timing.rel(js)}", WORK / "hier_t.log", "yosys hier_t")
-    nl = json.loads(js.read_text())
+    nl = _netlist("hier_t", HIER_V, lambda v: f"read_verilog {v}; {timing.xc5v_mapping('hier_t', True)}")
     # flat after the mapping: no instance of the child is left (the rest are cell models)
     assert "hier_c" not in nl["modules"]
     m = nl["modules"]["hier_t"]
