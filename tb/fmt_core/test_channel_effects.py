@@ -20,6 +20,7 @@ cannot apply stops the run with one line naming it.
 """
 from __future__ import annotations
 
+import inspect
 import shutil
 import subprocess
 from pathlib import Path
@@ -28,6 +29,7 @@ import numpy as np
 import pytest
 
 from bench.core import run_sim_rtl as rsr
+from common.runner import long_run
 from fmt import channel as ch
 from fmt import params
 from fmt import scene as _scene
@@ -298,9 +300,19 @@ def effect_scene(name: str, frames: int = 6) -> _scene.Scene:
 CORE_ONE_BY_ONE = sorted(set(EFFECTS) - {"display", "charger_harmonics"})
 
 
+# make test runs one by one only the effects that no other core run of make test has:
+# these are in test_all_effects_harness (both channels, Verilator) or, the charger, in
+# test_coupling_effects_through_core_icarus; make test-long (FMT_LONG=1) runs all
+COVERED_IN_MAKE_TEST = {"interferer", "dc_lsb", "enob", "delay_samples", "noise_rms",
+                        "interferer_sweep_burst", "charger"}
+
+
 @pytest.mark.skipif(not HAS_IVERILOG, reason="Icarus not installed")
 @pytest.mark.parametrize("name", CORE_ONE_BY_ONE)
 def test_effect_through_core_icarus(tmp_path, name):
+    if name in COVERED_IN_MAKE_TEST and not long_run():
+        pytest.skip(f"{name}: through the core in another run of make test (the harness test "
+                    "or the coupling test); one by one in make test-long (FMT_LONG=1)")
     sc = effect_scene(name)
     base = _scene.small_scene().replace(frames=sc.frames)
     n = sc.frames * sc.samples_per_frame
@@ -359,6 +371,28 @@ def test_pn_chip_len_through_core_icarus(tmp_path, cps, chip_len):
     assert rep["frames_dropped"] == 0 and rep["golden_mismatches"] == 0, rep["golden_detail"]
 
 
+def harness_effects(base: dict) -> dict:
+    """The effects of test_all_effects_harness: all of them at once."""
+    eff = dict(base)
+    for k in ("interferer", "dc_lsb", "enob", "display", "charger_harmonics"):
+        eff.update(EFFECTS[k])
+    eff["interferer"] = eff["interferer"] + EFFECTS["interferer_sweep_burst"]["interferer"]
+    eff.update({"delay_samples": 6, "noise": {"rms_lsb": 70.0}})
+    return eff
+
+
+def test_covered_effects_are_in_other_core_runs():
+    """Every effect make test does not run one by one is in the harness run (each of its
+    keys; its interferers among the harness's), or is the charger of the coupling run."""
+    eff = harness_effects(_scene.small_scene().effects)
+    for name in COVERED_IN_MAKE_TEST - {"charger"}:
+        for k, v in EFFECTS[name].items():
+            assert k in eff, (name, k)
+            if k == "interferer":
+                assert all(i in eff[k] for i in v), name
+    assert 'EFFECTS["charger"]' in inspect.getsource(test_coupling_effects_through_core_icarus)
+
+
 @pytest.mark.verilator_only
 @pytest.mark.parametrize("vch", [False, True], ids=["cpp_channel", "verilog_channel"])
 def test_all_effects_harness(sim, vch):
@@ -366,12 +400,7 @@ def test_all_effects_harness(sim, vch):
     channel of the top for the cross-check); small sensor, -O0 build."""
     assert sim == "verilator"
     sc = _scene.small_scene().replace(frames=10)
-    eff = dict(sc.effects)
-    for k in ("interferer", "dc_lsb", "enob", "display", "charger_harmonics"):
-        eff.update(EFFECTS[k])
-    eff["interferer"] = eff["interferer"] + EFFECTS["interferer_sweep_burst"]["interferer"]
-    eff.update({"delay_samples": 6, "noise": {"rms_lsb": 70.0}})
-    sc = sc.replace(effects=eff)
+    sc = sc.replace(effects=harness_effects(sc.effects))
     d, ref, cal, n_upd, res, _b = rsr.run_harness(sc, sc.frames, 3, None, cal="scene", tag="tb_fx",
                                                   quiet=True, cflags="-O0", verilog_channel=vch)
     rep = rsr.analyse(sc, ref, d, 3, res["status"], sc.frames, res["wall_s"], None, False, cal)
