@@ -77,8 +77,14 @@ class Renderer:
         self.tracks: dict[int, deque] = {}
         self.last: Update | None = None
         self.hm = None                          # the heat map on show (kept when draw gets None)
+        self._layout()
+
+    def _layout(self) -> None:
+        """Draw the static parts, keep them as the background, map the axes' pixels to
+        cells; again whenever the canvas changed size (a resized window)."""
         self.canvas.draw()
         self.bg = self.canvas.copy_from_bbox(self.fig.bbox)
+        self._size = tuple(self.fig.bbox.size)
         self._pixel_map()
 
     def _pixel_map(self) -> None:
@@ -122,6 +128,8 @@ class Renderer:
         """Render one frame (upd None: the contacts of the last update_tracks); the RGBA
         pixels (height, width, 4), a view of the canvas."""
         upd = upd if upd is not None else self.last
+        if tuple(self.fig.bbox.size) != self._size:
+            self._layout()
         self.canvas.restore_region(self.bg)
         ax = self.ax
         if heatmap is not None:
