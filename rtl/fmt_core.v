@@ -165,7 +165,7 @@ module fmt_core #(
     wire        tone_tw_we, tone_amp_we, tone_tw_re, tone_amp_re;
     wire [31:0] tone_tw_wdata;
     wire [8:0]  tone_amp_wdata;
-    wire [15:0] r_threshold, r_max_jump, r_hold_jump, r_blob_thr, r_on_thr;
+    wire [15:0] r_threshold, r_max_jump, r_gate_step, r_blob_thr, r_on_thr;
     wire [2:0]  r_confirm;
     wire [2:0]  r_mode;
     wire [11:0] r_hold_off, r_blob_min;
@@ -336,7 +336,7 @@ module fmt_core #(
     ) u_touch (
         .clk(clk), .rst(rst),
         .threshold_i(r_threshold[HM_W-1:0]), .moore_i(r_mode[0]), .limit_i(limit),
-        .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .hold_jump_i(r_hold_jump),
+        .bias_en_i(r_mode[1]), .max_jump_i(r_max_jump), .gate_step_i(r_gate_step),
         .hold_off_i(r_hold_off), .vel_shift_i(r_vel_shift), .max_speed_i(r_max_speed),
         .on_thr_i(r_on_thr[HM_W-1:0]), .confirm_i(r_confirm),
         .delay_i(r_lat_dial), .report_period_i(r_report_period),
@@ -502,7 +502,7 @@ module fmt_core #(
         .tone_amp_we_o(tone_amp_we), .tone_amp_wdata_o(tone_amp_wdata), .tone_amp_re_o(tone_amp_re),
         .tone_amp_rdata_i(tone_amp_rdata),
         .touch_threshold_o(r_threshold), .touch_mode_o(r_mode), .contact_limit_o(r_limit),
-        .track_max_jump_o(r_max_jump), .track_hold_jump_o(r_hold_jump),
+        .track_max_jump_o(r_max_jump), .track_gate_step_o(r_gate_step),
         .track_hold_off_o(r_hold_off), .track_vel_shift_o(r_vel_shift),
         .track_max_speed_o(r_max_speed), .blob_threshold_o(r_blob_thr),
         .blob_min_cells_o(r_blob_min), .touch_on_threshold_o(r_on_thr),

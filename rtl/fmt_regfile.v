@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0xB9E7.
+// Register map id 0xDA06.
 `default_nettype none
 
 module fmt_regfile (
@@ -36,7 +36,7 @@ module fmt_regfile (
     output reg  [2:0] touch_mode_o,                 // TOUCH_MODE (rw): Bit 0: 1 = Moore (3x3) maxima and fit, 0 = Von Neumann (moore_i); bit 1: bias correction on (bias_en_i); bit 2: blob detection on (blob_en_i: fingers inside blobs dropped, type-3 blob events)
     output reg  [4:0] contact_limit_o,              // CONTACT_LIMIT (rw): Contact limit per frame, <= MAX_TOUCHES (limit_i)
     output reg  [15:0] track_max_jump_o,            // TRACK_MAX_JUMP (rw): Tracker L1 gate of a contact seen last frame, cells Q8
-    output reg  [15:0] track_hold_jump_o,           // TRACK_HOLD_JUMP (rw): Tracker L1 gate of a contact in hold-off, cells Q8
+    output reg  [15:0] track_gate_step_o,           // TRACK_GATE_STEP (rw): Growth of a contact's L1 gate per frame it is missed, cells Q8
     output reg  [11:0] track_hold_off_o,            // TRACK_HOLD_OFF (rw): Frames a missing contact keeps its ID (default 200
     output reg  [3:0] track_vel_shift_o,            // TRACK_VEL_SHIFT (rw): Velocity filter gain 2^-S (default from a 2000
     output reg  [20:0] track_max_speed_o,           // TRACK_MAX_SPEED (rw): Velocity clamp per axis, 2^-(8+VF) cells per frame (default 3000
@@ -104,7 +104,7 @@ module fmt_regfile (
     localparam [15:0] A_TOUCH_MODE = 16'h0021;
     localparam [15:0] A_CONTACT_LIMIT = 16'h0022;
     localparam [15:0] A_TRACK_MAX_JUMP = 16'h0023;
-    localparam [15:0] A_TRACK_HOLD_JUMP = 16'h0024;
+    localparam [15:0] A_TRACK_GATE_STEP = 16'h0024;
     localparam [15:0] A_TRACK_HOLD_OFF = 16'h0025;
     localparam [15:0] A_TRACK_VEL_SHIFT = 16'h0026;
     localparam [15:0] A_TRACK_MAX_SPEED = 16'h0027;
@@ -159,7 +159,7 @@ module fmt_regfile (
     wire wr_touch_mode = reg_we_i && (reg_addr_i == A_TOUCH_MODE);
     wire wr_contact_limit = reg_we_i && (reg_addr_i == A_CONTACT_LIMIT);
     wire wr_track_max_jump = reg_we_i && (reg_addr_i == A_TRACK_MAX_JUMP);
-    wire wr_track_hold_jump = reg_we_i && (reg_addr_i == A_TRACK_HOLD_JUMP);
+    wire wr_track_gate_step = reg_we_i && (reg_addr_i == A_TRACK_GATE_STEP);
     wire wr_track_hold_off = reg_we_i && (reg_addr_i == A_TRACK_HOLD_OFF);
     wire wr_track_vel_shift = reg_we_i && (reg_addr_i == A_TRACK_VEL_SHIFT);
     wire wr_track_max_speed = reg_we_i && (reg_addr_i == A_TRACK_MAX_SPEED);
@@ -208,8 +208,8 @@ module fmt_regfile (
             touch_threshold_o <= 16'h07D0;
             touch_mode_o <= 3'h3;
             contact_limit_o <= 5'h10;
-            track_max_jump_o <= 16'h0300;
-            track_hold_jump_o <= 16'h00C0;
+            track_max_jump_o <= 16'h00B8;
+            track_gate_step_o <= 16'h0003;
             track_hold_off_o <= 12'h021;
             track_vel_shift_o <= 4'h8;
             track_max_speed_o <= 21'h000F19;
@@ -234,7 +234,7 @@ module fmt_regfile (
             if (wr_touch_mode) touch_mode_o <= reg_wdata_i[2:0];
             if (wr_contact_limit) contact_limit_o <= reg_wdata_i[4:0];
             if (wr_track_max_jump) track_max_jump_o <= reg_wdata_i[15:0];
-            if (wr_track_hold_jump) track_hold_jump_o <= reg_wdata_i[15:0];
+            if (wr_track_gate_step) track_gate_step_o <= reg_wdata_i[15:0];
             if (wr_track_hold_off) track_hold_off_o <= reg_wdata_i[11:0];
             if (wr_track_vel_shift) track_vel_shift_o <= reg_wdata_i[3:0];
             if (wr_track_max_speed) track_max_speed_o <= reg_wdata_i[20:0];
@@ -271,7 +271,7 @@ module fmt_regfile (
                 A_TOUCH_MODE: reg_rdata_o <= {29'h0, touch_mode_o};
                 A_CONTACT_LIMIT: reg_rdata_o <= {27'h0, contact_limit_o};
                 A_TRACK_MAX_JUMP: reg_rdata_o <= {16'h0, track_max_jump_o};
-                A_TRACK_HOLD_JUMP: reg_rdata_o <= {16'h0, track_hold_jump_o};
+                A_TRACK_GATE_STEP: reg_rdata_o <= {16'h0, track_gate_step_o};
                 A_TRACK_HOLD_OFF: reg_rdata_o <= {20'h0, track_hold_off_o};
                 A_TRACK_VEL_SHIFT: reg_rdata_o <= {28'h0, track_vel_shift_o};
                 A_TRACK_MAX_SPEED: reg_rdata_o <= {11'h0, track_max_speed_o};

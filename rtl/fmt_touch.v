@@ -80,7 +80,7 @@ module fmt_touch #(
     input  wire [LIM_W-1:0]      limit_i,            // contact limit (<= MAX_TOUCHES)
     input  wire                  bias_en_i,          // sub-cell bias correction on
     input  wire [15:0]           max_jump_i,         // tracker L1 gate (Q8.8)
-    input  wire [15:0]           hold_jump_i,        // tracker L1 gate in hold-off (Q8.8)
+    input  wire [15:0]           gate_step_i,        // tracker L1 gate growth per frame missed (Q8.8)
     input  wire [HOLD_W-1:0]     hold_off_i,         // frames missing before lift
     input  wire [3:0]            vel_shift_i,        // velocity filter gain 2^-S
     input  wire [V_W-2:0]        max_speed_i,        // velocity clamp
@@ -174,7 +174,7 @@ module fmt_touch #(
     always @(posedge clk) begin
         if (first_row) begin
             sti_mem[fi] <= {threshold_i, moore_i, limit_i, blob_threshold_i, blob_min_cells_i};
-            stt_mem[fi] <= {on_thr_i, confirm_i, max_jump_i, hold_jump_i, hold_off_i, vel_shift_i,
+            stt_mem[fi] <= {on_thr_i, confirm_i, max_jump_i, gate_step_i, hold_off_i, vel_shift_i,
                             max_speed_i};
         end
     end
@@ -481,7 +481,7 @@ module fmt_touch #(
     wire [HM_W-1:0]        on_thr_f    = trk_set_q[TRK_W-1 -: HM_W];
     wire [2:0]             confirm_f   = trk_set_q[TRK_W-HM_W-1 -: 3];
     wire [15:0]            max_jump_f  = trk_set_q[TRK_W-HM_W-4 -: 16];
-    wire [15:0]            hold_jump_f = trk_set_q[TRK_W-HM_W-20 -: 16];
+    wire [15:0]            gate_step_f = trk_set_q[TRK_W-HM_W-20 -: 16];
     wire [HOLD_W-1:0]      hold_off_f  = trk_set_q[4+V_W-1 +: HOLD_W];
     wire [3:0]             vel_shift_f = trk_set_q[V_W-1 +: 4];
     wire [V_W-2:0]         max_speed_f = trk_set_q[V_W-2:0];
@@ -489,7 +489,7 @@ module fmt_touch #(
     fmt_tracker #(.MAX_TOUCHES(MAX_TOUCHES), .HM_W(HM_W), .FRAME_W(FRAME_W), .ID_W(ID_W),
                   .VF(VF), .V_W(V_W), .HOLD_W(HOLD_W)) u_tracker (
         .clk(clk), .rst(rst),
-        .max_jump_i(max_jump_f), .hold_jump_i(hold_jump_f), .hold_off_i(hold_off_f),
+        .max_jump_i(max_jump_f), .gate_step_i(gate_step_f), .hold_off_i(hold_off_f),
         .vel_shift_i(vel_shift_f), .max_speed_i(max_speed_f), .on_thr_i(on_thr_f),
         .confirm_i(confirm_f),
         .tp_valid_i(g_valid), .tp_frame_i(g_frame), .tp_x_i(g_x), .tp_y_i(g_y),

@@ -15,8 +15,10 @@
 //   COLLECT  touches arrive (tp_valid, any cycles; beyond MAX_TOUCHES dropped, sticky
 //            drop_flag_o).  A1: the L1 distance of the touch to every slot's
 //            prediction, D = |x - pred_x| + |y - pred_y|, saturated to 17 bits.  A2:
-//            candidate = slot active and D <= gate (max_jump_i for a contact seen
-//            last frame, hold_jump_i in hold-off), the row {cand, D} per slot written
+//            candidate = slot active and D <= the slot's gate (gate_q: max_jump_i
+//            when the slot was matched or allocated, + gate_step_i, saturating at
+//            0xFFFF, for every frame it was kept in hold-off: the distance a finger
+//            can have moved), the row {cand, D} per slot written
 //            to a LUT RAM.  R1..R_SB: the row read back and its minimum over the free
 //            candidate slots, key (D, s), ties to the lower slot, one tree level per
 //            stage, the last two levels in one (a 4:1 minimum; SB - 1 tree stages, none
@@ -100,7 +102,7 @@ module fmt_tracker #(
     input  wire                  rst,              // synchronous, active high
     // settings (run time, from the register file)
     input  wire [15:0]           max_jump_i,       // L1 gate, contact seen last frame (Q8.8)
-    input  wire [15:0]           hold_jump_i,      // L1 gate, contact in hold-off (Q8.8)
+    input  wire [15:0]           gate_step_i,      // L1 gate growth per frame missed (Q8.8)
     input  wire [HOLD_W-1:0]     hold_off_i,       // frames missing before lift (0 acts as 1)
     input  wire [3:0]            vel_shift_i,      // velocity filter gain 2^-S, S <= VF
     input  wire [V_W-2:0]        max_speed_i,      // |v| clamp per axis, 2^-(8+VF) cells/frame
@@ -255,7 +257,7 @@ module fmt_tracker #(
     reg [1:0]           hev_typ_q;
     reg [TD_W-1:0]      hev_d_q;
     reg [MT*HOLD_W-1:0] miss_q;                   // frames since last seen
-    reg [MT-1:0]        mz_q;                     // miss == 0 (gate select)
+    reg [MT*16-1:0]     gate_q;                   // L1 match gate per slot (Q8.8)
     reg [MT-1:0]        lexp_q;                   // miss + 1 >= hold-off (lift if unmatched)
     reg [HOLD_W-1:0]    hm1_q;                    // max(hold_off, 1) - 1
     reg [MT*PR_W-1:0]   prx_q, pry_q;             // rounded, saturated predictions
@@ -342,13 +344,13 @@ module fmt_tracker #(
     end
 
     // ---- A2: candidate = slot active and D <= gate; row written to the distance RAM -----
-    // D > gate is the carry of D + ~gate (the gate select folds into the adder's LUTs)
+    // D > gate is the carry of D + ~gate
     reg [RW-1:0] drow;
     reg [DW:0]   dgt;
     always @* begin : c_drow
         integer s_i;
         for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-            dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~(mz_q[s_i] ? max_jump_i : hold_jump_i)};
+            dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~gate_q[s_i*16 +: 16]};
             drow[s_i*KW +: KW] = {act_q[s_i] && !dq_q[s_i*KW+DW] && !dgt[DW],
                                   dq_q[s_i*KW +: DW]};
         end
@@ -639,15 +641,24 @@ module fmt_tracker #(
     wire [31:0]      lrec  = lmem[op_s];
     reg  [GEN_W-1:0] e1_gen;          // one-hot selects
     reg  [HOLD_W-1:0] e1_miss;
+    reg  [15:0]      e1_gate;
     always @* begin : c_e1sel
         integer s_i;
         e1_gen  = {GEN_W{1'b0}};
         e1_miss = {HOLD_W{1'b0}};
+        e1_gate = 16'd0;
         for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
             e1_gen  = e1_gen  | (gen_q[s_i*GEN_W +: GEN_W]   & {GEN_W{op_so_q[s_i]}});
             e1_miss = e1_miss | (miss_q[s_i*HOLD_W +: HOLD_W] & {HOLD_W{op_so_q[s_i]}});
+            e1_gate = e1_gate | (gate_q[s_i*16 +: 16]         & {16{op_so_q[s_i]}});
         end
     end
+    // the slot's new gate, written in E2: max_jump_i for a move or a new, the old gate +
+    // gate_step_i (saturating) for a hold-off update; E1 registers the operand
+    reg  [15:0]      e2_g_q;
+    reg              e2_up_q;
+    wire [16:0]      e2_gs = {1'b0, e2_g_q} + {1'b0, gate_step_i};
+    wire [15:0]      e2_gn = !e2_up_q ? e2_g_q : (e2_gs[16] ? 16'hFFFF : e2_gs[15:0]);
     wire             e1_ev = op_go & op_vis_q;
     always @(posedge clk) begin
         if (op_go && (op_typ_q == T_MOVE || op_typ_q == T_NEW))
@@ -695,7 +706,9 @@ module fmt_tracker #(
             hev_typ_q      <= 2'd0;
             hev_d_q        <= {TD_W{1'b0}};
             miss_q         <= {(MT*HOLD_W){1'b0}};
-            mz_q           <= {MT{1'b1}};
+            gate_q         <= {(MT*16){1'b0}};
+            e2_g_q         <= 16'd0;
+            e2_up_q        <= 1'b0;
             lexp_q         <= {MT{1'b0}};
             hm1_q          <= {HOLD_W{1'b0}};
             prx_q          <= {(MT*PR_W){1'b0}};
@@ -797,7 +810,6 @@ module fmt_tracker #(
             // ---- per-slot flags (settle long before they are used) ---------------------
             hm1_q <= (hold_off_i == {HOLD_W{1'b0}}) ? {HOLD_W{1'b0}} : hold_off_i - 1'b1;
             for (s_i = 0; s_i < MT; s_i = s_i + 1) begin
-                mz_q[s_i]   <= (miss_q[s_i*HOLD_W +: HOLD_W] == {HOLD_W{1'b0}});
                 lexp_q[s_i] <= (miss_q[s_i*HOLD_W +: HOLD_W] >= hm1_q);
             end
 
@@ -929,6 +941,12 @@ module fmt_tracker #(
             e2_v_q   <= op_go;
             e2_typ_q <= op_typ_q;
             e2_s_q   <= op_s;
+            e2_up_q  <= (op_typ_q == T_UPD);
+            e2_g_q   <= (op_typ_q == T_UPD) ? e1_gate : max_jump_i;
+            // E2: the operation's slot gets its new gate (not for a lift)
+            for (s_i = 0; s_i < MT; s_i = s_i + 1)
+                if (e2_v_q && e2_typ_q != T_LIFT && e2_s_q == s_i[SB-1:0])
+                    gate_q[s_i*16 +: 16] <= e2_gn;
             e3_v_q   <= e2_v_q;
             e3_typ_q <= e2_typ_q;
             e3_s_q   <= e2_s_q;

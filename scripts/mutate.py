@@ -96,10 +96,16 @@ MUTATIONS = {
         "an offset of 257/512 cell or more is clamped to 0.5 cell"),
     "tracker_gate_strict": (
         "rtl/fmt_tracker.v",
-        "dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~(mz_q[s_i] ? max_jump_i : hold_jump_i)};",
-        "dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~(mz_q[s_i] ? max_jump_i : hold_jump_i)} + 1'b1;",
+        "dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~gate_q[s_i*16 +: 16]};",
+        "dgt = {1'b0, dq_q[s_i*KW +: DW]} + {1'b0, ~gate_q[s_i*16 +: 16]} + 1'b1;",
         "fmt_tracker/test_fmt_tracker.py::test_fmt_tracker[icarus-small-5]",
         "a touch at distance D <= gate (equal included) is a match candidate"),
+    "tracker_gate_no_growth": (
+        "rtl/fmt_tracker.v",
+        "wire [16:0]      e2_gs = {1'b0, e2_g_q} + {1'b0, gate_step_i};",
+        "wire [16:0]      e2_gs = {1'b0, e2_g_q};",
+        "fmt_tracker/test_fmt_tracker.py::test_fmt_tracker[icarus-small-5]",
+        "the gate of a contact in hold-off grows by gate_step per frame missed"),
     "tracker_confirm_late": (
         "rtl/fmt_tracker.v",
         "sc_all[s_i*5 +: 5] = {tent_q[s_i], s1 >= confirm_i, s1};",

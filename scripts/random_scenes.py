@@ -136,7 +136,7 @@ def random_settings(rng, cfg) -> TouchSettings:
         neighbourhood=str(rng.choice(["moore", "vn"])),
         max_touches=int(rng.integers(1, cfg.max_touches + 1)) if rng.random() < 0.5 else None,
         bias_correction=bool(rng.random() < 0.7),
-        max_jump_mm=_f(rng, 0.5, 30), hold_off_us=_f(rng, 0, 400),
+        position_noise_mm=_f(rng, 0, 10), hold_off_us=_f(rng, 0, 400),
         velocity_window_us=_f(rng, 0, 4000), max_speed_mm_s=_f(rng, 0, 6000),
         blobs=bool(rng.random() < 0.4), blob_threshold=int(rng.integers(1, 4000)),
         blob_min_cells=int(rng.integers(1, 16)),

@@ -386,7 +386,7 @@ def register_writes(scene: _scene.Scene, settings: TouchSettings) -> list:
         ("TOUCH_MODE", int(settings.neighbourhood == "moore") | (2 if settings.bias_correction else 0)
          | (4 if settings.blobs else 0)),
         ("CONTACT_LIMIT", settings.max_touches if settings.max_touches is not None else cfg.max_touches),
-        ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_HOLD_JUMP", tp.hold_jump_q),
+        ("TRACK_MAX_JUMP", tp.max_jump_q), ("TRACK_GATE_STEP", tp.gate_step_q),
         ("TRACK_HOLD_OFF", tp.hold_off_frames), ("TRACK_VEL_SHIFT", tp.vel_shift),
         ("TRACK_MAX_SPEED", tp.max_speed_v),
         ("TOUCH_ON_THRESHOLD", tp.on_threshold), ("TRACK_CONFIRM", tp.confirm_frames),

@@ -14,10 +14,14 @@ of the frame are dropped and counted):
 
 1. prediction of slot s: ``pred = (p + 2^(VF-1)) >> VF`` (round half up), per axis.
 2. distance ``D[t][s] = |x_t - predx_s| + |y_t - predy_s|`` (L1, Q8.8 units).  A pair
-   is a candidate when slot s is active and ``D <= gate_s``; the gate is
-   ``max_jump_q`` for a contact seen in the previous frame and ``hold_jump_q`` (a
-   tighter gate) for a contact in hold-off (``miss > 0``): a lifted finger may only
-   come back where it left, so a tap 10 mm away is a different contact (drumroll).
+   is a candidate when slot s is active and ``D <= gate_s``.  The gate is physical
+   (:meth:`TrackParams.from_settings`): ``max_jump_q`` (the farthest a finger at the
+   maximum speed can be from its prediction after one frame, plus the position noise)
+   for a contact seen in the previous frame, growing by ``gate_step_q`` (the same
+   bound for one more frame) with every frame a contact is missed (``gate_s`` is kept
+   per slot: ``max_jump_q`` when it is matched or new, ``min(gate_s + gate_step_q,
+   0xFFFF)`` when it is kept in hold-off).  A touch that no finger could have moved to
+   is never matched: at 162.76 kHz two fingers tapping 10 mm apart are two contacts.
 3. greedy global nearest pairs: repeat { take the candidate pair of smallest D among
    unassigned touches and slots; ties go to the smallest ``t * max_touches + s`` },
    each assignment emits a ``move`` event (in this order); for a *tentative* slot
@@ -123,8 +127,8 @@ def as_touch(t) -> Touch:
 @dataclass(frozen=True)
 class TrackParams:
     """Tracker settings in RTL units (all integers; the RTL's run-time inputs)."""
-    max_jump_q: int = 768          # L1 gate of a contact seen last frame (Q8.8 cells)
-    hold_jump_q: int = 192         # L1 gate of a contact in hold-off (Q8.8 cells)
+    max_jump_q: int = 184          # L1 gate of a contact seen last frame (Q8.8 cells)
+    gate_step_q: int = 3           # the gate's growth per frame missed (Q8.8 cells, L1)
     hold_off_frames: int = 33      # a contact missing this many frames is lifted
     vel_shift: int = 8             # S: velocity filter gain 2^-S (<= vel_frac)
     max_speed_v: int = 3865        # velocity clamp per axis, units 2^-(8+VF) cells/frame
@@ -143,7 +147,7 @@ class TrackParams:
     def from_settings(cls, cfg: SensorConfig, settings: TouchSettings | None = None,
                       frame_period_s: float | None = None, **kw) -> "TrackParams":
         """Convert the physical settings once.  ``frame_period_s`` defaults to one
-        window (M = 1).  ``hold_jump_q`` = max_jump_q / 4 (no shared setting yet).
+        window (M = 1); the gates scale with it (:meth:`TouchSettings.converted`).
         ``max_touches`` (slots) is the sensor's ``max_touches`` (an RTL parameter);
         ``settings.max_touches`` limits the candidates upstream."""
         s = settings or TouchSettings()
@@ -158,7 +162,7 @@ class TrackParams:
         hold = min(c["hold_off_frames"], (1 << 12) - 1)   # HOLD_W = 12
         mt = cfg.max_touches           # slots = the RTL parameter; the run-time limit is
                                        # applied to the candidates (fmt.localmax)
-        args = dict(max_jump_q=min(c["max_jump_q"], 0xFFFF), hold_jump_q=c["max_jump_q"] // 4,
+        args = dict(max_jump_q=c["max_jump_q"], gate_step_q=c["gate_step_q"],
                     hold_off_frames=hold, on_threshold=s.on_threshold,
                     confirm_frames=s.confirm_frames, vel_shift=shift, max_speed_v=vmax, max_touches=mt)
         args.update(kw)
@@ -174,6 +178,7 @@ class _Slot:
     vx: int = 0
     vy: int = 0
     miss: int = 0
+    gate: int = 0                 # L1 match gate (Q8.8): max_jump_q + gate_step_q per frame missed
     lx: int = 0
     ly: int = 0
     tent: bool = False            # tentative: not reported yet
@@ -271,9 +276,11 @@ class Tracker:
                 st.px = (mx << vf) + st.vx
                 st.py = (my << vf) + st.vy
                 st.miss = 0
+                st.gate = p.max_jump_q
                 st.lx, st.ly = mx, my
             elif st.active:
                 st.miss += 1
+                st.gate = min(st.gate + p.gate_step_q, 0xFFFF)
                 st.px += st.vx
                 st.py += st.vy
         # 5. news (a contact in hold-off seen longest ago makes room when no slot is free)
@@ -305,6 +312,7 @@ class Tracker:
             st.vx = st.vy = 0
             st.px, st.py = tt.x_q << vf, tt.y_q << vf
             st.miss = 0
+            st.gate = p.max_jump_q
             st.lx, st.ly = tt.x_q, tt.y_q
             if p.confirm_frames > 1:
                 st.tent, st.seen = True, 1
@@ -326,8 +334,7 @@ class Tracker:
         predx = np.array([(s.px + half) >> vf for s in sl], dtype=np.int64)
         predy = np.array([(s.py + half) >> vf for s in sl], dtype=np.int64)
         act = np.array([s.active for s in sl], dtype=bool)
-        gate = np.array([p.max_jump_q if s.miss == 0 else p.hold_jump_q for s in sl],
-                        dtype=np.int64)
+        gate = np.array([s.gate for s in sl], dtype=np.int64)
         tx = np.array([t.x_q for t in touches], dtype=np.int64)
         ty = np.array([t.y_q for t in touches], dtype=np.int64)
         d = np.abs(tx[:, None] - predx[None, :]) + np.abs(ty[:, None] - predy[None, :])

@@ -103,7 +103,7 @@ def test_touch_no_file_and_not_npy(tmp_path, capsys, no_sim):
 @pytest.mark.parametrize("st_json, key", [
     ({"threshhold": 100}, "threshhold"), ({"threshold": "high"}, "threshold"),
     ({"threshold": 70000}, "threshold"), ({"neighbourhood": "hex"}, "neighbourhood"),
-    ({"max_jump_mm": -1.0}, "max_jump_mm"), ({"blobs": 1}, "blobs"), ([1, 2], "expected an object")])
+    ({"position_noise_mm": -1.0}, "position_noise_mm"), ({"blobs": 1}, "blobs"), ([1, 2], "expected an object")])
 def test_touch_bad_settings(tmp_path, capsys, no_sim, st_json, key):
     p = tmp_path / "st.json"
     p.write_text(json.dumps(st_json))

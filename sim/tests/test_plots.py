@@ -84,9 +84,11 @@ def test_animated_gif(tmp_path):
     for f in range(8):
         hm[f] += 9000 * np.exp(-((xx - (8 + f)) ** 2 + (yy - 12.3) ** 2) / (2 * 0.7 ** 2))
     hm = np.rint(hm).astype(np.int64)
-    # new contacts reported at once (no confirmation frame): frame 0 has the finger
+    # new contacts reported at once (no confirmation frame): frame 0 has the finger; it
+    # moves a cell (5 mm) a frame, which a finger can at frames of 64 windows (0.39 ms:
+    # the tracker's gate is 6.9 mm there, 3.6 mm at one window)
     evs = process_frames(hm, cfg, TouchSettings(confirm_frames=1), fixed=True,
-                         frame_period_s=cfg.window_s)
+                         frame_period_s=64 * cfg.window_s)
     path = plots.animation_gif(hm, evs, cfg, tmp_path / "run.gif", fps=10)
     frames = iio.imread(path)
     assert frames.shape[0] == 8

@@ -36,8 +36,8 @@ def test_resets_from_shared_defaults():
     assert r["TRACK_MAX_JUMP"].reset == conv["max_jump_q"]
     assert r["TRACK_HOLD_OFF"].reset == conv["hold_off_frames"]
     tp = TrackParams.from_settings(cfg, s, regmap.FRAME_PERIOD_S)
-    assert (r["TRACK_HOLD_JUMP"].reset, r["TRACK_VEL_SHIFT"].reset, r["TRACK_MAX_SPEED"].reset) == \
-        (tp.hold_jump_q, tp.vel_shift, tp.max_speed_v)
+    assert (r["TRACK_GATE_STEP"].reset, r["TRACK_VEL_SHIFT"].reset, r["TRACK_MAX_SPEED"].reset) == \
+        (tp.gate_step_q, tp.vel_shift, tp.max_speed_v)
     # the report period keeps the event rate to the host at or below 250 Hz
     assert regmap.PROC_CLK_HZ / r["REPORT_PERIOD"].reset <= 250.0
 

@@ -31,7 +31,11 @@ def run(frames, p):
 
 def test_conversion_defaults():
     p = TrackParams.from_settings(CFG, TouchSettings())
-    assert p.max_jump_q == 768 and p.hold_jump_q == 192
+    # gates (issue #11 item 1): 2 x 3 m/s x 6.144 us = 0.036864 mm a frame; + 2.5 mm of
+    # noise = 2.536864 mm, x sqrt 2 = 3.5877 mm L1 = 183.69 Q8.8 units of a 5 mm cell ->
+    # 184; the step 0.036864 x sqrt 2 / 5 x 256 = 2.67 -> 3 (rounded up: bounds)
+    assert p.max_jump_q == 184 and p.gate_step_q == 3
+    assert (TrackParams().max_jump_q, TrackParams().gate_step_q) == (184, 3)
     assert p.hold_off_frames == 33
     assert p.vel_shift == 8                       # 326 frames -> 2^8
     # 3 m/s = 18.4 um/frame = 0.94 Q8.8 units = 3865 units of 2^-20 cells
@@ -62,12 +66,14 @@ def drumroll(on, off, n_taps, a=(40, 40), b=(50, 40)):
     return frames, who
 
 
-@pytest.mark.parametrize("on_us,off_us", [(30000, 30000), (60, 60), (30, 15)])
+@pytest.mark.parametrize("on_us,off_us", [(30000, 30000), (60, 60), (30, 15), (30, 0), (300, 0)])
 def test_drumroll_stays_two_contacts(on_us, off_us):
     """A B A B 10 mm apart never becomes one moving contact: no event of one tap's ID
     at the other finger's place, and each tap's events stay at its finger.  At 30 ms
     on/off each tap is a new contact; with gaps shorter than the hold-off, the two
-    contacts keep their own IDs across taps (flicker absorption), still two."""
+    contacts keep their own IDs across taps (flicker absorption), still two; also when
+    one lands in the frame the other lifts (off 0: the gates of issue #11 item 1, a 15 mm
+    gate made them one moving contact)."""
     p = TrackParams.from_settings(CFG, TouchSettings())
     on, off = round(on_us * 1e-6 * FR), round(off_us * 1e-6 * FR)
     frames, who = drumroll(on, off, 6)
@@ -89,7 +95,7 @@ def test_drumroll_stays_two_contacts(on_us, off_us):
                 live.add(e.id)
         assert len(live) <= 2
     ids = {e.id for evs in out for e in evs}
-    if off < p.hold_off_frames:
+    if on + 2 * off < p.hold_off_frames:          # each finger is away for on + 2 off frames
         assert len(ids) == 2                       # A and B keep their IDs
     else:
         assert len(ids) == 6                       # one per tap, none reused

@@ -75,7 +75,8 @@ def test_fmt_core(sim, cps):
                     "the other two in make test-long")
     frames = 14
     # lifts within the run (small frames are 1.536 us); a gate below the tap-drag distance
-    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
+    # (sqrt 2 x (2.8 mm + 2 x 3 m/s x 1.536 us) = 3.97 mm)
+    st = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8)
     scene = small_tap_scene(frames)
     cfg = scene.cfg
     uart = cps == 3                              # the UART phase once per simulator (test time)
@@ -140,7 +141,7 @@ def test_fmt_core_blobs(sim):
                     "both simulators in make test-long (FMT_LONG=1), for make test's time")
     frames = 12
     # threshold and size between the finger (3 cells above 3500) and the palm (8 cells)
-    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0, blobs=True,
+    st = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8, blobs=True,
                        blob_threshold=3500, blob_min_cells=5)
     scene = small_palm_scene(frames)
     d, ref, res, rep = _run(sim, scene, 3, False, st)
@@ -163,7 +164,7 @@ def test_fmt_core_no_blob_build(sim):
     """fmt_core built with BLOBS = 0: the detector is left out, so TOUCH_MODE bit 2 (written
     here) has no effect: the palm scene's events are those of the model with blobs off."""
     frames = 8
-    st_on = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0, blobs=True,
+    st_on = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8, blobs=True,
                           blob_threshold=3500, blob_min_cells=5)
     scene = small_palm_scene(frames)
     d, ref, res, rep = _run(sim, scene, 3, False, st_on, model_settings=st_on.replace(blobs=False),

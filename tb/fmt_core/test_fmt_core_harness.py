@@ -45,7 +45,7 @@ def small_tap_scene(frames: int) -> _scene.Scene:
 def test_fmt_core_harness(sim):
     assert sim == "verilator"
     frames = 24
-    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
+    st = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8)
     scene = small_tap_scene(frames)
     cfg = scene.cfg
     d, ref, cal, n_upd, res, build_s = rsr.run_harness(scene, frames, 3, st, cal="scene",

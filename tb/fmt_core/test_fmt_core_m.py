@@ -41,7 +41,7 @@ def test_fmt_core_m3(sim):
     scene = _scene.small_scene().replace(frames=frames, m=M)
     cfg = scene.cfg
     assert scene.samples_per_frame == M * cfg.n_fft
-    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
+    st = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8)
     d, ref, cal, _n_upd = rsr.prepare(scene, frames, cps, st, cal=None, tag=f"tbm{M}_{sim}")
     assert ref.heatmaps.shape[0] == frames
     res = _run_job(sim, cfg, cps, d)
@@ -85,7 +85,7 @@ def test_fmt_core_m_written_during_run(sim):
     frames, cps, m0 = 12, 3, 3
     scene = _scene.small_scene().replace(frames=frames, m=m0)
     cfg = scene.cfg
-    st = TouchSettings(hold_off_us=5.0, max_jump_mm=4.0)
+    st = TouchSettings(hold_off_us=5.0, position_noise_mm=2.8)
     d, _ref, cal, _n = rsr.prepare(scene, frames, cps, st, cal=None, tag=f"tbmw_{sim}")
     job = json.loads((d / "job.json").read_text())
     total, vals, cur = job["run_cycles"], [], m0

@@ -109,7 +109,7 @@ module fmt_ctrl_tb_top #(
         .tone_amp_we_o(tone_amp_we), .tone_amp_wdata_o(tone_amp_wdata), .tone_amp_re_o(tone_amp_re),
         .tone_amp_rdata_i(tone_amp_mem[tone_sel]),
         .touch_threshold_o(), .touch_mode_o(), .contact_limit_o(), .track_max_jump_o(),
-        .track_hold_jump_o(), .track_hold_off_o(), .track_vel_shift_o(), .track_max_speed_o(),
+        .track_gate_step_o(), .track_hold_off_o(), .track_vel_shift_o(), .track_max_speed_o(),
         .blob_threshold_o(), .blob_min_cells_o(), .touch_on_threshold_o(), .track_confirm_o(),
         .cal_row_o(cal_row), .cal_col_o(cal_col),
         .cal_offset_we_o(cal_off_we), .cal_offset_wdata_o(cal_off_wdata), .cal_offset_re_o(cal_off_re),

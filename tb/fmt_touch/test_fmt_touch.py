@@ -216,7 +216,7 @@ def random_settings(cfg, rng) -> TouchSettings:
         neighbourhood=str(rng.choice(["moore", "vn"])),
         max_touches=int(rng.integers(1, cfg.max_touches + 1)) if rng.random() < 0.5 else None,
         bias_correction=bool(rng.random() < 0.5),
-        max_jump_mm=float(rng.uniform(2.0, 30.0)),
+        position_noise_mm=float(rng.uniform(0.0, 10.0)),
         hold_off_us=float(rng.choice([1000.0, 2000.0, 5000.0])),
         velocity_window_us=float(rng.choice([1000.0, 4000.0, 16000.0])),
         max_speed_mm_s=float(rng.uniform(200.0, 5000.0)),

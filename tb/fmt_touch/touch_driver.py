@@ -57,7 +57,7 @@ class TB(ClockedTB):
         d.limit_i.value = st.max_touches if st.max_touches is not None else cfg.max_touches
         d.bias_en_i.value = int(st.bias_correction)
         d.max_jump_i.value = tp.max_jump_q
-        d.hold_jump_i.value = tp.hold_jump_q
+        d.gate_step_i.value = tp.gate_step_q
         d.hold_off_i.value = tp.hold_off_frames
         d.vel_shift_i.value = tp.vel_shift
         d.max_speed_i.value = tp.max_speed_v

@@ -56,7 +56,7 @@ class TB(ClockedTB):
     def set_params(self, p: TrackParams):
         d = self.dut
         d.max_jump_i.value = p.max_jump_q
-        d.hold_jump_i.value = p.hold_jump_q
+        d.gate_step_i.value = p.gate_step_q
         d.hold_off_i.value = p.hold_off_frames
         d.vel_shift_i.value = p.vel_shift
         d.max_speed_i.value = p.max_speed_v
@@ -265,7 +265,7 @@ async def random_streams(dut):
     mt = tb.mt
     for trial in range(3):
         p = TrackParams(max_jump_q=rng.choice([300, 768, 2000]),
-                        hold_jump_q=rng.choice([100, 192, 400]),
+                        gate_step_q=rng.choice([0, 3, 100, 0xFFFF]),   # 0xFFFF: saturates
                         hold_off_frames=rng.choice([1, 2, 4, 7]),
                         vel_shift=rng.choice([0, 1, 3, 8, 12]),
                         max_speed_v=rng.choice([1000, 1 << 16, (1 << 21) - 1]),
@@ -318,10 +318,12 @@ async def scripted_scenarios(dut):
     tb = TB(dut)
     rng = random.Random(7)
     mt = tb.mt
-    base = dict(max_jump_q=q(15), hold_jump_q=q(15) // 4, max_touches=mt)
-    # drumroll A B A B 10 mm apart, off-time shorter and longer than the hold-off
+    base = dict(max_jump_q=q(15), gate_step_q=q(1), max_touches=mt)
+    # drumroll A B A B 10 mm apart, off-time shorter and longer than the hold-off (gates
+    # of a finger that moves ~0.25 mm a frame: 4 mm, + 0.5 mm per frame missed)
     for on, off, hold in ((4, 2, 10), (3, 6, 3)):
-        p = TrackParams(hold_off_frames=hold, vel_shift=2, max_speed_v=1 << 16, **base)
+        p = TrackParams(hold_off_frames=hold, vel_shift=2, max_speed_v=1 << 16,
+                        max_jump_q=q(4), gate_step_q=q(0.5), max_touches=mt)
         tb.set_params(p)
         await tb.reset()
         frames = []
@@ -372,7 +374,7 @@ async def confirm_and_activation(dut):
     tb = TB(dut)
     mt = tb.mt
     for conf in (2, 3):
-        p = TrackParams(max_jump_q=q(15), hold_jump_q=q(4), hold_off_frames=4, vel_shift=2,
+        p = TrackParams(max_jump_q=q(15), gate_step_q=q(1), hold_off_frames=4, vel_shift=2,
                         on_threshold=2500, confirm_frames=conf, max_touches=mt)
         tb.set_params(p)
         await tb.reset()
@@ -401,23 +403,25 @@ async def confirm_and_activation(dut):
 @cocotb.test()
 async def gate_boundaries(dut):
     """The match gates include their bound: a touch exactly max_jump (L1, Q8.8) from a
-    contact seen last frame, or exactly hold_jump from one in hold-off, continues it; one
-    unit farther starts a new contact.  No velocity (max_speed 0): the prediction is the
-    last position, so the distances are exact."""
+    contact seen last frame continues it, one unit farther starts a new contact; the gate
+    of a contact missed for m frames is max_jump + m gate_step, exactly (one unit farther:
+    a new contact, at the bound: a move).  No velocity (max_speed 0): the prediction is
+    the last position, so the distances are exact."""
     tb = TB(dut)
-    mj, hj = 300, 100
-    p = TrackParams(max_jump_q=mj, hold_jump_q=hj, hold_off_frames=3, vel_shift=0,
+    mj, st = 300, 40
+    p = TrackParams(max_jump_q=mj, gate_step_q=st, hold_off_frames=6, vel_shift=0,
                     max_speed_v=0, max_touches=tb.mt)
     tb.set_params(p)
     await tb.reset()
-    x0, y0 = 2000, 1500
-    frames = [[Touch(x0, y0, 3000)],
-              [Touch(x0 + mj - 40, y0 + 40, 3000)],           # D = max_jump: move
-              [Touch(x0 + 2 * mj - 40 + 1, y0 + 40, 3000)],   # D = max_jump + 1: new
-              [],                                             # both in hold-off
-              [Touch(x0 + 2 * mj - 39 + hj - 30, y0 + 70, 3000)],   # D = hold_jump: move
-              [],
-              [Touch(x0 + 2 * mj - 39 + 2 * hj - 30 + 1, y0 + 70, 3000)]]  # hold_jump + 1
+    a0 = (2000, 1500)
+    a1 = (a0[0] + mj - 40, a0[1] + 40)                  # D = max_jump from a0
+    b0 = (a1[0] + mj + 1 - 40, a1[1] + 40)              # D = max_jump + 1 from a1
+    frames = [[Touch(*a0, 3000)],
+              [Touch(*a1, 3000)],                       # move
+              [Touch(*b0, 3000)],                       # new B; A missed once
+              [],                                       # A missed twice, B once
+              [Touch(b0[0], b0[1] + mj + st + 1, 3000)],  # B's gate + 1: new C; B missed twice
+              [Touch(b0[0] + mj + 2 * st, b0[1], 3000)]]  # B's gate (mj + 2 st): move
     n0 = len(tb.events)
     await run_frames(tb, p, frames)
     per = {}
@@ -430,9 +434,10 @@ async def gate_boundaries(dut):
     assert [t for _, t in per[2]] == [new] and per[2][0][0] != first_id, \
         f"D = max_jump + 1 must not match: {per[2]}"
     second_id = per[2][0][0]
-    assert (second_id, move) in per[4], f"D = hold_jump (in hold-off) must match: {per[4]}"
-    assert any(t == new for _, t in per[6]) and (second_id, move) not in per[6], \
-        f"D = hold_jump + 1 must not match: {per[6]}"
+    assert [t for _, t in per[4]] == [new] and per[4][0][0] not in (first_id, second_id), \
+        f"D = max_jump + gate_step + 1 after one missed frame must not match: {per[4]}"
+    assert per[5] == [(second_id, move)], \
+        f"D = max_jump + 2 gate_step after two missed frames must match: {per[5]}"
 
 
 @cocotb.test()
@@ -485,7 +490,7 @@ async def match_timing(dut):
     line, all touches left of it), MT(MT-1)/2 stale picks."""
     tb = TB(dut)
     mt = tb.mt
-    p = TrackParams(max_jump_q=0xFFFF, hold_jump_q=0xFFFF, hold_off_frames=2, vel_shift=3,
+    p = TrackParams(max_jump_q=0xFFFF, gate_step_q=0xFFFF, hold_off_frames=2, vel_shift=3,
                     max_touches=mt)
     tb.set_params(p)
     for n in sorted({1, min(3, mt), mt}):

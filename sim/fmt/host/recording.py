@@ -72,7 +72,7 @@ def settings_from_registers(regs: dict, cfg) -> tuple[dict, bool]:
     if cfg is not None:
         m = max(1, int(regs.get("WINDOWS_M", 1)))
         tp = TrackParams.from_settings(cfg, st, cfg.window_s * m)
-        want = {"TRACK_MAX_JUMP": tp.max_jump_q, "TRACK_HOLD_JUMP": tp.hold_jump_q,
+        want = {"TRACK_MAX_JUMP": tp.max_jump_q, "TRACK_GATE_STEP": tp.gate_step_q,
                 "TRACK_HOLD_OFF": tp.hold_off_frames, "TRACK_VEL_SHIFT": tp.vel_shift,
                 "TRACK_MAX_SPEED": tp.max_speed_v}
         exact = all(int(regs.get(k, v)) == v for k, v in want.items())
