@@ -260,3 +260,20 @@ def test_fixed_vs_float_edges():
             fl = interp.interp_float(cand(z, row=3, col=4, missing=missing), CFG, moore=moore)
             assert fx.flags == fl.flags
             assert abs(fx.x / 256 - fl.x) <= 2.5 / 256 and abs(fx.y / 256 - fl.y) <= 2.5 / 256
+
+
+def test_edge_accuracy_tool_geometry():
+    """scripts/edge_accuracy.py (issue #11 item 6) places its fingers where it says: an
+    8 mm finger centred on the edge electrode (2.5 mm inside the border) is reported
+    there (within 0.3 mm) at the edge, the top and in the corner, and one 1 mm inside
+    is found in all three places (its error is what the tool measures)."""
+    import importlib.util
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[2] / "scripts" / "edge_accuracy.py"
+    spec = importlib.util.spec_from_file_location("edge_accuracy", path)
+    ea = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ea)
+    centred = ea.errors(8.0, 2.5)
+    assert all(v is not None and v <= 0.3 for v in centred.values()), centred
+    near = ea.errors(8.0, 1.0)
+    assert all(v is not None and v <= 5.0 for v in near.values()), near
