@@ -7,7 +7,7 @@
 // 32 bits, a register of width w uses bits w-1..0 (other bits read 0).  Unmapped
 // addresses read 0 and ignore writes.  Window/strobe ports are combinational decodes
 // of the (registered) bus signals.  Reset values are those of docs/REGISTERS.md.
-// Register map id 0xDA06.
+// Register map id 0xB198.
 `default_nettype none
 
 module fmt_regfile (
@@ -208,8 +208,8 @@ module fmt_regfile (
             touch_threshold_o <= 16'h07D0;
             touch_mode_o <= 3'h3;
             contact_limit_o <= 5'h10;
-            track_max_jump_o <= 16'h00B8;
-            track_gate_step_o <= 16'h0003;
+            track_max_jump_o <= 16'h00B9;
+            track_gate_step_o <= 16'h0004;
             track_hold_off_o <= 12'h021;
             track_vel_shift_o <= 4'h8;
             track_max_speed_o <= 21'h000F19;

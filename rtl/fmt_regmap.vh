@@ -3,5 +3,5 @@
 // the default of fmt_core's REGMAP_ID (reported by the INFO command).
 `ifndef FMT_REGMAP_VH
 `define FMT_REGMAP_VH
-`define FMT_REGMAP_ID 16'hDA06
+`define FMT_REGMAP_ID 16'hB198
 `endif

@@ -119,11 +119,11 @@ REGISTERS: list[Reg] = [
       SETTINGS.max_touches if SETTINGS.max_touches is not None else CFG.max_touches,
       "Contact limit per frame, <= MAX_TOUCHES (limit_i)."),
     R("TRACK_MAX_JUMP", 0x023, 16, "rw", _TRACK.max_jump_q,
-      f"Tracker L1 gate of a contact seen last frame, cells Q8.8 (default: 2 x {SETTINGS.max_speed_mm_s} "
-      f"mm/s x one window + {SETTINGS.position_noise_mm} mm, times sqrt 2, rounded up; max_jump_i)."),
+      f"Tracker L1 gate of a contact seen last frame, cells Q8.8 (default: (2 + sqrt 2) x {SETTINGS.max_speed_mm_s} "
+      f"mm/s x one window + sqrt 2 x {SETTINGS.position_noise_mm} mm, rounded up; max_jump_i)."),
     R("TRACK_GATE_STEP", 0x024, 16, "rw", _TRACK.gate_step_q,
-      "Growth of a contact's L1 gate per frame it is missed, cells Q8.8 (default: 2 x the "
-      "maximum speed x one window, times sqrt 2, rounded up; gate_step_i)."),
+      "Growth of a contact's L1 gate per frame it is missed, cells Q8.8 (default: (2 + sqrt 2) "
+      "x the maximum speed x one window, rounded up; gate_step_i)."),
     R("TRACK_HOLD_OFF", 0x025, _HOLD_W, "rw", _TRACK.hold_off_frames,
       f"Frames a missing contact keeps its ID (default {SETTINGS.hold_off_us} us; hold_off_i)."),
     R("TRACK_VEL_SHIFT", 0x026, 4, "rw", _TRACK.vel_shift,

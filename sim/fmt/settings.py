@@ -55,22 +55,22 @@ class TouchSettings:
     def converted(self, cfg: SensorConfig, frame_period_s: float) -> dict:
         """Tracking settings in cells (Q8.8 integers) and frames.
 
-        The match gate is physical: a finger moves at most ``max_speed_mm_s`` x T per
-        frame of T s, and the prediction it is compared with (last position plus the
-        estimated velocity, itself clamped to that speed) may be off by as much in the
-        other direction, so after one frame a finger is within r1 = 2 v T +
-        ``position_noise_mm`` of its prediction, and each further frame it is missed
-        adds 2 v T.  The tracker's distance is L1 (|dx| + |dy| <= sqrt(2) r), so the
-        gates are ``max_jump_q`` = ceil(sqrt(2) r1) and ``gate_step_q`` = ceil(sqrt(2)
-        2 v T), in Q8.8 cells, rounded up (each is a bound), at most 0xFFFF."""
+        The match gate is physical, in the tracker's L1 distance (|dx| + |dy|): in a
+        frame of T s a finger moves at most v T (v = ``max_speed_mm_s``), sqrt(2) v T in
+        L1, and its prediction moves by the estimated velocity, clamped to v per axis,
+        at most 2 v T in L1; the position noise r adds at most sqrt(2) r.  So a finger
+        seen last frame is within ``max_jump_q`` = ceil((2 + sqrt 2) v T + sqrt(2) r)
+        of its prediction, and each further frame it is missed adds ``gate_step_q`` =
+        ceil((2 + sqrt 2) v T), both in Q8.8 cells, rounded up (bounds), at most
+        0xFFFF."""
         cell = cfg.pitch_mm
         q = 1 << cfg.frac_bits
         frames = lambda us: max(1, int(round(us * 1e-6 / frame_period_s)))
-        step_mm = 2.0 * self.max_speed_mm_s * frame_period_s
-        l1 = lambda mm: min(0xFFFF, math.ceil(math.sqrt(2.0) * mm / cell * q - 1e-9))
+        step_l1 = (2.0 + math.sqrt(2.0)) * self.max_speed_mm_s * frame_period_s
+        cells = lambda mm: min(0xFFFF, math.ceil(mm / cell * q - 1e-9))
         return {
-            "max_jump_q": l1(step_mm + self.position_noise_mm),
-            "gate_step_q": l1(step_mm),
+            "max_jump_q": cells(step_l1 + math.sqrt(2.0) * self.position_noise_mm),
+            "gate_step_q": cells(step_l1),
             "hold_off_frames": frames(self.hold_off_us),
             "velocity_window_frames": frames(self.velocity_window_us),
             "max_speed_q_per_frame": int(round(self.max_speed_mm_s * frame_period_s / cell * q)),

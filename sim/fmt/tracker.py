@@ -127,8 +127,8 @@ def as_touch(t) -> Touch:
 @dataclass(frozen=True)
 class TrackParams:
     """Tracker settings in RTL units (all integers; the RTL's run-time inputs)."""
-    max_jump_q: int = 184          # L1 gate of a contact seen last frame (Q8.8 cells)
-    gate_step_q: int = 3           # the gate's growth per frame missed (Q8.8 cells, L1)
+    max_jump_q: int = 185          # L1 gate of a contact seen last frame (Q8.8 cells)
+    gate_step_q: int = 4           # the gate's growth per frame missed (Q8.8 cells, L1)
     hold_off_frames: int = 33      # a contact missing this many frames is lifted
     vel_shift: int = 8             # S: velocity filter gain 2^-S (<= vel_frac)
     max_speed_v: int = 3865        # velocity clamp per axis, units 2^-(8+VF) cells/frame

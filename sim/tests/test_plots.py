@@ -86,7 +86,7 @@ def test_animated_gif(tmp_path):
     hm = np.rint(hm).astype(np.int64)
     # new contacts reported at once (no confirmation frame): frame 0 has the finger; it
     # moves a cell (5 mm) a frame, which a finger can at frames of 64 windows (0.39 ms:
-    # the tracker's gate is 6.9 mm there, 3.6 mm at one window)
+    # the tracker's gate is 7.6 mm there, 3.6 mm at one window)
     evs = process_frames(hm, cfg, TouchSettings(confirm_frames=1), fixed=True,
                          frame_period_s=64 * cfg.window_s)
     path = plots.animation_gif(hm, evs, cfg, tmp_path / "run.gif", fps=10)

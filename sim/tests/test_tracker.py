@@ -31,11 +31,12 @@ def run(frames, p):
 
 def test_conversion_defaults():
     p = TrackParams.from_settings(CFG, TouchSettings())
-    # gates (issue #11 item 1): 2 x 3 m/s x 6.144 us = 0.036864 mm a frame; + 2.5 mm of
-    # noise = 2.536864 mm, x sqrt 2 = 3.5877 mm L1 = 183.69 Q8.8 units of a 5 mm cell ->
-    # 184; the step 0.036864 x sqrt 2 / 5 x 256 = 2.67 -> 3 (rounded up: bounds)
-    assert p.max_jump_q == 184 and p.gate_step_q == 3
-    assert (TrackParams().max_jump_q, TrackParams().gate_step_q) == (184, 3)
+    # gates (issue #11 item 1), L1: (2 + sqrt 2) x 3 m/s x 6.144 us = 0.062928 mm a frame
+    # (the finger sqrt 2 v T, its prediction 2 v T); + sqrt 2 x 2.5 mm of noise = 3.598481
+    # mm = 184.24 Q8.8 units of a 5 mm cell -> 185; the step 0.062928 / 5 x 256 = 3.22 -> 4
+    # (rounded up: bounds)
+    assert p.max_jump_q == 185 and p.gate_step_q == 4
+    assert (TrackParams().max_jump_q, TrackParams().gate_step_q) == (185, 4)
     assert p.hold_off_frames == 33
     assert p.vel_shift == 8                       # 326 frames -> 2^8
     # 3 m/s = 18.4 um/frame = 0.94 Q8.8 units = 3865 units of 2^-20 cells
