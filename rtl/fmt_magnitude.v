@@ -113,15 +113,16 @@ module fmt_magnitude #(
         for (i = 0; i < ITER; i = i + 1) begin : g_iter
             wire signed [IW-1:0] xs = x_q[i] >>> i;
             wire signed [IW-1:0] ys = y_q[i] >>> i;
+            // one adder per word: y < 0 rotates counter-clockwise (x -= ys, y += xs),
+            // y >= 0 clockwise (x += ys, y -= xs); a subtraction adds the inverted
+            // operand plus a carry in (not an adder and a subtractor behind a mux)
+            wire                 neg = y_q[i][IW-1];
+            wire [IW-1:0]        x_n = x_q[i] + (ys ^ {IW{neg}}) + {{(IW-1){1'b0}}, neg};
+            wire [IW-1:0]        y_n = y_q[i] + (xs ^ {IW{~neg}}) + {{(IW-1){1'b0}}, ~neg};
             always @(posedge clk) begin
                 if (ce) begin
-                    if (y_q[i][IW-1]) begin        // y < 0: rotate counter-clockwise
-                        x_q[i+1] <= x_q[i] - ys;
-                        y_q[i+1] <= y_q[i] + xs;
-                    end else begin                 // y >= 0: rotate clockwise
-                        x_q[i+1] <= x_q[i] + ys;
-                        y_q[i+1] <= y_q[i] - xs;
-                    end
+                    x_q[i+1] <= x_n;
+                    y_q[i+1] <= y_n;
                     t_q[i+1] <= t_q[i];
                 end
             end

@@ -43,6 +43,12 @@ MUTATIONS = {
         "x_fin} << (GAIN_BITS - 1)) + round_w - 1'b1;",
         "fmt_magnitude/test_fmt_magnitude.py::test_fmt_magnitude[icarus-19]",
         "CORDIC gain compensation rounded half up"),
+    "magnitude_cordic_no_carry": (
+        "rtl/fmt_magnitude.v",
+        "x_n = x_q[i] + (ys ^ {IW{neg}}) + {{(IW-1){1'b0}}, neg};",
+        "x_n = x_q[i] + (ys ^ {IW{neg}});",
+        "fmt_magnitude/test_fmt_magnitude.py::test_fmt_magnitude[icarus-19]",
+        "a CORDIC subtraction adds the inverted operand plus one (x - ys exactly)"),
     "dds_negative_rounding": (
         "rtl/fmt_dds_chan.v",
         "rnd_w = (SH > 0) ? HALF - {{(PW - 1){1'b0}}, sg2_q} : {PW{1'b0}};",
