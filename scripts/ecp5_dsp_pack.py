@@ -15,7 +15,10 @@ Rules (the netlist is Yosys's JSON, the top module only):
 * operands: every non-constant bit of A0..A17 and of B0..B17 comes from the Q of a
   TRELLIS_FF; those flip-flops share one clock (CLKMUX "CLK"), one clock enable (CEMUX
   "CE" with the same net, or "1": none) per operand, no set / reset (LSR constant 0) and
-  GSR "DISABLED".  Then the pins take the flip-flops' D nets and REG_INPUTA_* /
+  GSR "DISABLED", and none is loaded straight from a RAM's read data (a block RAM's
+  clock-to-out, ~4.1 ns without its output register, and the route to the DSP column
+  would then share one cycle: the flip-flop stays, as the RAM's output register).  Then
+  the pins take the flip-flops' D nets and REG_INPUTA_* /
   REG_INPUTB_* use CLK0 and CE0 / CE1; a flip-flop whose Q is left without a user is
   deleted (one shared by several multipliers is thus copied into each of them, as a
   vendor tool does).  nextpnr's timing model has a class for both operands registered,
@@ -44,6 +47,7 @@ from pathlib import Path
 A_BITS = [f"A{i}" for i in range(18)]
 B_BITS = [f"B{i}" for i in range(18)]
 P_BITS = [f"P{i}" for i in range(36)]
+RAM_TYPES = ("DP16KD", "PDPW16KD", "TRELLIS_DPR16X4")
 
 
 def _s(v) -> str:
@@ -113,6 +117,12 @@ def pack(nl: dict, top: str | None = None) -> dict:
                         continue
                     d = drv.get(b)
                     if d is None or d[1] != "Q" or d[0] in removed or not _ff_ok(cells[d[0]]):
+                        return None
+                    # a flip-flop loaded from a block RAM's read port stays in the fabric:
+                    # moved into the multiplier, the RAM's slow clock-to-out (~4.1 ns, no
+                    # output register) and the route to the DSP column would share a cycle
+                    dd = drv.get(cells[d[0]]["connections"]["DI"][0])
+                    if dd is not None and cells[dd[0]]["type"] in RAM_TYPES:
                         return None
                     fclk, fce = _ff_clk_ce(cells[d[0]])
                     if clk is not None and fclk != clk:

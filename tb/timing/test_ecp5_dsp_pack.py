@@ -175,3 +175,31 @@ def test_pack_refuses_reset_and_signed_pins():
     st = ecp5_dsp_pack.pack(nl)
     assert st["packed_out"] == 1 and "r" not in nl["modules"]["t"]["cells"]
     assert nl["modules"]["t"]["cells"]["m"]["connections"]["P0"] == [200]
+
+
+def test_pack_keeps_ram_output_register():
+    """An operand flip-flop loaded from a block RAM's read data stays in the fabric (the
+    RAM's output register); so does the other operand (both or neither)."""
+    ff = {"CEMUX": "1 ", "CLKMUX": "CLK", "GSR": "DISABLED", "LSRMUX": "LSR", "REGSET": "RESET"}
+    ffdir = {"CLK": "input", "DI": "input", "LSR": "input", "Q": "output"}
+    cells = {
+        "m": {"type": "MULT18X18D", "parameters": {},
+              "port_directions": {**{f"A{i}": "input" for i in range(18)},
+                                  **{f"B{i}": "input" for i in range(18)},
+                                  **{f"P{i}": "output" for i in range(36)}},
+              "connections": {**{f"A{i}": [10] for i in range(18)},
+                              **{f"B{i}": [11] for i in range(18)},
+                              **{f"P{i}": ["x"] for i in range(36)}}},
+        "ra": {"type": "TRELLIS_FF", "parameters": ff, "port_directions": ffdir,
+               "connections": {"CLK": [2], "DI": [20], "LSR": ["0"], "Q": [10]}},
+        "rb": {"type": "TRELLIS_FF", "parameters": ff, "port_directions": ffdir,
+               "connections": {"CLK": [2], "DI": [21], "LSR": ["0"], "Q": [11]}},
+        "ram": {"type": "DP16KD", "parameters": {}, "port_directions": {"DOA0": "output"},
+                "connections": {"DOA0": [20]}}}
+    nl = {"modules": {"t": {"attributes": {"top": "1"}, "cells": cells}}}
+    st = ecp5_dsp_pack.pack(nl)
+    assert st["packed_in"] == 0 and "ra" in cells and "rb" in cells
+    cells["ram"]["connections"]["DOA0"] = [99]              # no longer the RAM's data
+    st = ecp5_dsp_pack.pack(nl)
+    assert st["packed_in"] == 1 and "ra" not in cells and "rb" not in cells
+    assert cells["m"]["connections"]["A0"] == [20] and cells["m"]["connections"]["B0"] == [21]
