@@ -93,6 +93,17 @@ def pack(nl: dict, top: str | None = None) -> dict:
     stats = {"mults": 0, "packed_in": 0, "packed_out": 0, "ffs_removed": 0}
     maybe_dead = set()
     removed = set()
+
+    def drop(f):
+        """Delete flip-flop f; its inputs lose it as a user."""
+        for p2, bits in cells[f]["connections"].items():
+            for bb in bits:
+                if not isinstance(bb, str) and p2 != "Q":
+                    users[bb] = [u for u in users[bb] if u[0] != f]
+        del cells[f]
+        removed.add(f)
+        stats["ffs_removed"] += 1
+
     for n in sorted(cells):
         c = cells.get(n)
         if c is None or c["type"] != "MULT18X18D":
@@ -199,14 +210,7 @@ def pack(nl: dict, top: str | None = None) -> dict:
                 con[pn] = [q]
                 drv[q] = (n, pn)
                 users.pop(dn, None)
-                # the flip-flop's own inputs lose a user
-                for p2, bits in cells[f]["connections"].items():
-                    for bb in bits:
-                        if not isinstance(bb, str) and p2 != "Q":
-                            users[bb] = [u for u in users[bb] if u[0] != f]
-                del cells[f]
-                removed.add(f)
-                stats["ffs_removed"] += 1
+                drop(f)
             wire("CE2", oce)
             par["REG_OUTPUT_CLK"] = "CLK0"
             par["REG_OUTPUT_CE"] = "CE2"
@@ -216,16 +220,8 @@ def pack(nl: dict, top: str | None = None) -> dict:
     for f in sorted(maybe_dead):
         if f in removed or f not in cells:
             continue
-        q = cells[f]["connections"]["Q"][0]
-        if users.get(q):
-            continue
-        for p2, bits in cells[f]["connections"].items():
-            for bb in bits:
-                if not isinstance(bb, str) and p2 != "Q":
-                    users[bb] = [u for u in users[bb] if u[0] != f]
-        del cells[f]
-        removed.add(f)
-        stats["ffs_removed"] += 1
+        if not users.get(cells[f]["connections"]["Q"][0]):
+            drop(f)
     # nets named in netnames but no longer driven are harmless for nextpnr (it builds nets
     # from the cells' connections)
     return stats
