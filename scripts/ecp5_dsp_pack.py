@@ -75,8 +75,10 @@ def _ff_clk_ce(c: dict):
 def pack(nl: dict, top: str | None = None) -> dict:
     """Pack in place; returns counts {mults, packed_in, packed_out, ffs_removed}."""
     if top is None:
-        top = next(n for n, m in nl["modules"].items()
-                   if int(m.get("attributes", {}).get("top", "0") or 0))
+        top = next((n for n, m in nl.get("modules", {}).items()
+                    if int(m.get("attributes", {}).get("top", "0") or 0)), None)
+        if top is None:
+            raise ValueError("no module marked top in the netlist")
     cells = nl["modules"][top]["cells"]
     drv: dict = {}
     users: dict = defaultdict(list)
@@ -238,7 +240,11 @@ def main(argv=None) -> int:
     except (OSError, ValueError) as e:
         print(f"ecp5_dsp_pack: cannot read {p}: {e}", file=sys.stderr)
         return 2
-    st = pack(nl)
+    try:
+        st = pack(nl)
+    except (ValueError, KeyError, TypeError, AttributeError) as e:
+        print(f"ecp5_dsp_pack: {p} is not a synth_ecp5 netlist: {e}", file=sys.stderr)
+        return 2
     out = Path(a.out) if a.out else p
     tmp = out.with_suffix(out.suffix + ".tmp")
     tmp.write_text(json.dumps(nl))

@@ -203,3 +203,15 @@ def test_pack_keeps_ram_output_register():
     st = ecp5_dsp_pack.pack(nl)
     assert st["packed_in"] == 1 and "ra" not in cells and "rb" not in cells
     assert cells["m"]["connections"]["A0"] == [20] and cells["m"]["connections"]["B0"] == [21]
+
+
+def test_cli_refuses_a_bad_netlist(tmp_path, capsys):
+    """One line and exit status 2 for a file that is not JSON or has no top module; the
+    file is left as it was."""
+    bad = tmp_path / "bad.json"
+    for text in ("not json", '{"modules": {}}'):
+        bad.write_text(text)
+        assert ecp5_dsp_pack.main([str(bad)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("ecp5_dsp_pack: ")
+        assert bad.read_text() == text
