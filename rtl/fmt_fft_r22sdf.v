@@ -80,9 +80,6 @@ module fmt_fft_r22sdf #(
     input  wire signed [IN_W-1:0] in_re_i,   // input, real part (natural order)
     input  wire signed [IN_W-1:0] in_im_i,   // input, imaginary part
     output wire                 out_valid_o, // 1 on the ce cycles that carry an output
-    output wire                 out_pend_o,  // an output is presented (out_valid_o before its
-                                             // ce gate: out_valid_o = out_pend_o & ce), for a
-                                             // user that ANDs it with its own copy of ce
     output wire [LOG2_N-1:0]    out_slot_o,  // position in the output window, 0..N-1
     output wire [LOG2_N-1:0]    out_bin_o,   // natural bin index = bit-reversed slot
     output wire signed [OUT_W-1:0] out_re_o, // X[bin] * 2^-SHIFT, real part
@@ -288,7 +285,6 @@ module fmt_fft_r22sdf #(
     assign out_ch_o  = och_q;
 
     assign out_valid_o = out_valid_q & ce;
-    assign out_pend_o  = out_valid_q;
     assign ovf_o       = (|bus_ovf) | out_ovf;
 
 endmodule

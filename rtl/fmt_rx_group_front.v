@@ -77,10 +77,7 @@ module fmt_rx_group_front #(
     // ---- capture (on ce) and step sequencer ----
     reg [2*NP*ADC_BITS-1:0] cap_q;
     reg                     sign_q;
-    reg                     run_q;       // the engine steps this clk (the FFT's ce)
-    // run_q's copy for the FFT output side (f_valid, the window bookkeeping, the split):
-    // run_q reaches every register of the engine and is routed across it
-    (* keep *) reg          run_o_q;
+    reg                     run_q;       // the engine steps this clk
     reg [CH_W-1:0]          ch_q;        // channel (pair) of this step
 
     always @(posedge clk) begin
@@ -93,21 +90,15 @@ module fmt_rx_group_front #(
     always @(posedge clk) begin
         if (rst) begin
             run_q     <= 1'b0;
-            run_o_q   <= 1'b0;
             ch_q      <= {CH_W{1'b0}};
             seq_ovf_o <= 1'b0;
         end else if (ce) begin
-            run_q   <= 1'b1;
-            run_o_q <= 1'b1;
-            ch_q    <= {CH_W{1'b0}};
+            run_q <= 1'b1;
+            ch_q  <= {CH_W{1'b0}};
             if (run_q && ch_q != CH_LAST) seq_ovf_o <= 1'b1;
         end else if (run_q) begin
-            if (ch_q == CH_LAST) begin
-                run_q   <= 1'b0;
-                run_o_q <= 1'b0;
-            end else begin
-                ch_q <= ch_q + 1'b1;
-            end
+            if (ch_q == CH_LAST) run_q <= 1'b0;
+            else                 ch_q  <= ch_q + 1'b1;
         end
     end
 
@@ -137,11 +128,7 @@ module fmt_rx_group_front #(
     wire signed [XW-1:0] xb    = sign_q ? -ext_b : ext_b;
 
     // ---- FFT: G channels ----
-    wire                f_pend;          // the FFT presents an output (before the ce gate)
-    wire                f_valid = f_pend & run_o_q;   // = the FFT's out_valid_o
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire                f_valid_ce;      // the FFT's out_valid_o (from run_q): equal to f_valid
-    /* verilator lint_on UNUSEDSIGNAL */
+    wire                f_valid;
     wire [LOG2_N-1:0]   f_slot, f_bin;
     wire [CH_W-1:0]     f_ch;
     wire signed [W-1:0] f_re, f_im;
@@ -150,15 +137,8 @@ module fmt_rx_group_front #(
         .BRAM_MIN(FFT_BRAM_MIN)
     ) u_fft (
         .clk(clk), .rst(rst), .ce(run_q), .in_re_i(xa), .in_im_i(xb),
-        .out_valid_o(f_valid_ce), .out_pend_o(f_pend), .out_slot_o(f_slot), .out_bin_o(f_bin),
+        .out_valid_o(f_valid), .out_slot_o(f_slot), .out_bin_o(f_bin),
         .out_re_o(f_re), .out_im_o(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
-
-    // synthesis translate_off
-    always @(posedge clk) begin
-        if (!rst && f_valid !== f_valid_ce)
-            $display("%m: ERROR: run_o_q differs from run_q at %0t", $time);
-    end
-    // synthesis translate_on
 
     // ---- window / frame bookkeeping (at the FFT output; channel 0 opens a window) ----
     wire                 new_win = f_valid && (f_slot == {LOG2_N{1'b0}}) && (f_ch == {CH_W{1'b0}});

@@ -78,14 +78,11 @@ module fmt_rx_pair_front #(
     wire [LOG2_N-1:0]   f_slot, f_bin;
     wire signed [W-1:0] f_re, f_im;
     wire                f_ch;          // one channel: always 0
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire                f_pend;        // out_valid_o before its ce gate: not needed here
-    /* verilator lint_on UNUSEDSIGNAL */
     fmt_fft_r22sdf #(
         .LOG2_N(LOG2_N), .IN_W(ADC_BITS + 1), .OUT_W(W)
     ) u_fft (
         .clk(clk), .rst(fft_rst_q), .ce(ce), .in_re_i(xa), .in_im_i(xb),
-        .out_valid_o(f_valid), .out_pend_o(f_pend), .out_slot_o(f_slot), .out_bin_o(f_bin),
+        .out_valid_o(f_valid), .out_slot_o(f_slot), .out_bin_o(f_bin),
         .out_re_o(f_re), .out_im_o(f_im), .out_ch_o(f_ch), .ovf_o(fft_ovf_o));
 
     // The FFT's out_valid_o is 1 only on ce cycles: its outputs are taken on ce edges; the
