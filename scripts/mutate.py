@@ -3,7 +3,8 @@
 
 Each mutation below changes one rule of the RTL (a rounding constant, a tie order, a
 boundary, a delay) in a throwaway copy of the checkout and runs the block's own test
-(Icarus, one small parametrization).  A mutation is *caught* when that test fails.  The
+(Icarus, one small parametrization).  A mutation is *caught* when that test fails (pytest
+exit 1; a test that did not run, e.g. a node id that matches nothing, is an error).  The
 script prints one line per mutation and exits 1 if any mutation survives (the test
 missed a broken rule) or if a mutation no longer applies (its original text is not
 found exactly once: the RTL moved on and the list must follow; `sim/tests/
@@ -178,7 +179,7 @@ def main() -> int:
         return 2
     logdir = ROOT / "build" / "mutate"
     logdir.mkdir(parents=True, exist_ok=True)
-    survived, failed_base = [], []
+    survived, failed_base, errors = [], [], []
     for name in names:
         node = MUTATIONS[name][3]
         tmp = Path(tempfile.mkdtemp(prefix=f"fmt_mut_{name}_"))
@@ -194,19 +195,26 @@ def main() -> int:
                 shutil.rmtree(tmp / "build", ignore_errors=True)
             apply(tmp, name)
             rc = run_test(tmp, node, logdir / f"{name}.log")
-            verdict = "caught" if rc != 0 else "SURVIVED"
+            # pytest: 1 = a test failed; 2-5 = interrupted, internal or usage error, no
+            # test collected (e.g. a wrong node id): nothing was checked, not a catch
+            verdict = {0: "SURVIVED", 1: "caught"}.get(rc, f"ERROR({rc})")
             if rc == 0:
                 survived.append(name)
+            elif rc != 1:
+                errors.append(name)
             print(f"{name:28s} {verdict:8s} {time.time() - t0:6.0f} s  {node}", flush=True)
         finally:
             if a.keep:
                 print(f"  copy kept: {tmp}")
             else:
                 shutil.rmtree(tmp, ignore_errors=True)
-    print(f"mutate: {len(names) - len(survived) - len(failed_base)} of {len(names)} caught"
+    n_caught = len(names) - len(survived) - len(failed_base) - len(errors)
+    print(f"mutate: {n_caught} of {len(names)} caught"
           + (f"; survived: {', '.join(survived)}" if survived else "")
-          + (f"; baseline failed: {', '.join(failed_base)}" if failed_base else ""))
-    return 1 if survived or failed_base else 0
+          + (f"; baseline failed: {', '.join(failed_base)}" if failed_base else "")
+          + (f"; test did not run (see build/mutate/<name>.log): {', '.join(errors)}"
+             if errors else ""))
+    return 1 if survived or failed_base or errors else 0
 
 
 if __name__ == "__main__":
